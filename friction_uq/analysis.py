@@ -1,0 +1,141 @@
+"""The field's deterministic identification: f from eq. 17 over the stationary window, for a given nu.
+
+This is the lab's analysis (a point estimate for an assumed nu), kept as a reference and as the
+starting point of the Bayesian one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .forces import Forces, compute_forces
+from .physics import cell
+from .record import Record
+from .signals import moving_average
+from .window import (
+    StationaryData,
+    Window,
+    WindowCriterion,
+    find_stationary_window,
+    stationary_data,
+    window_from_times,
+)
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A record processed up to the stationary phase."""
+
+    record: Record
+    forces: Forces
+    window: Window
+    data: StationaryData
+
+
+def prepare(
+    record: Record,
+    *,
+    window: tuple[float, float] | None = None,
+    dispersion: bool = False,
+    criterion: WindowCriterion = WindowCriterion(),
+) -> Prepared:
+    """Forces, stationary window (automatic unless ``window`` is given, in seconds) and likelihood data."""
+    forces = compute_forces(record, dispersion=dispersion)
+    if window is None:
+        win = find_stationary_window(forces, record.apparatus, criterion)
+    else:
+        win = window_from_times(forces, *window)
+    data = stationary_data(
+        forces, record.apparatus, win, test_id=record.test_id, campaign=record.campaign,
+        striker_velocity=record.striker_velocity,
+    )
+    return Prepared(record, forces, win, data)
+
+
+@dataclass(frozen=True)
+class Identification:
+    """Deterministic results over the window (SI units); series are on ``time``."""
+
+    nu: float
+    window: tuple[float, float]
+    ratio: float
+    f: float
+    kappa: float
+    p_mean: float
+    p_mean_approx: float
+    p_min: float
+    p_max: float
+    tau_mean: float
+    V: float
+    F_io: float
+    F_eo: float
+    equilibrium_error: float
+    stationarity_error: float
+    time: np.ndarray
+    f_series: np.ndarray
+
+    def to_json(self) -> dict:
+        """The keys of ``friction-uq analyze --json`` (SI units)."""
+        return {
+            "f": self.f,
+            "f_series": {"time": self.time.tolist(), "f": self.f_series.tolist()},
+            "ratio": self.ratio,
+            "kappa": self.kappa,
+            "nu": self.nu,
+            "p_mean": self.p_mean,
+            "p_mean_approx": self.p_mean_approx,
+            "p_min": self.p_min,
+            "p_max": self.p_max,
+            "tau_mean": self.tau_mean,
+            "V": self.V,
+            "F_io": self.F_io,
+            "F_eo": self.F_eo,
+            "equilibrium_error": self.equilibrium_error,
+            "stationarity_error": self.stationarity_error,
+            "window": list(self.window),
+        }
+
+
+def identify(prepared: Prepared, *, nu: float) -> Identification:
+    """f (eq. 17), p_min, p_max (eq. 19), p_mean (eq. 20 and its approximation eq. 21), tau_mean (eq. 18), V (eq. 7).
+
+    Means are taken over the window; the ratio is the ratio of the mean forces (noise in F_io
+    would bias a mean of ratios).
+    """
+    if not 0.0 < nu < 0.5:
+        raise ValueError(f"nu must lie in (0, 0.5), got {nu!r}")
+    fo, win = prepared.forces, prepared.window
+    app = prepared.record.apparatus
+    R, L = app.sample.radius, app.sample.length
+    seg = win.slice
+    F_io = float(np.mean(fo.F_io[seg]))
+    F_eo = float(np.mean(fo.F_eo[seg]))
+    ratio = F_eo / F_io
+    f = float(cell.friction_from_ratio(ratio, nu, radius=R, length=L))
+    tau = float(cell.mean_friction_stress(F_eo, radius=R, length=L))
+    p_min = float(cell.pressure_min(F_io, nu, radius=R))
+    p_max = float(cell.pressure_max(F_io, F_eo, nu, radius=R))
+    smooth = max(1, int(round(10e-6 * prepared.record.sample_rate)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r_t = moving_average(fo.F_eo[seg], smooth) / moving_average(fo.F_io[seg], smooth)
+    return Identification(
+        nu=nu,
+        window=(win.t0, win.t1),
+        ratio=ratio,
+        f=f,
+        kappa=float(cell.kappa(f, nu)),
+        p_mean=tau / f if f > 0 else float("nan"),
+        p_mean_approx=0.5 * (p_min + p_max),
+        p_min=p_min,
+        p_max=p_max,
+        tau_mean=tau,
+        V=float(np.mean(fo.V[seg])),
+        F_io=F_io,
+        F_eo=F_eo,
+        equilibrium_error=float(np.mean(fo.equilibrium[seg])),
+        stationarity_error=float(np.mean(fo.stationarity[seg])),
+        time=np.array(fo.time[seg]),
+        f_series=np.asarray(cell.friction_from_ratio(np.clip(r_t, -0.999, None), nu, radius=R, length=L)),
+    )

@@ -1,0 +1,151 @@
+"""The ``friction-uq`` command. Thin: parse, call one library function, print or write.
+
+Every error the package raises on purpose (:class:`~friction_uq.errors.FrictionUQError`) is
+printed as one sentence on stderr with exit status 2, without a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from . import __version__
+from .errors import FrictionUQError
+
+EXIT_BAD_INPUT = 2
+
+
+def _window(text: str) -> tuple[float, float]:
+    try:
+        a, b = text.split(":")
+        return float(a), float(b)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"window {text!r} is not T0:T1 in seconds on the record's time base, e.g. 3.2e-4:4.4e-4"
+        ) from None
+
+
+def _nu(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"nu {text!r} is not a number") from None
+    if not 0.0 < v < 0.5:
+        raise argparse.ArgumentTypeError(f"nu must lie in (0, 0.5), got {v}")
+    return v
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="friction-uq",
+        description="Friction coefficient with honest uncertainty from confined friction tests on "
+        "split Hopkinson bars (Durand et al. 2016).",
+    )
+    p.add_argument("--version", action="version", version=f"friction-uq {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    s = sub.add_parser("inspect", help="summarise a test record: ids, channels, apparatus, arrivals, noise",
+                       description="Print a readable summary of a test record.")
+    s.add_argument("file", type=Path, help="test record (test.h5)")
+
+    s = sub.add_parser("analyze", help="the lab's deterministic analysis (eq. 17) for a given nu",
+                       description="Deterministic identification of f from eq. 17 over the stationary window.")
+    s.add_argument("file", type=Path, help="test record (test.h5)")
+    s.add_argument("--nu", type=_nu, default=0.4, help="sample Poisson ratio (default 0.4)")
+    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds (default: automatic)")
+    s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
+    s.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of a table")
+
+    s = sub.add_parser("design", help="draw the paper's figure 4 (p_mean and V against f) for a record",
+                       description="Design relations eq. 15-16 for a record's apparatus and striker speed.")
+    s.add_argument("file", type=Path, help="test record (test.h5)")
+    s.add_argument("-o", "--output", type=Path, required=True, help="figure file (PDF or PNG)")
+    s.add_argument("--nu", type=_nu, default=0.4, help="sample Poisson ratio (default 0.4)")
+    s.add_argument("--striker-velocity", type=float, help="m/s (default: the record's, else from the incident wave)")
+
+    s = sub.add_parser("simulate", help="simulate a whole test into a record",
+                       description="Simulate a confined friction test from a TOML configuration.")
+    s.add_argument("config", type=Path, help="simulation configuration (TOML)")
+    s.add_argument("-o", "--output", type=Path, required=True, help="record to write (test.h5)")
+    s.add_argument("--seed", type=int, help="noise seed (default: the config's)")
+
+    s = sub.add_parser("run", help="joint posterior of f and nu, uncertainty propagation, PDF report",
+                       description="The main job: sample the posterior of f and nu for one record and "
+                       "write <campaign>_<test_id>.nc, .json and .pdf.")
+    s.add_argument("file", type=Path, help="test record (test.h5)")
+    s.add_argument("--priors", type=Path, help="prior file (TOML; default: priors/<material>.toml)")
+    s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
+    s.add_argument("--seed", type=int, default=20161, help="random seed (default 20161)")
+    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds (default: automatic)")
+    s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
+    s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
+    s.add_argument("--no-pdf", action="store_true", help="skip the PDF report")
+    s.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return _dispatch(args)
+    except FrictionUQError as exc:
+        print(f"friction-uq: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("friction-uq: interrupted", file=sys.stderr)
+        return 130
+
+
+def _dispatch(args: argparse.Namespace) -> int:
+    if args.command == "inspect":
+        from .record import read_record
+        from .summary import inspect_text
+
+        print(inspect_text(read_record(args.file)))
+        return 0
+    if args.command == "analyze":
+        from .analysis import identify, prepare
+        from .record import read_record
+        from .summary import identification_table
+
+        rec = read_record(args.file)
+        ident = identify(prepare(rec, window=args.window, dispersion=args.dispersion), nu=args.nu)
+        if args.json:
+            out = ident.to_json()
+            out["test_id"], out["campaign"] = rec.test_id, rec.campaign
+            print(json.dumps(out))
+        else:
+            print(identification_table(rec, ident))
+        return 0
+    if args.command == "design":
+        from .record import read_record
+        from .report.design_figure import design_figure
+
+        rec = read_record(args.file)
+        path = design_figure(rec, args.output, nu=args.nu, striker_velocity=args.striker_velocity)
+        print(f"wrote {path}")
+        return 0
+    if args.command == "simulate":
+        from .simulate import load_config, simulate_to_file
+
+        cfg = load_config(args.config)
+        path = simulate_to_file(cfg, args.output, seed=args.seed)
+        print(f"wrote {path}")
+        return 0
+    if args.command == "run":
+        from .run import run_file
+
+        run_file(
+            args.file, priors_path=args.priors, out_dir=args.out, seed=args.seed, window=args.window,
+            dispersion=args.dispersion, hoop=not args.no_hoop, pdf=not args.no_pdf, progress=not args.quiet,
+        )
+        return 0
+    raise AssertionError(args.command)  # argparse restricts the choices
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,183 @@
+"""From a record to interface waves, forces and velocities (eq. 2-7), with each channel's noise.
+
+Steps, per channel:
+
+1. baseline offset, noise standard deviation and lag-1 autocorrelation from the pre-pulse
+   segment (:func:`friction_uq.signals.prepulse_noise`), offset removed;
+2. waves separated and transported to the bar end touching the cell: on the input bar the
+   incident wave (from its arrival until the reflected wave reaches the gauge, 2 d / c later)
+   forward by d, the reflected wave back by d; on the output bars the transmitted wave back by d;
+3. each transported wave is valid until the first reflection from the bar's far (free) end
+   reaches the gauge; outside its validity a wave is set to NaN, so nothing downstream mistakes a
+   far-end echo for cell physics;
+4. forces and velocities by eq. 2-4, sliding velocity (eq. 7), equilibrium (eq. 5) and
+   stationarity (eq. 6) indicators.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .physics import bars as eq
+from .record import Bar, Record
+from .signals import NoiseEstimate, prepulse_noise, transport, window_mask
+
+
+@dataclass(frozen=True)
+class ChannelInfo:
+    """What the processing found on one channel (indices are fractional samples)."""
+
+    name: str
+    noise: NoiseEstimate
+    arrival: float
+    valid_until: float
+
+
+@dataclass(frozen=True)
+class Forces:
+    """Interface waves, forces (N) and velocities (m/s) on the record's time base.
+
+    Arrays are NaN where no valid wave is available.
+    """
+
+    time: np.ndarray
+    eps_incident: np.ndarray
+    eps_reflected: np.ndarray
+    eps_internal: np.ndarray
+    eps_external: np.ndarray
+    hoop: np.ndarray | None
+    F_i: np.ndarray
+    F_io: np.ndarray
+    F_eo: np.ndarray
+    V_i: np.ndarray
+    V_io: np.ndarray
+    V_eo: np.ndarray
+    channels: dict[str, ChannelInfo] = field(default_factory=dict)
+    dispersion: bool = False
+
+    @property
+    def V(self) -> np.ndarray:
+        """Sliding velocity V = V_io - V_eo (m/s). Eq. 7."""
+        return eq.sliding_velocity(self.V_io, self.V_eo)
+
+    @property
+    def ratio(self) -> np.ndarray:
+        """F_eo / F_io."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return self.F_eo / self.F_io
+
+    @property
+    def equilibrium(self) -> np.ndarray:
+        """(F_i - F_io - F_eo) / F_i. Eq. 5."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return eq.equilibrium_error(self.F_i, self.F_io, self.F_eo)
+
+    @property
+    def stationarity(self) -> np.ndarray:
+        """(V_i - V_io) / V_i. Eq. 6."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return eq.stationarity_error(self.V_i, self.V_io)
+
+    @property
+    def loading_start(self) -> float:
+        """Time (s) the incident wave reaches the plug."""
+        return float(np.interp(self.channels["incident"].arrival, np.arange(len(self.time)), self.time))
+
+    def force_noise_sd(self, bar: Bar, channel: str) -> float:
+        """Noise standard deviation of a transmitted force, A E sd(strain) (N)."""
+        return bar.area * bar.young_modulus * self.channels[channel].noise.sd
+
+
+def _transported(x: np.ndarray, bar: Bar, distance: float, dt: float, dispersion: bool) -> np.ndarray:
+    return transport(
+        x,
+        sample_interval=dt,
+        distance=distance,
+        wave_speed=bar.wave_speed,
+        diameter=bar.outer_diameter,
+        inner_diameter=bar.inner_diameter,
+        poisson_ratio=bar.poisson_ratio,
+        dispersion=dispersion,
+    )
+
+
+def compute_forces(record: Record, *, dispersion: bool = False) -> Forces:
+    """Transport the waves of a record to the cell and compute eq. 2-7.
+
+    Parameters
+    ----------
+    record
+        A record read by :func:`friction_uq.record.read_record`.
+    dispersion
+        Apply the Pochhammer-Chree correction on the solid bars (and the Love estimate on the
+        hollow external bar) when transporting; off by default.
+    """
+    app = record.apparatus
+    dt = record.sample_interval
+    n = record.n_samples
+    fs = record.sample_rate
+    span = int(app.pulse_duration * fs / 2)
+    info: dict[str, ChannelInfo] = {}
+
+    # --- input bar: incident then reflected on one gauge
+    ib = app.input_bar
+    x = record.strain("input_bar")
+    noise_in, arr_inc = prepulse_noise(x, span=span, polarity=+1)
+    y = x - noise_in.offset
+    sep = arr_inc + 2.0 * ib.gauge_delay * fs  # reflected wave's front at the gauge
+    margin = 0.02 * app.pulse_duration * fs
+    echo = arr_inc + 2.0 * ib.length / ib.wave_speed * fs  # far-end echo of the reflected wave
+    inc = np.where(window_mask(n, 0, sep - margin), y, 0.0)
+    ref = np.where(window_mask(n, sep - margin, echo - margin), y, 0.0)
+    eps_i = _transported(inc, ib, +ib.gauge_distance, dt, dispersion)
+    eps_r = _transported(ref, ib, -ib.gauge_distance, dt, dispersion)
+    d_in = ib.gauge_delay * fs
+    valid_until_in = min(echo - d_in, sep + d_in) - margin  # far-end echo, end of the incident window
+    valid_in = window_mask(n, arr_inc + d_in - margin, valid_until_in)
+    eps_i = np.where(valid_in, eps_i, np.nan)
+    eps_r = np.where(valid_in, eps_r, np.nan)
+    info["incident"] = ChannelInfo("incident", noise_in, arr_inc + d_in, valid_until_in)
+    info["input_bar"] = ChannelInfo("input_bar", noise_in, arr_inc, echo - margin)
+
+    # --- output bars: transmitted waves, back by their gauge distance
+    out: dict[str, np.ndarray] = {}
+    for name in ("internal_output_bar", "external_output_bar"):
+        bar = app.bars[name]
+        x = record.strain(name)
+        nz, arr = prepulse_noise(x, span=span, polarity=+1)
+        d = bar.gauge_delay * fs
+        echo = arr + 2.0 * (bar.length - bar.gauge_distance) / bar.wave_speed * fs
+        y = np.where(window_mask(n, 0, echo - margin), x - nz.offset, 0.0)
+        eps = _transported(y, bar, -bar.gauge_distance, dt, dispersion)
+        valid_until = echo - d - margin
+        out[name] = np.where(window_mask(n, 0, valid_until), eps, np.nan)
+        info[name] = ChannelInfo(name, nz, arr - d, valid_until)
+
+    hoop = None
+    if record.has_hoop:
+        x = record.strain("tube_hoop")
+        # the tube swells: compression-positive hoop strain goes negative
+        nz, arr = prepulse_noise(x, span=span, polarity=-1)
+        hoop = x - nz.offset
+        info["tube_hoop"] = ChannelInfo("tube_hoop", nz, arr, float(n))
+
+    io, eo = app.internal_output_bar, app.external_output_bar
+    eps_io, eps_eo = out["internal_output_bar"], out["external_output_bar"]
+    return Forces(
+        time=record.time,
+        eps_incident=eps_i,
+        eps_reflected=eps_r,
+        eps_internal=eps_io,
+        eps_external=eps_eo,
+        hoop=hoop,
+        F_i=eq.input_force(eps_i, eps_r, area=ib.area, young_modulus=ib.young_modulus),
+        F_io=eq.transmitted_force(eps_io, area=io.area, young_modulus=io.young_modulus),
+        F_eo=eq.transmitted_force(eps_eo, area=eo.area, young_modulus=eo.young_modulus),
+        V_i=eq.input_velocity(eps_i, eps_r, wave_speed=ib.wave_speed),
+        V_io=eq.transmitted_velocity(eps_io, wave_speed=io.wave_speed),
+        V_eo=eq.transmitted_velocity(eps_eo, wave_speed=eo.wave_speed),
+        channels=info,
+        dispersion=dispersion,
+    )

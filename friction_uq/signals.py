@@ -1,0 +1,232 @@
+"""Generic gauge-signal processing: baseline and noise, pulse arrival, transport to an interface.
+
+Nothing here knows about the friction cell: these functions work on any split Hopkinson bar
+record (the tests run them on a real two-bar SHPB record too). Signals are strain, compression
+positive, sampled uniformly.
+
+Conventions
+-----------
+*Pre-pulse segment*: the samples before a channel's first pulse, less a safety margin. The gauge
+is at rest there, so its mean is the amplifier offset and its spread is the electrical noise of
+the channel; this is the segment the whole package uses to estimate noise, because it is the only
+part of a record where the true signal is known (zero). The noise is summarised by its standard
+deviation and lag-1 autocorrelation (an AR(1) description of coloured noise).
+
+*Arrival*: the foot of the first pulse, where the line through the front's 10 % and 50 %
+crossings (linearly interpolated between samples) meets the baseline. Exact for a linear front,
+sub-sample for any smooth one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .dispersion import propagate
+from .errors import SignalError
+
+#: Threshold, in noise standard deviations, for the first crossing that starts an arrival search.
+ARRIVAL_SIGMAS = 8.0
+#: The crossing must also exceed this fraction of the channel's largest excursion.
+ARRIVAL_FRACTION = 0.05
+#: Minimum pre-pulse segment (samples) for a noise estimate.
+MIN_BASELINE_SAMPLES = 32
+
+
+@dataclass(frozen=True)
+class NoiseEstimate:
+    """Baseline statistics of one channel from its pre-pulse segment.
+
+    Attributes
+    ----------
+    offset : float
+        Mean of the segment (strain): the amplifier offset.
+    sd : float
+        Standard deviation of the segment (strain).
+    rho : float
+        Lag-1 autocorrelation of the segment (AR(1) coefficient), in (-1, 1).
+    start, stop : int
+        Sample indices of the segment, ``x[start:stop]``.
+    """
+
+    offset: float
+    sd: float
+    rho: float
+    start: int
+    stop: int
+
+    @property
+    def n(self) -> int:
+        return self.stop - self.start
+
+    @property
+    def effective_fraction(self) -> float:
+        """(1 - rho) / (1 + rho): effective independent samples per sample of AR(1) noise (mean)."""
+        return (1.0 - self.rho) / (1.0 + self.rho)
+
+
+def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate:
+    """Offset, standard deviation and lag-1 autocorrelation of ``x[start:stop]``.
+
+    >>> rng = np.random.default_rng(1)
+    >>> e = noise_estimate(3.0 + rng.normal(0, 2.0, 20000), stop=20000)
+    >>> round(e.offset, 1), round(e.sd, 1), abs(e.rho) < 0.05
+    (3.0, 2.0, True)
+    """
+    seg = np.asarray(x[start:stop], dtype=float)
+    if seg.size < MIN_BASELINE_SAMPLES:
+        raise SignalError(
+            f"the pre-pulse segment has {seg.size} samples, at least {MIN_BASELINE_SAMPLES} are needed "
+            "to estimate the baseline and noise"
+        )
+    offset = float(seg.mean())
+    d = seg - offset
+    var = float(np.mean(d * d))
+    sd = float(np.sqrt(var * seg.size / (seg.size - 1)))
+    rho = float(np.sum(d[1:] * d[:-1]) / (var * seg.size)) if var > 0 else 0.0
+    rho = float(np.clip(rho, -0.99, 0.99))
+    return NoiseEstimate(offset=offset, sd=sd, rho=rho, start=int(start), stop=int(stop))
+
+
+def first_crossing(y: np.ndarray, level: float, *, start: int = 0) -> float | None:
+    """Fractional index where ``y`` first rises through ``level`` at or after ``start`` (None if never)."""
+    above = np.flatnonzero(y[start:] >= level)
+    if above.size == 0:
+        return None
+    i = start + int(above[0])
+    if i == 0:
+        return 0.0
+    y0, y1 = y[i - 1], y[i]
+    return (i - 1) + float((level - y0) / (y1 - y0)) if y1 != y0 else float(i)
+
+
+def pulse_arrival(
+    x: np.ndarray,
+    *,
+    offset: float,
+    sd: float,
+    start: int = 0,
+    span: int | None = None,
+    polarity: int = 0,
+) -> float:
+    """Fractional sample index of the foot of the first pulse after ``start``.
+
+    Parameters
+    ----------
+    x
+        Signal (strain).
+    offset, sd
+        Baseline offset and noise standard deviation of the channel.
+    start
+        First index searched.
+    span
+        Samples after the first threshold crossing searched for the pulse's peak (default: to the
+        end of the signal).
+    polarity
+        +1 for a compressive pulse, -1 for a tensile one, 0 for whichever comes first.
+
+    Raises
+    ------
+    SignalError
+        If no sample rises above the noise.
+    """
+    y = np.asarray(x, dtype=float) - offset
+    if polarity == 0:
+        excursion = np.abs(y[start:])
+    else:
+        excursion = polarity * y[start:]
+    peak_all = float(excursion.max()) if excursion.size else 0.0
+    level = max(ARRIVAL_SIGMAS * sd, ARRIVAL_FRACTION * peak_all)
+    hit = np.flatnonzero(excursion >= level)
+    if hit.size == 0 or peak_all <= ARRIVAL_SIGMAS * sd:
+        raise SignalError("no pulse rises above the noise")
+    i0 = start + int(hit[0])
+    sign = polarity if polarity != 0 else (1 if y[i0] > 0 else -1)
+    s = sign * y
+    stop = len(s) if span is None else min(len(s), i0 + span)
+    peak = float(s[i0:stop].max())
+    t50 = first_crossing(s, 0.5 * peak, start=max(start, i0 - 1))
+    t10_start = start
+    # walk back from the 50 % crossing to the last sample below 10 % of the peak
+    j = int(np.floor(t50)) if t50 is not None else i0
+    while j > t10_start and s[j] >= 0.1 * peak:
+        j -= 1
+    t10 = first_crossing(s, 0.1 * peak, start=j)
+    if t10 is None or t50 is None or t50 <= t10:
+        return float(i0)
+    # line through (t10, 0.1 peak) and (t50, 0.5 peak) meets zero at:
+    return t10 - 0.1 * peak * (t50 - t10) / (0.4 * peak)
+
+
+def prepulse_noise(
+    x: np.ndarray, *, margin: int = 8, initial_fraction: float = 0.02, span: int | None = None, polarity: int = 0
+) -> tuple[NoiseEstimate, float]:
+    """Noise estimate from the pre-pulse segment, and the first pulse's arrival (fractional index).
+
+    A provisional, robust baseline (median and median absolute deviation of the first
+    ``initial_fraction`` of the record, at least 32 samples) locates the first pulse; the segment
+    then runs from the start to ``margin`` samples before that arrival and is estimated again.
+    """
+    n = len(x)
+    n0 = min(n, max(MIN_BASELINE_SAMPLES, int(initial_fraction * n)))
+    head = np.asarray(x[:n0], dtype=float)
+    med = float(np.median(head))
+    mad_sd = 1.4826 * float(np.median(np.abs(head - med)))
+    arrival = pulse_arrival(x, offset=med, sd=max(mad_sd, 1e-300), span=span, polarity=polarity)
+    stop = int(np.floor(arrival)) - margin
+    if stop < MIN_BASELINE_SAMPLES:
+        raise SignalError(
+            f"the first pulse arrives at sample {arrival:.0f}, leaving no pre-pulse baseline "
+            f"(at least {MIN_BASELINE_SAMPLES + margin} samples needed)"
+        )
+    est = noise_estimate(x, stop=stop)
+    # a second pass with the refined baseline
+    arrival = pulse_arrival(x, offset=est.offset, sd=max(est.sd, 1e-300), span=span, polarity=polarity)
+    return est, arrival
+
+
+def window_mask(n: int, start: float, stop: float) -> np.ndarray:
+    """Boolean mask of the samples with start <= index < stop (fractional bounds allowed)."""
+    i = np.arange(n)
+    return (i >= start) & (i < stop)
+
+
+def transport(
+    x: np.ndarray,
+    *,
+    sample_interval: float,
+    distance: float,
+    wave_speed: float,
+    diameter: float | None = None,
+    inner_diameter: float = 0.0,
+    poisson_ratio: float | None = None,
+    dispersion: bool = False,
+) -> np.ndarray:
+    """Move a wave recorded at a gauge by ``distance`` along its direction of travel.
+
+    ``distance`` > 0 carries a wave forward (incident: gauge -> interface); ``distance`` < 0
+    brings a wave back to where it came from (reflected and transmitted: interface <- gauge).
+    Without dispersion this is an exact sub-sample delay by distance / wave_speed; with it, each
+    frequency travels at the first-mode Pochhammer-Chree phase velocity of the bar (see
+    :mod:`friction_uq.dispersion`). The signal must be baseline-free (zero at both ends).
+    """
+    return propagate(
+        np.asarray(x, dtype=float),
+        sample_interval=sample_interval,
+        distance=distance,
+        c0=wave_speed,
+        diameter=diameter,
+        nu=poisson_ratio,
+        inner_diameter=inner_diameter,
+        dispersive=dispersion,
+    )
+
+
+def moving_average(x: np.ndarray, width: int) -> np.ndarray:
+    """Centred moving average over ``width`` samples (edges averaged over what exists)."""
+    width = max(1, int(width))
+    kernel = np.ones(width)
+    num = np.convolve(x, kernel, mode="same")
+    den = np.convolve(np.ones_like(x), kernel, mode="same")
+    return num / den

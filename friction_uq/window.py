@@ -1,0 +1,249 @@
+"""The stationary phase: where it is, and the data the likelihood sees inside it.
+
+Criterion (documented in README.md). A sample time t is *steady* when, over the evaluation span
+``span`` (40 us by default) centred on t, all of these hold:
+
+1. the cell is loaded: F_io(t) >= ``load_fraction`` (0.5) of its largest value;
+2. the force ratio F_eo/F_io (smoothed over ``smooth`` = 10 us) changes across the span by less
+   than ``sigmas`` (3) times its noise, or by less than ``ratio_tol`` (3 %) of itself, whichever
+   is larger: the friction does not evolve;
+3. the sample's ends move together (eq. 6): the smoothed |V_i - V_io| is within ``sigmas`` times
+   its noise, or within ``velocity_tol`` (5 %) of V_io.
+
+The stationary window is the longest run of steady times, at least ``min_duration`` (30 us)
+long; otherwise the record has no stationary phase and is refused. The noise of each smoothed
+quantity is propagated from the channels' pre-pulse noise (standard deviation and AR(1)
+coefficient).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import NoStationaryPhase, SignalError
+from .forces import Forces
+from .record import Apparatus, Tube
+from .signals import moving_average
+
+
+@dataclass(frozen=True)
+class WindowCriterion:
+    """Parameters of the stationary-phase criterion (see the module docstring)."""
+
+    smooth: float = 10e-6
+    span: float = 40e-6
+    load_fraction: float = 0.5
+    sigmas: float = 3.0
+    ratio_tol: float = 0.03
+    velocity_tol: float = 0.05
+    min_duration: float = 30e-6
+
+
+@dataclass(frozen=True)
+class Window:
+    """A time window [t0, t1] (s) on the record's time base, and its sample indices [i0, i1)."""
+
+    t0: float
+    t1: float
+    i0: int
+    i1: int
+    automatic: bool
+
+    @property
+    def duration(self) -> float:
+        return self.t1 - self.t0
+
+    @property
+    def slice(self) -> slice:
+        return slice(self.i0, self.i1)
+
+
+def _mean_noise_factor(rho: float, width: int) -> float:
+    """Standard deviation of the mean of ``width`` AR(1) samples, per unit sample sd (large-n form)."""
+    return math.sqrt((1.0 + rho) / ((1.0 - rho) * max(width, 1)))
+
+
+def steady_mask(forces: Forces, apparatus: Apparatus, criterion: WindowCriterion = WindowCriterion()) -> np.ndarray:
+    """Boolean array: True where the record is steady by the criterion of this module."""
+    t = forces.time
+    fs = 1.0 / (t[1] - t[0])
+    w = max(1, int(round(criterion.smooth * fs)))
+    half = max(1, int(round(criterion.span * fs / 2)))
+    ch = forces.channels
+    io, eo, ib = apparatus.internal_output_bar, apparatus.external_output_bar, apparatus.input_bar
+
+    valid = np.isfinite(forces.F_io) & np.isfinite(forces.F_eo) & np.isfinite(forces.V_i)
+    F_io = np.where(valid, forces.F_io, 0.0)
+    F_eo = np.where(valid, forces.F_eo, 0.0)
+    fio_s = moving_average(F_io, w)
+    feo_s = moving_average(F_eo, w)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r_s = feo_s / fio_s
+    sd_io = io.area * io.young_modulus * ch["internal_output_bar"].noise.sd
+    sd_eo = eo.area * eo.young_modulus * ch["external_output_bar"].noise.sd
+    k_io = _mean_noise_factor(ch["internal_output_bar"].noise.rho, w)
+    k_eo = _mean_noise_factor(ch["external_output_bar"].noise.rho, w)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sd_r = np.sqrt((sd_eo * k_eo) ** 2 + (r_s * sd_io * k_io) ** 2) / np.abs(fio_s)
+
+    loaded = valid & (F_io >= criterion.load_fraction * np.nanmax(np.where(valid, F_io, np.nan)))
+
+    n = len(t)
+    idx = np.arange(n)
+    lo = np.clip(idx - half, 0, n - 1)
+    hi = np.clip(idx + half, 0, n - 1)
+    dr = np.abs(r_s[hi] - r_s[lo])
+    tol_r = np.maximum(criterion.sigmas * math.sqrt(2.0) * sd_r[idx], criterion.ratio_tol * np.abs(r_s))
+    ratio_ok = dr <= tol_r
+
+    V_i = np.where(valid, forces.V_i, 0.0)
+    V_io = np.where(valid, forces.V_io, 0.0)
+    dv_s = moving_average(V_i - V_io, w)
+    vio_s = moving_average(V_io, w)
+    sd_dv = math.hypot(
+        ib.wave_speed * math.sqrt(2.0) * ch["input_bar"].noise.sd * _mean_noise_factor(ch["input_bar"].noise.rho, w),
+        io.wave_speed * ch["internal_output_bar"].noise.sd * k_io,
+    )
+    vel_ok = np.abs(dv_s) <= np.maximum(criterion.sigmas * sd_dv, criterion.velocity_tol * np.abs(vio_s))
+
+    # a time is steady when the whole span around it is loaded and valid
+    loaded_span = np.convolve(loaded.astype(int), np.ones(2 * half + 1, int), mode="same") == 2 * half + 1
+    return loaded_span & ratio_ok & vel_ok
+
+
+def _longest_run(mask: np.ndarray) -> tuple[int, int]:
+    if not mask.any():
+        return 0, 0
+    padded = np.concatenate(([0], mask.astype(np.int8), [0]))
+    edges = np.flatnonzero(np.diff(padded))
+    starts, stops = edges[0::2], edges[1::2]
+    k = int(np.argmax(stops - starts))
+    return int(starts[k]), int(stops[k])
+
+
+def find_stationary_window(
+    forces: Forces, apparatus: Apparatus, criterion: WindowCriterion = WindowCriterion()
+) -> Window:
+    """The longest steady run of the record (see module docstring).
+
+    Raises
+    ------
+    NoStationaryPhase
+        If no steady run lasts ``criterion.min_duration``.
+    """
+    t = forces.time
+    dt = t[1] - t[0]
+    mask = steady_mask(forces, apparatus, criterion)
+    i0, i1 = _longest_run(mask)
+    if (i1 - i0) * dt < criterion.min_duration:
+        raise NoStationaryPhase(
+            f"no stationary phase: the longest run where F_eo/F_io and V_i - V_io stay steady within "
+            f"their noise lasts {(i1 - i0) * dt * 1e6:.1f} us, less than the {criterion.min_duration * 1e6:.0f} us "
+            "required; give a window by hand with --window T0:T1 if you know one"
+        )
+    return Window(float(t[i0]), float(t[i1 - 1]), i0, i1, automatic=True)
+
+
+def window_from_times(forces: Forces, t0: float, t1: float) -> Window:
+    """A window given by hand (seconds on the record's time base), checked against the valid waves."""
+    t = forces.time
+    if not t1 > t0:
+        raise SignalError(f"window {t0}:{t1}: T1 must be after T0")
+    if t0 < t[0] or t1 > t[-1]:
+        raise SignalError(f"window {t0}:{t1} s lies outside the record ({t[0]:.6g} to {t[-1]:.6g} s)")
+    i0 = int(np.searchsorted(t, t0))
+    i1 = int(np.searchsorted(t, t1, side="right"))
+    seg = slice(i0, i1)
+    if i1 - i0 < 8:
+        raise SignalError(f"window {t0}:{t1} s holds {i1 - i0} samples, at least 8 are needed")
+    for name, arr in (("F_io", forces.F_io), ("F_eo", forces.F_eo)):
+        if not np.all(np.isfinite(arr[seg])):
+            raise SignalError(
+                f"window {t0}:{t1} s reaches outside the time where {name} is valid (before the wave "
+                "reaches the cell or after the bar's far-end echo)"
+            )
+    return Window(float(t[i0]), float(t[i1 - 1]), i0, i1, automatic=False)
+
+
+@dataclass(frozen=True)
+class StationaryData:
+    """What a likelihood sees: the stationary-phase force signals and their noise. SI units.
+
+    Noise of the forces comes from each output bar's pre-pulse segment (the gauge at rest, before
+    any wave): sd = A E sd(strain), rho = lag-1 autocorrelation of that segment.
+
+    ``hoop`` is the tube gauge's strain in the package's convention (compression positive, so it
+    is negative while the tube swells), baseline removed. ``slip`` is the sample's sliding
+    displacement relative to the tube since the start of loading (m), from eq. 7.
+    """
+
+    test_id: str
+    campaign: str
+    time: np.ndarray
+    F_io: np.ndarray
+    F_eo: np.ndarray
+    V: np.ndarray
+    slip: np.ndarray
+    sd_io: float
+    sd_eo: float
+    rho_io: float
+    rho_eo: float
+    radius: float
+    length: float
+    tube: Tube
+    window: tuple[float, float]
+    sample_rate: float
+    hoop: np.ndarray | None = None
+    sd_hoop: float | None = None
+    rho_hoop: float | None = None
+    striker_velocity: float | None = None
+
+    @property
+    def n(self) -> int:
+        return len(self.time)
+
+
+def stationary_data(
+    forces: Forces, apparatus: Apparatus, window: Window, *, test_id: str = "", campaign: str = "",
+    striker_velocity: float | None = None,
+) -> StationaryData:
+    """Cut the stationary phase out of ``forces`` for a likelihood."""
+    seg = window.slice
+    t = forces.time
+    dt = t[1] - t[0]
+    V = np.nan_to_num(forces.V, nan=0.0)
+    start = forces.loading_start
+    V = np.where(t >= start, V, 0.0)
+    slip = np.cumsum(V) * dt
+    io, eo = apparatus.internal_output_bar, apparatus.external_output_bar
+    ch = forces.channels
+    hoop = sd_h = rho_h = None
+    if forces.hoop is not None:
+        hoop = np.array(forces.hoop[seg])
+        sd_h = ch["tube_hoop"].noise.sd
+        rho_h = ch["tube_hoop"].noise.rho
+    return StationaryData(
+        test_id=test_id,
+        campaign=campaign,
+        time=np.array(t[seg]),
+        F_io=np.array(forces.F_io[seg]),
+        F_eo=np.array(forces.F_eo[seg]),
+        V=np.array(forces.V[seg]),
+        slip=np.array(slip[seg]),
+        sd_io=io.area * io.young_modulus * ch["internal_output_bar"].noise.sd,
+        sd_eo=eo.area * eo.young_modulus * ch["external_output_bar"].noise.sd,
+        rho_io=ch["internal_output_bar"].noise.rho,
+        rho_eo=ch["external_output_bar"].noise.rho,
+        radius=apparatus.sample.radius,
+        length=apparatus.sample.length,
+        tube=apparatus.tube,
+        window=(window.t0, window.t1),
+        sample_rate=1.0 / dt,
+        hoop=hoop,
+        sd_hoop=sd_h,
+        rho_hoop=rho_h,
+        striker_velocity=striker_velocity,
+    )
