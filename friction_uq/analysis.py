@@ -76,11 +76,19 @@ class Identification:
     time: np.ndarray
     f_series: np.ndarray
 
+    def series_json(self, *, points: int = 50) -> dict:
+        """f(t) over the window, decimated to about ``points`` values (it is smoothed over 10 us)."""
+        step = max(1, len(self.time) // points)
+        return {
+            "time": [float(f"{v:.7g}") for v in self.time[::step]],
+            "f": [float(f"{v:.5g}") for v in self.f_series[::step]],
+        }
+
     def to_json(self) -> dict:
         """The keys of ``friction-uq analyze --json`` (SI units)."""
         return {
             "f": self.f,
-            "f_series": {"time": self.time.tolist(), "f": self.f_series.tolist()},
+            "f_series": self.series_json(),
             "ratio": self.ratio,
             "kappa": self.kappa,
             "nu": self.nu,

@@ -22,7 +22,8 @@ import numpy as np
 
 from .physics import bars as eq
 from .record import Bar, Record
-from .signals import NoiseEstimate, prepulse_noise, transport, window_mask
+from .errors import SignalError
+from .signals import NoiseEstimate, noise_estimate, prepulse_noise, transport, window_mask
 
 
 @dataclass(frozen=True)
@@ -90,6 +91,23 @@ class Forces:
         return bar.area * bar.young_modulus * self.channels[channel].noise.sd
 
 
+def _noise_and_arrival(x: np.ndarray, *, earliest: float, span: int, polarity: int) -> tuple[NoiseEstimate, float]:
+    """Pre-pulse noise and arrival of a channel whose pulse cannot come before ``earliest`` (index).
+
+    A channel whose pulse stays below its noise (a tiny friction force, say) still has a valid
+    noise estimate: the segment then ends where the wave could arrive at the earliest, which is
+    also taken as its arrival.
+    """
+    try:
+        nz, arr = prepulse_noise(x, span=span, polarity=polarity)
+    except SignalError:
+        stop = int(np.floor(earliest)) - 8
+        return noise_estimate(x, stop=stop), float(earliest)
+    if nz.stop > earliest:  # a pulse "before" the earliest possible arrival: keep to physics
+        nz = noise_estimate(x, stop=int(np.floor(earliest)) - 8)
+    return nz, arr
+
+
 def _transported(x: np.ndarray, bar: Bar, distance: float, dt: float, dispersion: bool) -> np.ndarray:
     return transport(
         x,
@@ -146,8 +164,8 @@ def compute_forces(record: Record, *, dispersion: bool = False) -> Forces:
     for name in ("internal_output_bar", "external_output_bar"):
         bar = app.bars[name]
         x = record.strain(name)
-        nz, arr = prepulse_noise(x, span=span, polarity=+1)
         d = bar.gauge_delay * fs
+        nz, arr = _noise_and_arrival(x, earliest=arr_inc + d_in + d, span=span, polarity=+1)
         echo = arr + 2.0 * (bar.length - bar.gauge_distance) / bar.wave_speed * fs
         y = np.where(window_mask(n, 0, echo - margin), x - nz.offset, 0.0)
         eps = _transported(y, bar, -bar.gauge_distance, dt, dispersion)
@@ -159,7 +177,7 @@ def compute_forces(record: Record, *, dispersion: bool = False) -> Forces:
     if record.has_hoop:
         x = record.strain("tube_hoop")
         # the tube swells: compression-positive hoop strain goes negative
-        nz, arr = prepulse_noise(x, span=span, polarity=-1)
+        nz, arr = _noise_and_arrival(x, earliest=arr_inc + d_in, span=span, polarity=-1)
         hoop = x - nz.offset
         info["tube_hoop"] = ChannelInfo("tube_hoop", nz, arr, float(n))
 

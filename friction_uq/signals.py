@@ -131,6 +131,19 @@ def pulse_arrival(
     SignalError
         If no sample rises above the noise.
     """
+    return pulse_front(x, offset=offset, sd=sd, start=start, span=span, polarity=polarity)[0]
+
+
+def pulse_front(
+    x: np.ndarray,
+    *,
+    offset: float,
+    sd: float,
+    start: int = 0,
+    span: int | None = None,
+    polarity: int = 0,
+) -> tuple[float, float, float]:
+    """Foot, 10 % and 50 % crossings (fractional indices) of the first pulse; see :func:`pulse_arrival`."""
     y = np.asarray(x, dtype=float) - offset
     if polarity == 0:
         excursion = np.abs(y[start:])
@@ -154,9 +167,9 @@ def pulse_arrival(
         j -= 1
     t10 = first_crossing(s, 0.1 * peak, start=j)
     if t10 is None or t50 is None or t50 <= t10:
-        return float(i0)
+        return float(i0), float(i0), float(i0)
     # line through (t10, 0.1 peak) and (t50, 0.5 peak) meets zero at:
-    return t10 - 0.1 * peak * (t50 - t10) / (0.4 * peak)
+    return t10 - 0.25 * (t50 - t10), t10, t50
 
 
 def prepulse_noise(
@@ -173,8 +186,9 @@ def prepulse_noise(
     head = np.asarray(x[:n0], dtype=float)
     med = float(np.median(head))
     mad_sd = 1.4826 * float(np.median(np.abs(head - med)))
-    arrival = pulse_arrival(x, offset=med, sd=max(mad_sd, 1e-300), span=span, polarity=polarity)
-    stop = int(np.floor(arrival)) - margin
+    arrival, t10, t50 = pulse_front(x, offset=med, sd=max(mad_sd, 1e-300), span=span, polarity=polarity)
+    # a smooth front starts before its extrapolated foot: stay one 10-50 % rise time further away
+    stop = int(np.floor(arrival - (t50 - t10))) - margin
     if stop < MIN_BASELINE_SAMPLES:
         raise SignalError(
             f"the first pulse arrives at sample {arrival:.0f}, leaving no pre-pulse baseline "

@@ -10,8 +10,13 @@ Criterion (documented in README.md). A sample time t is *steady* when, over the 
 3. the sample's ends move together (eq. 6): the smoothed |V_i - V_io| is within ``sigmas`` times
    its noise, or within ``velocity_tol`` (5 %) of V_io.
 
-The stationary window is the longest run of steady times, at least ``min_duration`` (30 us)
-long; otherwise the record has no stationary phase and is refused. The noise of each smoothed
+Isolated unsteady instants shorter than ``max_gap`` (10 us) between steady runs are noise
+excursions (thousands of instants are tested, so a 3-sigma test fails by chance a few times):
+they are closed. Within the longest steady run, the window is then the longest stretch in which the
+smoothed ratio stays inside a band of +- ``band_sigmas`` (4) times its noise or ``ratio_tol``,
+whichever is larger (a slow drift passes the local test but not this one; 4 sigma because a
+plateau of pure noise holds some 40 independent 10 us averages, whose range reaches about
++- 2.7 sigma). It must be at least ``min_duration`` (50 us) long; otherwise the record has no stationary phase and is refused. The noise of each smoothed
 quantity is propagated from the channels' pre-pulse noise (standard deviation and AR(1)
 coefficient).
 """
@@ -39,7 +44,9 @@ class WindowCriterion:
     sigmas: float = 3.0
     ratio_tol: float = 0.03
     velocity_tol: float = 0.05
-    min_duration: float = 30e-6
+    min_duration: float = 50e-6
+    max_gap: float = 10e-6
+    band_sigmas: float = 4.0
 
 
 @dataclass(frozen=True)
@@ -68,6 +75,13 @@ def _mean_noise_factor(rho: float, width: int) -> float:
 
 def steady_mask(forces: Forces, apparatus: Apparatus, criterion: WindowCriterion = WindowCriterion()) -> np.ndarray:
     """Boolean array: True where the record is steady by the criterion of this module."""
+    return _steadiness(forces, apparatus, criterion)[0]
+
+
+def _steadiness(
+    forces: Forces, apparatus: Apparatus, criterion: WindowCriterion
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Steady mask, smoothed ratio and the half-width of its steadiness band at each time."""
     t = forces.time
     fs = 1.0 / (t[1] - t[0])
     w = max(1, int(round(criterion.smooth * fs)))
@@ -111,7 +125,45 @@ def steady_mask(forces: Forces, apparatus: Apparatus, criterion: WindowCriterion
 
     # a time is steady when the whole span around it is loaded and valid
     loaded_span = np.convolve(loaded.astype(int), np.ones(2 * half + 1, int), mode="same") == 2 * half + 1
-    return loaded_span & ratio_ok & vel_ok
+    band = np.maximum(criterion.band_sigmas * sd_r, criterion.ratio_tol * np.abs(r_s))
+    return loaded_span & ratio_ok & vel_ok, r_s, band
+
+
+def _longest_banded(values: np.ndarray, half_width: float) -> tuple[int, int]:
+    """Longest [i, j) with max - min of ``values`` <= 2 half_width (two pointers, monotone deques)."""
+    from collections import deque
+
+    best = (0, 0)
+    lo_q: deque[int] = deque()
+    hi_q: deque[int] = deque()
+    i = 0
+    for j, v in enumerate(values):
+        while hi_q and values[hi_q[-1]] <= v:
+            hi_q.pop()
+        hi_q.append(j)
+        while lo_q and values[lo_q[-1]] >= v:
+            lo_q.pop()
+        lo_q.append(j)
+        while values[hi_q[0]] - values[lo_q[0]] > 2.0 * half_width:
+            i += 1
+            if hi_q[0] < i:
+                hi_q.popleft()
+            if lo_q[0] < i:
+                lo_q.popleft()
+        if j + 1 - i > best[1] - best[0]:
+            best = (i, j + 1)
+    return best
+
+
+def _close_gaps(mask: np.ndarray, max_gap: int) -> np.ndarray:
+    """Fill runs of False no longer than ``max_gap`` that have True on both sides."""
+    out = mask.copy()
+    padded = np.concatenate(([1], mask.astype(np.int8), [1]))
+    edges = np.flatnonzero(np.diff(padded))
+    for a, b in zip(edges[0::2], edges[1::2]):  # runs of False: [a, b)
+        if 0 < a and b < len(mask) and b - a <= max_gap:
+            out[a:b] = True
+    return out
 
 
 def _longest_run(mask: np.ndarray) -> tuple[int, int]:
@@ -136,8 +188,12 @@ def find_stationary_window(
     """
     t = forces.time
     dt = t[1] - t[0]
-    mask = steady_mask(forces, apparatus, criterion)
+    steady, r_s, band = _steadiness(forces, apparatus, criterion)
+    mask = _close_gaps(steady, int(round(criterion.max_gap / dt)))
     i0, i1 = _longest_run(mask)
+    if i1 > i0:
+        a, b = _longest_banded(r_s[i0:i1], float(np.median(band[i0:i1])))
+        i0, i1 = i0 + a, i0 + b
     if (i1 - i0) * dt < criterion.min_duration:
         raise NoStationaryPhase(
             f"no stationary phase: the longest run where F_eo/F_io and V_i - V_io stay steady within "
@@ -162,9 +218,14 @@ def window_from_times(forces: Forces, t0: float, t1: float) -> Window:
     for name, arr in (("F_io", forces.F_io), ("F_eo", forces.F_eo)):
         if not np.all(np.isfinite(arr[seg])):
             raise SignalError(
-                f"window {t0}:{t1} s reaches outside the time where {name} is valid (before the wave "
-                "reaches the cell or after the bar's far-end echo)"
+                f"window {t0}:{t1} s reaches outside the time where {name} is valid (after the bar's "
+                "far-end echo reaches the gauge)"
             )
+    if np.mean(forces.F_io[seg]) < 0.2 * np.nanmax(forces.F_io):
+        raise SignalError(
+            f"window {t0}:{t1} s: the cell is not loaded there (mean F_io {np.mean(forces.F_io[seg]):.0f} N, "
+            f"less than 20 % of its peak {np.nanmax(forces.F_io):.0f} N)"
+        )
     return Window(float(t[i0]), float(t[i1 - 1]), i0, i1, automatic=False)
 
 

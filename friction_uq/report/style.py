@@ -1,0 +1,31 @@
+"""Shared matplotlib settings: readable when printed (A4, >= 9 pt)."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+
+RC = {
+    "font.size": 10,
+    "axes.titlesize": 11,
+    "axes.labelsize": 10,
+    "xtick.labelsize": 9,
+    "ytick.labelsize": 9,
+    "legend.fontsize": 9,
+    "figure.titlesize": 13,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "pdf.fonttype": 42,
+}
+A4_LANDSCAPE = (11.69, 8.27)
+
+
+def figure(title: str, *, nrows: int = 1, ncols: int = 1, **kw):
+    """A titled A4-landscape figure with a grid of axes."""
+    with plt.rc_context(RC):
+        fig, axes = plt.subplots(nrows, ncols, figsize=A4_LANDSCAPE, **kw)
+    fig.suptitle(title)
+    return fig, axes

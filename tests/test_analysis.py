@@ -1,0 +1,107 @@
+"""The deterministic identification on closed-form records (truth known by construction)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from friction_uq.analysis import identify, prepare
+from friction_uq.errors import NoStationaryPhase, SignalError
+from friction_uq.record import read_record, read_truth
+from friction_uq.synthetic import ClosedFormTest, closed_form_strains, write_closed_form_record
+from friction_uq.record import paper_apparatus
+
+
+@pytest.fixture(scope="module")
+def paper_record(tmp_path_factory):
+    return write_closed_form_record(tmp_path_factory.mktemp("rec") / "paper.h5", ClosedFormTest(), seed=11)
+
+
+def _sd_f(prep, nu):
+    """Standard error of eq. 17's f from the window's noise (AR(1) effective sample size)."""
+    d = prep.data
+    n_eff = d.n * (1 - d.rho_eo) / (1 + d.rho_eo)
+    r = np.mean(d.F_eo) / np.mean(d.F_io)
+    sd_r = np.hypot(d.sd_eo, r * d.sd_io) / np.mean(d.F_io) / np.sqrt(n_eff)
+    return (1 - nu) * d.radius / (2 * nu * d.length) * sd_r / (1 + r)
+
+
+@pytest.mark.parametrize("f, nu", [(0.05, 0.4), (0.2, 0.4), (0.131, 0.2), (0.01, 0.3)])
+def test_identification_recovers_f_within_its_noise(tmp_path, f, nu):
+    p = write_closed_form_record(tmp_path / "r.h5", ClosedFormTest(f=f, nu=nu), seed=5)
+    prep = prepare(read_record(p))
+    ident = identify(prep, nu=nu)
+    tol = 4 * _sd_f(prep, nu)
+    assert ident.f == pytest.approx(f, abs=tol)
+    truth = read_truth(p)
+    assert ident.ratio == pytest.approx(truth["ratio"], abs=tol * 2 * nu * 0.01 / ((1 - nu) * 0.005) * 1.5)
+    assert ident.V == pytest.approx(truth["V"], rel=0.01)
+    assert ident.p_mean == pytest.approx(truth["p_mean"], rel=max(0.01, 4 * _sd_f(prep, nu) / f))
+    # eq. 21 approximates eq. 20 for small f beta
+    assert ident.p_mean_approx == pytest.approx(ident.p_mean, rel=0.02 + f)
+    assert abs(ident.equilibrium_error) < 0.01
+
+
+def test_window_lies_in_the_plateau(paper_record):
+    rec = read_record(paper_record)
+    prep = prepare(rec)
+    test = ClosedFormTest()
+    a = rec.apparatus
+    t_cell = a.input_bar.gauge_delay  # incident front at the gauge at t = 0
+    plateau = (t_cell + test.rise_time, t_cell + a.pulse_duration - test.rise_time)
+    assert plateau[0] <= prep.window.t0 < prep.window.t1 <= plateau[1]
+    # most of the plateau is found
+    assert prep.window.duration > 0.8 * (plateau[1] - plateau[0])
+
+
+def test_noise_levels_recovered_within_ten_percent(paper_record):
+    prep = prepare(read_record(paper_record))
+    truth = read_truth(paper_record)
+    for ch in ("internal_output_bar", "external_output_bar"):
+        assert prep.forces.channels[ch].noise.sd == pytest.approx(truth[f"noise_sd_{ch}"], rel=0.10)
+
+
+def test_manual_window_overrides(paper_record):
+    rec = read_record(paper_record)
+    prep = prepare(rec, window=(4.0e-4, 5.0e-4))
+    assert prep.window.t0 == pytest.approx(4.0e-4, abs=rec.sample_interval)
+    assert not prep.window.automatic
+    with pytest.raises(SignalError, match="outside the record"):
+        prepare(rec, window=(-1.0, 5.0e-4))
+    with pytest.raises(SignalError, match="outside the time where F_io is valid"):
+        prepare(rec, window=(1.1e-3, 1.2e-3))
+    with pytest.raises(SignalError, match="the cell is not loaded there"):
+        prepare(rec, window=(-5e-5, 1e-4))
+
+
+def test_a_drifting_ratio_has_no_stationary_phase(tmp_path):
+    """F_eo keeps growing through the plateau: the criterion must refuse the record."""
+    test = ClosedFormTest()
+    app = paper_apparatus()
+    t, strains, _ = closed_form_strains(test, app)
+    eo = app.external_output_bar
+    ramp = np.clip((t - 0.2e-3) / 0.5e-3, 0, None)
+    strains_eo = strains["external_output_bar"] * (0.3 + 4.0 * ramp)
+    p = write_closed_form_record(tmp_path / "drift.h5", test, seed=2,
+                                 strains_override={"external_output_bar": strains_eo})
+    with pytest.raises(NoStationaryPhase, match="no stationary phase"):
+        prepare(read_record(p))
+    del eo
+
+
+def test_dispersion_option_changes_little_on_slow_fronts(paper_record):
+    rec = read_record(paper_record)
+    a = identify(prepare(rec), nu=0.4)
+    b = identify(prepare(rec, dispersion=True), nu=0.4)
+    assert b.f == pytest.approx(a.f, rel=0.02)
+
+
+def test_analyze_json_cli(paper_record, capsys):
+    from friction_uq.cli import main
+
+    assert main(["analyze", str(paper_record), "--nu", "0.4", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("f", "ratio", "p_mean", "p_min", "p_max", "tau_mean", "V", "window"):
+        assert key in out
+    assert out["f"] == pytest.approx(0.05, abs=0.003)
+    assert len(out["window"]) == 2

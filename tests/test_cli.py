@@ -1,0 +1,65 @@
+"""The command line, end to end, as a user runs it."""
+
+import subprocess
+import sys
+
+import pytest
+
+from friction_uq import __version__
+from friction_uq.cli import build_parser, main
+from friction_uq.synthetic import ClosedFormTest, write_closed_form_record
+
+SUBCOMMANDS = ["inspect", "analyze", "design", "simulate", "run"]
+
+
+@pytest.fixture(scope="module")
+def record(tmp_path_factory):
+    return write_closed_form_record(tmp_path_factory.mktemp("cli") / "c.h5", ClosedFormTest(), seed=3,
+                                    units={"external_output_bar": "V", "tube_hoop": "microstrain"},
+                                    strain_per_volt={"external_output_bar": 2e-4})
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--version"])
+    assert e.value.code == 0
+    assert capsys.readouterr().out.strip() == f"friction-uq {__version__}"
+
+
+@pytest.mark.parametrize("cmd", SUBCOMMANDS)
+def test_help_on_every_subcommand(cmd, capsys):
+    with pytest.raises(SystemExit) as e:
+        main([cmd, "--help"])
+    assert e.value.code == 0
+    assert f"usage: friction-uq {cmd}" in capsys.readouterr().out
+
+
+def test_parser_knows_every_subcommand():
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    assert sorted(sub.choices) == sorted(SUBCOMMANDS)
+
+
+def test_inspect_prints_the_summary(record, capsys):
+    assert main(["inspect", str(record)]) == 0
+    out = capsys.readouterr().out
+    for text in ("S-01", "campaign S", "5 MHz", "input_bar", "tube_hoop", "V (0.0002 strain/V)", "microstrain",
+                 "arrival us", "noise ue", "Z N s/m", "11449.1", "Lame 2.10 ue/MPa"):
+        assert text in out, text
+
+
+def test_design_writes_a_figure(record, tmp_path, capsys):
+    out = tmp_path / "fig4.pdf"
+    assert main(["design", str(record), "-o", str(out)]) == 0
+    assert out.read_bytes()[:4] == b"%PDF"
+
+
+def test_bad_window_is_a_usage_error(record, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["analyze", str(record), "--window", "abc"])
+    assert e.value.code == 2
+    assert "T0:T1" in capsys.readouterr().err
+
+
+def test_console_script_runs():
+    r = subprocess.run([sys.executable, "-m", "friction_uq.cli", "--version"], capture_output=True, text=True)
+    assert r.returncode == 0 and __version__ in r.stdout

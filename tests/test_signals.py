@@ -1,0 +1,170 @@
+"""Generic signal code: noise, arrivals, transport. Closed forms and property tests."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from friction_uq.errors import SignalError
+from friction_uq.signals import noise_estimate, prepulse_noise, pulse_arrival, transport
+from friction_uq.synthetic import ar1_noise
+
+FS = 5e6
+DT = 1.0 / FS
+C = 4555.0
+
+
+def ramp_pulse(n: int, foot: float, *, rise: int = 100, plateau: int = 1500, amp: float = 1e-3) -> np.ndarray:
+    """Trapezoid with a smooth (raised-cosine) front whose foot is at fractional index ``foot``.
+
+    The 10 % and 50 % crossings of a raised cosine are not on a line through the foot, so
+    the test compares arrivals before/after transport rather than against ``foot`` itself.
+    """
+    i = np.arange(n, dtype=float)
+    u = np.clip((i - foot) / rise, 0, 1)
+    up = 0.5 - 0.5 * np.cos(np.pi * u)
+    d = np.clip((foot + rise + plateau + rise - i) / rise, 0, 1)
+    down = 0.5 - 0.5 * np.cos(np.pi * d)
+    return amp * np.minimum(up, down)
+
+
+def linear_front(n: int, foot: float, *, rise: int = 50, amp: float = 1e-3) -> np.ndarray:
+    i = np.arange(n, dtype=float)
+    return amp * np.clip((i - foot) / rise, 0, 1)
+
+
+def test_noise_estimate_recovers_ar1_parameters():
+    rng = np.random.default_rng(7)
+    x = 2e-5 + ar1_noise(200_000, sd=3e-6, rho=0.6, white_fraction=0.0, rng=rng)
+    e = noise_estimate(x, stop=len(x))
+    assert e.offset == pytest.approx(2e-5, abs=3 * 3e-6 / np.sqrt(200_000 * 0.25))
+    assert e.sd == pytest.approx(3e-6, rel=0.02)
+    assert e.rho == pytest.approx(0.6, abs=0.01)
+
+
+def test_noise_estimate_needs_enough_samples():
+    with pytest.raises(SignalError, match="at least 32 are needed"):
+        noise_estimate(np.zeros(10), stop=10)
+
+
+@pytest.mark.parametrize("foot", [700.0, 700.25, 700.5, 933.8])
+def test_arrival_of_a_linear_front_is_exact(foot):
+    x = linear_front(3000, foot)
+    assert pulse_arrival(x, offset=0.0, sd=1e-9) == pytest.approx(foot, abs=1e-6)
+
+
+@pytest.mark.parametrize("distance", [1.22, 0.33, 0.295])
+def test_transported_pulse_arrives_where_travel_time_says(distance):
+    """A pulse at a gauge, transported to the interface, arrives distance/c later within 0.1 sample."""
+    n = 8192
+    x = ramp_pulse(n, 600.3)
+    a0 = pulse_arrival(x, offset=0.0, sd=1e-9)
+    y = transport(x, sample_interval=DT, distance=distance, wave_speed=C)
+    a1 = pulse_arrival(y, offset=0.0, sd=1e-9)
+    expected = distance / C * FS
+    assert a1 - a0 == pytest.approx(expected, abs=0.1)
+    # and a linear front lands on its exact foot (foot moved by the travel time)
+    z = transport(linear_front(n, 600.0, rise=200), sample_interval=DT, distance=distance, wave_speed=C)
+    assert pulse_arrival(z, offset=0.0, sd=1e-9) == pytest.approx(600.0 + expected, abs=0.1)
+
+
+def test_transport_back_and_forth_is_identity():
+    x = ramp_pulse(4096, 1000.0)
+    y = transport(transport(x, sample_interval=DT, distance=1.22, wave_speed=C),
+                  sample_interval=DT, distance=-1.22, wave_speed=C)
+    assert np.max(np.abs(y - x)) < 1e-9 * np.max(x) + 1e-6 * np.max(x)
+
+
+def test_prepulse_noise_on_a_noisy_record():
+    rng = np.random.default_rng(3)
+    n = 6000
+    x = ramp_pulse(n, 800.0) + 1e-5 + ar1_noise(n, sd=3e-6, rho=0.5, white_fraction=0.3, rng=rng)
+    est, arr = prepulse_noise(x, polarity=+1)
+    assert est.stop <= 800
+    assert est.offset == pytest.approx(1e-5, abs=1.5e-6)
+    assert est.sd == pytest.approx(3e-6, rel=0.15)
+    assert arr == pytest.approx(pulse_arrival(ramp_pulse(n, 800.0), offset=0, sd=1e-9), abs=5.0)
+
+
+def test_no_pulse_is_refused():
+    rng = np.random.default_rng(4)
+    with pytest.raises(SignalError, match="no pulse rises above the noise"):
+        prepulse_noise(rng.normal(0, 1e-6, 4000))
+
+
+# ---------------------------------------------------------------- property tests (hypothesis)
+
+pulses = st.builds(
+    lambda foot, amp, rise: ramp_pulse(4096, foot, rise=rise, plateau=800, amp=amp),
+    st.floats(500.0, 1200.0), st.floats(1e-5, 5e-3), st.integers(20, 150),
+)
+
+
+@settings(max_examples=25, deadline=None)
+@given(x=pulses, y=pulses, a=st.floats(-3, 3), b=st.floats(-3, 3), d=st.floats(-1.5, 1.5))
+def test_transport_is_linear(x, y, a, b, d):
+    kw = dict(sample_interval=DT, distance=d, wave_speed=C)
+    lhs = transport(a * x + b * y, **kw)
+    rhs = a * transport(x, **kw) + b * transport(y, **kw)
+    assert np.allclose(lhs, rhs, atol=1e-12 * (abs(a) + abs(b) + 1))
+
+
+@settings(max_examples=25, deadline=None)
+@given(x=pulses, k=st.integers(-300, 300))
+def test_integer_delay_is_a_shift(x, k):
+    y = transport(x, sample_interval=DT, distance=k * DT * C, wave_speed=C)
+    expected = np.zeros_like(x)
+    if k >= 0:
+        expected[k:] = x[: len(x) - k]
+    else:
+        expected[:k] = x[-k:]
+    assert np.allclose(y, expected, atol=1e-9 * np.max(np.abs(x)))
+
+
+@settings(max_examples=25, deadline=None)
+@given(x=pulses, shift=st.floats(-200.0, 200.0))
+def test_arrival_detection_is_shift_invariant(x, shift):
+    a0 = pulse_arrival(x, offset=0.0, sd=1e-12)
+    y = transport(x, sample_interval=DT, distance=shift * DT * C, wave_speed=C)
+    assert pulse_arrival(y, offset=0.0, sd=1e-12) - a0 == pytest.approx(shift, abs=0.1)
+
+
+@settings(max_examples=25, deadline=None)
+@given(x=pulses, offset=st.floats(-1e-3, 1e-3), scale=st.floats(0.1, 10.0))
+def test_noise_estimate_is_offset_and_scale_equivariant(x, offset, scale):
+    rng = np.random.default_rng(11)
+    z = x + rng.normal(0, 1e-6, len(x))
+    e0 = noise_estimate(z, stop=400)
+    e1 = noise_estimate(scale * z + offset, stop=400)
+    assert e1.offset == pytest.approx(scale * e0.offset + offset, abs=1e-15 + 1e-12 * abs(offset))
+    assert e1.sd == pytest.approx(scale * e0.sd, rel=1e-9)
+    assert e1.rho == pytest.approx(e0.rho, abs=1e-9)
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    units=st.sampled_from(["strain", "microstrain", "V"]),
+    spv=st.floats(1e-5, 1e-3),
+    amp=st.floats(1e-5, 3e-3),
+)
+def test_units_round_trip(units, spv, amp):
+    """Strain written in any of the contract's units reads back as the same strain, compression positive."""
+    import tempfile
+    from pathlib import Path
+
+    from friction_uq.record import paper_apparatus, read_record, write_record
+
+    rng = np.random.default_rng(5)
+    n = 6000
+    eps = {name: amp * ramp_pulse(n, 500.0 + 40 * k, amp=1.0) + rng.normal(0, 1e-7, n)
+           for k, name in enumerate(["input_bar", "internal_output_bar", "external_output_bar"])}
+    with tempfile.TemporaryDirectory() as d:
+        p = write_record(
+            Path(d) / "u.h5", test_id="U-1", campaign="U", sample_rate=FS, strains=eps,
+            apparatus=paper_apparatus(), units={k: units for k in eps},
+            strain_per_volt={k: spv for k in eps} if units == "V" else None,
+        )
+        rec = read_record(p)
+    for name, e in eps.items():
+        assert np.allclose(rec.strain(name), e, rtol=1e-12, atol=1e-18)
+        assert rec.channels[name].units == units
