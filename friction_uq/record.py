@@ -21,6 +21,7 @@ import os
 import tempfile
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
+from datetime import datetime
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -44,6 +45,9 @@ UNITS = {"strain": 1.0, "microstrain": 1e-6, "V": None}
 DEFAULT_BAR_POISSON_RATIO = 0.30
 
 #: Minimum run of identical samples at a channel's extreme value that marks it as clipped.
+#: The test applies only to channels whose pre-trigger head (first 2 %, at least 32 samples)
+#: shows resolved noise: in a noise-free (synthetic) record or one whose noise is below one
+#: digitiser step, a run of equal values is a plateau, not a saturated amplifier.
 CLIP_RUN = 8
 
 #: Minimum number of samples in a channel.
@@ -302,6 +306,8 @@ class _Reader:
             if value.shape not in ((), (1,)):
                 raise self.fail(loc, f"must be a scalar, got an array of shape {value.shape}")
             value = value.reshape(())[()]
+        if isinstance(value, np.generic):  # messages show plain values, not np.float64(...)
+            value = value.item()
         if isinstance(value, bytes):
             value = value.decode("utf-8", "replace")
         if kind == "str":
@@ -324,6 +330,15 @@ class _Reader:
         if not math.isfinite(value):
             raise self.fail(loc, f"must be finite, got {value!r}")
         return value
+
+    def member(self, group: Any, name: str, where: str) -> Any:
+        """``group[name]``, or None if absent; a dangling soft or external link is refused at ``where``."""
+        if name not in group:
+            return None
+        try:
+            return group[name]
+        except (KeyError, OSError) as exc:
+            raise self.fail(where, f"is a broken link ({exc})") from None
 
     def positive(self, obj: Any, where: str, name: str) -> float:
         value = self.attr(obj, where, name, "float")
@@ -407,23 +422,30 @@ def _read_open(fh: Any, p: Path, r: _Reader) -> Record:
     if not campaign.strip():
         raise r.fail("/@campaign", "is empty")
     date = r.attr(fh, "/", "date", "str", required=False)
+    if date is not None:
+        try:
+            datetime.fromisoformat(date)
+        except ValueError:
+            raise r.fail(
+                "/@date", f"is {date!r}, not an ISO 8601 date such as '2016-03-01' or '2016-03-01T10:42:00'"
+            ) from None
     description = r.attr(fh, "/", "description", "str", required=False)
     striker_velocity = r.attr(fh, "/", "striker_velocity", "float", required=False)
     if striker_velocity is not None and striker_velocity <= 0:
         raise r.fail("/@striker_velocity", f"must be > 0 m/s, got {striker_velocity!r}")
 
     # ---- apparatus ----
-    if "apparatus" not in fh:
+    app = r.member(fh, "apparatus", "/apparatus")
+    if app is None:
         raise r.fail("/apparatus", "required group is missing")
-    app = fh["apparatus"]
     if not isinstance(app, h5py.Group):
         raise r.fail("/apparatus", "must be a group")
     apparatus = _read_apparatus(app, r)
 
     # ---- signals ----
-    if "signals" not in fh:
+    sig = r.member(fh, "signals", "/signals")
+    if sig is None:
         raise r.fail("/signals", "required group is missing")
-    sig = fh["signals"]
     if not isinstance(sig, h5py.Group):
         raise r.fail("/signals", "must be a group")
     sample_rate = r.attr(sig, "/signals", "sample_rate", "float")
@@ -437,19 +459,21 @@ def _read_open(fh: Any, p: Path, r: _Reader) -> Record:
     first: str | None = None
     for name in CHANNELS:
         where = f"/signals/{name}"
-        if name not in sig:
+        ds = r.member(sig, name, where)
+        if ds is None:
             if name in REQUIRED_CHANNELS:
                 raise r.fail(where, "required channel is missing")
             continue
-        ds = sig[name]
         if not isinstance(ds, h5py.Dataset):
             raise r.fail(where, "must be a dataset")
         if ds.ndim != 1:
             raise r.fail(where, f"must be 1-D, got shape {ds.shape}")
-        if ds.dtype not in (np.float32, np.float64):
+        if ds.dtype.kind != "f" or ds.dtype.itemsize not in (4, 8):
             raise r.fail(where, f"must be float32 or float64, got {ds.dtype}")
         if length is None:
             length, first = ds.shape[0], name
+            if length < MIN_SAMPLES:
+                raise r.fail(where, f"has {length} samples, at least {MIN_SAMPLES} are needed")
         elif ds.shape[0] != length:
             raise r.fail(
                 where, f"has {ds.shape[0]} samples but /signals/{first} has {length}; channels must have equal length"
@@ -473,8 +497,6 @@ def _read_open(fh: Any, p: Path, r: _Reader) -> Record:
         strain.setflags(write=False)
         channels[name] = Channel(name, strain, units, spv)
     assert length is not None  # REQUIRED_CHANNELS is not empty
-    if length < MIN_SAMPLES:
-        raise r.fail(f"/signals/{first}", f"has {length} samples, at least {MIN_SAMPLES} are needed")
 
     # a record must be long enough for the reflected wave to pass the input-bar gauge
     duration = length / sample_rate
@@ -489,9 +511,9 @@ def _read_open(fh: Any, p: Path, r: _Reader) -> Record:
         )
 
     provenance: dict[str, Any] = {}
-    if "provenance" in fh:
-        for k, v in fh["provenance"].attrs.items():
-            provenance[k] = v.decode() if isinstance(v, bytes) else (v.item() if hasattr(v, "item") else v)
+    prov = r.member(fh, "provenance", "/provenance")
+    if prov is not None:
+        provenance = {k: _plain(v) for k, v in prov.attrs.items()}
 
     return Record(
         path=str(p),
@@ -509,6 +531,17 @@ def _read_open(fh: Any, p: Path, r: _Reader) -> Record:
     )
 
 
+def _plain(value: Any) -> Any:
+    """An attribute value of the free-form groups as plain Python (any shape, any encoding)."""
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    if isinstance(value, np.ndarray):
+        return _plain(value.reshape(())[()]) if value.size == 1 else [_plain(v) for v in value.tolist()]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
 def _check_samples(raw: np.ndarray, where: str, r: _Reader) -> None:
     bad = ~np.isfinite(raw)
     if bad.any():
@@ -516,13 +549,20 @@ def _check_samples(raw: np.ndarray, where: str, r: _Reader) -> None:
         kind = "NaN" if np.isnan(raw[i]) else "inf"
         raise r.fail(where, f"has {int(bad.sum())} non-finite samples ({kind} first at index {i})")
     if raw.size and np.ptp(raw) == 0.0:
-        raise r.fail(where, f"is flat (every sample equals {raw[0]!r}): the gauge recorded no signal")
+        raise r.fail(where, f"is flat (every sample equals {float(raw[0])!r}): the gauge recorded no signal")
+    head = raw[: max(32, raw.size // 50)]
+    if np.ptp(head) == 0.0:
+        return
+    median = float(np.median(raw))
+    swing = float(np.max(np.abs(raw - median)))
     for extreme, label in ((raw.max(), "maximum"), (raw.min(), "minimum")):
+        if abs(float(extreme) - median) < 0.5 * swing:
+            continue  # the extreme of the side the pulse does not reach: baseline noise
         run = _longest_run(raw == extreme)
         if run >= CLIP_RUN:
             raise r.fail(
                 where,
-                f"is clipped: {run} consecutive samples sit at the {label} value {extreme!r} "
+                f"is clipped: {run} consecutive samples sit at the {label} value {float(extreme)!r} "
                 "(amplifier or digitiser saturated); re-record with a smaller gain",
             )
 
@@ -541,9 +581,9 @@ def _read_apparatus(app: Any, r: _Reader) -> Apparatus:
     parts: dict[str, dict[str, Any]] = {}
     for part, names in _APPARATUS_SCHEMA.items():
         where = f"/apparatus/{part}"
-        if part not in app:
+        g = r.member(app, part, where)
+        if g is None:
             raise r.fail(where, "required group is missing")
-        g = app[part]
         if not isinstance(g, h5py.Group):
             raise r.fail(where, "must be a group")
         vals: dict[str, Any] = {}
@@ -562,8 +602,8 @@ def _read_apparatus(app: Any, r: _Reader) -> Apparatus:
         parts[part] = vals
 
     plug = None
-    if "plug" in app:
-        g = app["plug"]
+    g = r.member(app, "plug", "/apparatus/plug")
+    if g is not None:
         plug = Plug(**{n: r.positive(g, "/apparatus/plug", n) for n in _PLUG_ATTRS})
 
     # cross-checks
@@ -765,5 +805,4 @@ def read_truth(path: str | os.PathLike[str]) -> dict[str, Any]:
     with h5py.File(path, "r") as fh:
         if "truth" not in fh:
             return {}
-        return {k: (v.decode() if isinstance(v, bytes) else (v.item() if hasattr(v, "item") else v))
-                for k, v in fh["truth"].attrs.items()}
+        return {k: _plain(v) for k, v in fh["truth"].attrs.items()}
