@@ -790,6 +790,9 @@ def write_record(
                 tg = fh.create_group("truth")
                 for k, v in truth.items():
                     tg.attrs[k] = v
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a record is an ordinary file
         os.replace(tmp, p)
     except BaseException:
         if os.path.exists(tmp):

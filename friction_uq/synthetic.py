@@ -5,7 +5,8 @@ of amplitude V_s / (2 C_i) (eq. 14); the two output forces follow the same trape
 stationary levels (eq. 15-16), the input force is their sum (eq. 5), so the reflected wave is
 F_i / (A_i E_i) - eps_i (eq. 2) and the ends of the sample move together in the plateau (eq. 6).
 The hoop gauge reads the Lame strain of the eq. 20 wall pressure, seen through the tube kernel
-(physics.md section 6) as the sample slides past it. Noise is white plus AR(1), with offsets.
+(physics.md section 6) as the sample slides past it, plus the Poisson widening of the tube under
+the axial friction load it carries at the gauge. Noise is white plus AR(1), with offsets.
 
 These records test the analysis against the paper's own model. The simulator
 (:mod:`friction_uq.simulate`) adds the physics the model leaves out. Both write through
@@ -123,7 +124,14 @@ def closed_form_strains(test: ClosedFormTest, apparatus: Apparatus) -> tuple[np.
         kern = tube.hoop_kernel(z_g[:, None] - s[None, :], beta=test.hoop_beta)
         seen = np.trapezoid(shape[None, :] * kern, s, axis=1)
         lame = tb.lame_hoop_strain_per_pressure
-        strains["tube_hoop"] = -lame * p_mean * seen  # compression positive: swelling reads negative
+        # friction carried by the tube at the gauge: the wall force between the input face and
+        # the gauge, F_i - sigma(z) pi R^2 (eq. 11-13); axial compression widens the tube by
+        # nu_t N / (E_t A_t) (physics.md section 6)
+        z_in = np.clip(z_g + L / 2, 0.0, L)
+        fb = test.f * float(cell.beta(test.nu, radius=R, length=L))
+        N = F_io(t) * (np.exp(fb) - np.exp(fb * (L - z_in) / L))
+        axial = tb.poisson_ratio * N / (tb.young_modulus * tb.area)
+        strains["tube_hoop"] = -(lame * p_mean * seen + axial)  # compression positive: swelling reads negative
     truth = {
         "f": test.f, "nu": test.nu, "kappa": float(cell.kappa(test.f, test.nu)),
         "striker_velocity_true": test.striker_velocity, "F_io": F_io0, "F_eo": F_eo0,

@@ -1,0 +1,122 @@
+"""Wall friction laws of the simulator: one registry, one entry per named law.
+
+A law gives the shear strength tau_max (Pa) of the sample/tube interface from the local wall
+pressure p (Pa), the local sliding speed V (m/s) and the slip distance already travelled d (m).
+The cell kernel (:mod:`.cell`) applies it at every node as a Coulomb-type set-valued law: the
+interface sticks while the force needed to stick stays below tau_max times the node's wall area,
+and slides with tau = tau_max against the sliding direction otherwise (physics.md eq. 10 for the
+``coulomb`` law).
+
+Laws (physics.md section 5):
+
+``coulomb``         tau = f p                                       (eq. 10)
+``velocity``        tau = [f_d + (f_s - f_d) exp(-V / v_c)] p       (velocity weakening or strengthening)
+``pressure``        tau = min(f p, tau_max)                         (shear-strength limited)
+``hyperbolic``      tau = f0 p / (1 + p / p0)                       (pressure dependent, smooth)
+``slip_weakening``  tau = [f_d + (f_s - f_d) max(0, 1 - d / d_c)] p (linear weakening over d_c)
+
+Adding a law touches this module only: one :class:`FrictionLaw` entry in :data:`LAWS` (name,
+code, parameters with units and bounds) and one branch of :func:`shear_strength`. The
+configuration reader, the ``/truth`` group and the documentation read the registry.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._jit import njit
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter of a friction law: name, unit, allowed interval [low, high] and meaning."""
+
+    name: str
+    unit: str
+    low: float
+    high: float
+    doc: str
+    low_open: bool = False  # True: the value must be > low
+
+    def allows(self, value: float) -> bool:
+        above = value > self.low if self.low_open else value >= self.low
+        return above and value <= self.high
+
+    def describe_range(self) -> str:
+        lo = "(" if self.low_open else "["
+        return f"{lo}{self.low:g}, {self.high:g}]"
+
+
+@dataclass(frozen=True)
+class FrictionLaw:
+    """A named friction law: integer ``code`` used by the compiled kernel and its parameters."""
+
+    name: str
+    code: int
+    params: tuple[Param, ...]
+    doc: str
+
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.params)
+
+    def pack(self, values: Mapping[str, float]) -> np.ndarray:
+        """Parameter vector in the order of :attr:`params` (what :func:`shear_strength` reads)."""
+        return np.array([float(values[p.name]) for p in self.params], dtype=np.float64)
+
+
+_F = 5.0  # largest friction coefficient accepted (far beyond any lubricated interface)
+COULOMB, VELOCITY, PRESSURE, HYPERBOLIC, SLIP_WEAKENING = 0, 1, 2, 3, 4
+
+LAWS: dict[str, FrictionLaw] = {
+    "coulomb": FrictionLaw("coulomb", COULOMB, (
+        Param("f", "-", 0.0, _F, "friction coefficient"),
+    ), "tau = f p (eq. 10)"),
+    "velocity": FrictionLaw("velocity", VELOCITY, (
+        Param("f_s", "-", 0.0, _F, "coefficient at zero sliding speed"),
+        Param("f_d", "-", 0.0, _F, "coefficient at high sliding speed"),
+        Param("v_c", "m/s", 0.0, 1e3, "characteristic speed", low_open=True),
+    ), "tau = [f_d + (f_s - f_d) exp(-V/v_c)] p"),
+    "pressure": FrictionLaw("pressure", PRESSURE, (
+        Param("f", "-", 0.0, _F, "friction coefficient below the shear limit"),
+        Param("tau_max", "Pa", 0.0, 1e10, "shear strength of the interface", low_open=True),
+    ), "tau = min(f p, tau_max)"),
+    "hyperbolic": FrictionLaw("hyperbolic", HYPERBOLIC, (
+        Param("f0", "-", 0.0, _F, "coefficient at zero pressure"),
+        Param("p0", "Pa", 0.0, 1e11, "pressure at which f has halved", low_open=True),
+    ), "tau = f0 p / (1 + p/p0)"),
+    "slip_weakening": FrictionLaw("slip_weakening", SLIP_WEAKENING, (
+        Param("f_s", "-", 0.0, _F, "static (initial) coefficient"),
+        Param("f_d", "-", 0.0, _F, "dynamic coefficient after the slip d_c"),
+        Param("d_c", "m", 0.0, 1.0, "critical slip distance", low_open=True),
+    ), "tau = [f_d + (f_s - f_d) max(0, 1 - d/d_c)] p"),
+}
+
+
+@njit
+def shear_strength(code: int, par: np.ndarray, p: float, v: float, d: float) -> float:
+    """Shear strength tau_max (Pa) of the wall at pressure ``p`` (Pa), speed ``v`` (m/s), slip ``d`` (m).
+
+    ``code`` and ``par`` come from a :class:`FrictionLaw` (:data:`LAWS`); ``v`` and ``d`` are >= 0.
+
+    >>> round(shear_strength(COULOMB, np.array([0.05]), 1e8, 0.0, 0.0) / 1e6, 6)
+    5.0
+    """
+    if p <= 0.0:
+        return 0.0
+    if code == COULOMB:
+        return par[0] * p
+    if code == VELOCITY:
+        return (par[1] + (par[0] - par[1]) * math.exp(-v / par[2])) * p
+    if code == PRESSURE:
+        return min(par[0] * p, par[1])
+    if code == HYPERBOLIC:
+        return par[0] * p / (1.0 + p / par[1])
+    if code == SLIP_WEAKENING:
+        w = 1.0 - d / par[2]
+        return (par[1] + (par[0] - par[1]) * (w if w > 0.0 else 0.0)) * p
+    return math.nan  # unknown code: poisons the run instead of failing silently

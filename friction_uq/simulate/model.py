@@ -1,0 +1,190 @@
+"""The noise-free model of one test: striker, bars, cell and gauges, from a configuration.
+
+Time base: t = 0 when the incident wave's foot reaches the input-bar gauge; the record starts at
+t0 = -pretrigger. The cell is integrated on a grid of step dt = (1 / sample_rate) / n_sub, n_sub
+the smallest integer that keeps dt below ``cfl`` times the column's CFL limit
+(:func:`.cell.critical_time_step`); everything is reported on the record's grid (every n_sub-th
+step). The bar legs feed the cell through waves that return after free far-end reflections, so
+the cell is advanced in blocks no longer than the shortest bar round trip 2 L / c: each block's
+returning waves depend only on waves that left the cell in earlier blocks, which makes the
+coupling exact with or without dispersion.
+
+Stationary window (:attr:`ModelOutput.plateau`): the last quarter of the incident plateau as it
+acts on the cell, [t_c + t_r + 3 (T - t_r)/4, t_c + T], with t_c = d_i / c_i the arrival of the
+incident foot at the cell, t_r the rise time and T = 2 L_s / c_s the pulse length (the plateau's
+fall starts at t_c + T). The forces approach their stationary values exponentially: the soft sample
+(a spring of stiffness k = M A / L, M the confined modulus) is compressed through the two bar
+impedances, with time constant tau ~ 1 / (k_eff (1/Z_i + 1/(e Z_io))), e = exp(f beta), about
+30 us at f = 0.01 and 90 us at f = 0.5 for the paper's set-up (physics.md section 4: the paper's
+stationary phase came 300-400 us after the start of loading). In the last quarter of the plateau
+the forces are within 0.1 % of eq. 15-16 for f <= 0.5; the cell's fast transients (sample
+transit ~7 us, tube m_t / Z_eo ~5 us) are long over and the output bars' far-end reflections
+(2 L / c ~ 570 us) arrive later.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..physics.tube import bore_compliance_factor
+from . import bars, cell
+from .config import SimulationConfig
+from .friction import LAWS
+from .hoop import hoop_strain
+
+
+@dataclass(frozen=True)
+class ModelOutput:
+    """Noise-free result on the record's grid (n samples). SI units, compression positive.
+
+    Forces at the cell (N): ``force_input`` F_i (input bar on plug), ``force_internal`` F_io
+    (sample on internal output bar), ``force_external`` F_eo (tube on external output bar),
+    ``plug_friction`` (tube on plug, negative while the plug slides forward).
+    Velocities (m/s, towards the output bars): ``velocity_plug`` (plug and input face),
+    ``velocity_output_face`` (sample face on the internal bar), ``velocity_tube``,
+    ``sliding_velocity`` V = velocity_output_face - velocity_tube (eq. 7).
+    ``sliding_displacement`` (m): mean displacement of the sample's nodes relative to the tube.
+    ``wall_pressure`` (Pa), shape (n, N): pressure on each element's wall; ``node_displacement``
+    (m), shape (n, N + 1): nodes relative to the tube; ``wall_friction`` (N), shape (n, N + 1):
+    friction force on each node of the sample.
+    Momenta (kg m/s) of the sample, the plug and the tube, and ``impulse`` (N s), the running
+    integral of F_i - F_io - F_eo (the cell's momentum balance).
+    ``strains``: gauge strains, true (no gain, no noise), channel name -> array.
+    """
+
+    time: np.ndarray
+    strains: dict[str, np.ndarray]
+    force_input: np.ndarray
+    force_internal: np.ndarray
+    force_external: np.ndarray
+    plug_friction: np.ndarray
+    velocity_plug: np.ndarray
+    velocity_output_face: np.ndarray
+    velocity_tube: np.ndarray
+    sliding_velocity: np.ndarray
+    sliding_displacement: np.ndarray
+    wall_pressure: np.ndarray
+    node_displacement: np.ndarray
+    wall_friction: np.ndarray
+    momentum_sample: np.ndarray
+    momentum_plug: np.ndarray
+    momentum_tube: np.ndarray
+    impulse: np.ndarray
+    plateau: tuple[float, float]
+    incident_strain: float
+    time_step: float
+    substeps: int
+
+
+def run_model(config: SimulationConfig) -> ModelOutput:
+    """Integrate the test described by ``config`` (deterministic, no noise)."""
+    app = config.apparatus
+    ib, iob, eob, tube, sample = app.input_bar, app.internal_output_bar, app.external_output_bar, app.tube, app.sample
+    plug = app.plug
+    assert plug is not None  # the configuration always sets one
+    nu, n_el = config.poisson_ratio, config.elements
+    dt_out = 1.0 / config.sample_rate
+    n_out = int(round(config.duration * config.sample_rate))
+    t_start = -config.pretrigger
+
+    # sample column, tube, plug
+    h = sample.length / n_el
+    radius, area = sample.radius, sample.area
+    a, b = tube.inner_diameter / 2, tube.outer_diameter / 2
+    c_t = bore_compliance_factor(inner_radius=a, outer_radius=b, poisson_ratio=tube.poisson_ratio)
+    den = (1.0 - nu) + (sample.young_modulus * c_t / tube.young_modulus if config.tube_compliance else 0.0)
+    egr = sample.young_modulus * config.gap / radius
+    c_max = cell.max_wave_speed(young_modulus=sample.young_modulus, density=sample.density, nu=nu, den=den)
+    dt_crit = cell.critical_time_step(element_length=h, wave_speed=c_max, damping=config.damping)
+    n_sub = max(1, math.ceil(dt_out / (config.cfl * dt_crit)))
+    dt = dt_out / n_sub
+    n = n_out * n_sub
+    m_plug = plug.density * math.pi * a * a * plug.length
+    mass = np.full(n_el + 1, sample.density * area * h)
+    mass[0] = 0.5 * mass[0] + m_plug
+    mass[-1] *= 0.5
+    par = np.zeros(cell.N_PAR)
+    par[[cell.DT, cell.H, cell.AREA, cell.WALL]] = dt, h, area, math.pi * radius * h
+    par[[cell.E, cell.NU, cell.DEN, cell.EGR, cell.SIGSTAR]] = (
+        sample.young_modulus, nu, den, egr, egr / nu)
+    par[[cell.ZI, cell.CI, cell.ZIO, cell.CIO, cell.ZEO, cell.CEO]] = (
+        ib.impedance, ib.wave_speed, iob.impedance, iob.wave_speed, eob.impedance, eob.wave_speed)
+    par[cell.MT] = config.tube_density * tube.area * tube.length
+    par[[cell.PF_FORCE, cell.PF_COEF, cell.MPLUG]] = (
+        config.plug_friction_force, config.plug_friction_coefficient, m_plug)
+    par[cell.ETA] = config.damping * sample.density * c_max * h
+    law = LAWS[config.friction_law]
+    fpar = law.pack(config.friction_params)
+
+    # incident wave
+    eps_i = bars.incident_amplitude(config.striker_velocity, striker=app.striker, input_bar=ib)
+    pulse = app.pulse_duration
+    disp = config.dispersion
+    inc_cell, inc_gauge = bars.incident_waves(amplitude=eps_i, pulse_duration=pulse, rise_time=config.rise_time,
+                                              input_bar=ib, t_start=t_start, dt=dt, n=n, dispersive=disp)
+
+    # state and outputs
+    u, v, slip, st = np.zeros(n_el + 1), np.zeros(n_el + 1), np.zeros(n_el + 1), np.zeros(cell.N_STATE)
+    eps_in = [inc_cell.copy(), np.zeros(n), np.zeros(n)]
+    eps_out = [np.zeros(n), np.zeros(n), np.zeros(n)]
+    forces = [np.zeros(n), np.zeros(n), np.zeros(n)]
+    rec_p = np.zeros((n_out, n_el))
+    rec_u = np.zeros((n_out, n_el + 1))
+    rec_ff = np.zeros((n_out, n_el + 1))
+    rec_s = np.zeros((n_out, cell.N_REC))
+    legs = (ib, iob, eob)
+    block = min(int(2.0 * bar.length / bar.wave_speed / dt) for bar in legs)
+    k0 = 0
+    while k0 < n:
+        k1 = min(n, k0 + block)
+        if k0 > 0:  # waves back from the free far ends, from what left the cell before k0
+            for j, bar in enumerate(legs):
+                back = bars.returning_wave(eps_out[j], dt=dt, bar=bar, dispersive=disp)
+                eps_in[j][k0:k1] = back[k0:k1] + (inc_cell[k0:k1] if j == 0 else 0.0)
+        cell.run_block(k0, k1, n_sub, par, law.code, fpar, mass, u, v, slip, st, *eps_in, *eps_out, *forces,
+                       rec_p, rec_u, rec_ff, rec_s)
+        k0 = k1
+
+    # gauges
+    strains = {
+        "input_bar": bars.gauge_strain_input(inc_gauge, eps_out[0], dt=dt, bar=ib, dispersive=disp)[::n_sub],
+        "internal_output_bar": bars.gauge_strain_output(eps_out[1], dt=dt, bar=iob, dispersive=disp)[::n_sub],
+        "external_output_bar": bars.gauge_strain_output(eps_out[2], dt=dt, bar=eob, dispersive=disp)[::n_sub],
+    }
+    if config.channels["tube_hoop"].enabled:
+        tube_force = -rec_ff.copy()
+        tube_force[:, 0] -= rec_s[:, cell.R_PLUG_FRICTION]
+        hoop = hoop_strain(rec_p, rec_u, tube=tube, sample_length=sample.length, beta=config.hoop_beta,
+                           tube_force=tube_force if config.hoop_axial_term else None)
+        strains["tube_hoop"] = -hoop  # compression positive inside the package
+    t_c = ib.gauge_distance / ib.wave_speed
+    tr = config.rise_time
+    plateau = (t_c + tr + 0.75 * (pulse - tr), t_c + pulse)
+    s = rec_s
+    return ModelOutput(
+        time=t_start + np.arange(n_out) * dt_out,
+        strains=strains,
+        force_input=forces[0][::n_sub].copy(),
+        force_internal=forces[1][::n_sub].copy(),
+        force_external=forces[2][::n_sub].copy(),
+        plug_friction=s[:, cell.R_PLUG_FRICTION].copy(),
+        velocity_plug=s[:, cell.R_V0].copy(),
+        velocity_output_face=s[:, cell.R_VN].copy(),
+        velocity_tube=s[:, cell.R_VT].copy(),
+        sliding_velocity=s[:, cell.R_VN] - s[:, cell.R_VT],
+        sliding_displacement=s[:, cell.R_SLIP].copy(),
+        wall_pressure=rec_p,
+        node_displacement=rec_u,
+        wall_friction=rec_ff,
+        momentum_sample=s[:, cell.R_P_SAMPLE].copy(),
+        momentum_plug=s[:, cell.R_P_PLUG].copy(),
+        momentum_tube=s[:, cell.R_P_TUBE].copy(),
+        impulse=s[:, cell.R_IMPULSE].copy(),
+        plateau=plateau,
+        incident_strain=eps_i,
+        time_step=dt,
+        substeps=n_sub,
+    )
