@@ -1,0 +1,125 @@
+"""The multi-page PDF report of one run, written atomically."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from ..analysis import Identification, Prepared
+from ..diagnostics import Convergence, FNuBand, FUnderPrior, RatioPPC, VariableSummary
+from ..sampler import PosteriorSamples
+from .posterior_pages import page_convergence, page_corner, page_ppc, page_propagation
+from .signal_pages import page_forces, page_raw, page_window
+from .style import figure
+
+UNITS = {"f": ("-", 1.0), "nu": ("-", 1.0), "kappa": ("-", 1.0), "hoop_gain": ("-", 1.0), "ratio": ("-", 1.0),
+         "p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
+
+
+@dataclass(frozen=True)
+class ReportInputs:
+    """Everything the report draws, computed upstream."""
+
+    prepared: Prepared
+    samples: PosteriorSamples
+    datatree: xr.DataTree
+    summary: dict[str, VariableSummary]
+    convergence: Convergence
+    band: FNuBand
+    sensitivity: dict[str, FUnderPrior]
+    nu_share: float
+    ppc: RatioPPC
+    lab: Identification
+    V: VariableSummary
+    version: str
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.4g}"
+
+
+def page_summary(r: ReportInputs) -> Figure:
+    """Page: the answer first, in words and one table."""
+    rec = r.prepared.record
+    fig, ax = figure(f"friction-uq report: {rec.campaign} {rec.test_id} (sample {rec.apparatus.sample.material})")
+    ax.axis("off")
+    s = r.summary
+    f, nu = s["f"], s["nu"]
+    share = r.nu_share
+    lines = [
+        f"Friction coefficient f = {f.q50:.3f}, 90 % credible interval [{f.q05:.3f}, {f.q95:.3f}] "
+        f"(posterior mean {f.mean:.3f}, sd {f.sd:.3f}).",
+        f"Poisson ratio nu = {nu.q50:.3f} [{nu.q05:.3f}, {nu.q95:.3f}]; the forces fix only "
+        f"kappa = f nu/(1-nu) = {s['kappa'].q50:.4f} [{s['kappa'].q05:.4f}, {s['kappa'].q95:.4f}] (eq. 17).",
+        f"{100 * share:.0f} % of the variance of f comes from the uncertainty of nu (law of total variance).",
+        f"Stationary phase {r.prepared.window.t0 * 1e6:.1f} - {r.prepared.window.t1 * 1e6:.1f} us "
+        f"({'automatic' if r.prepared.window.automatic else 'given by hand'}); sliding velocity "
+        f"V = {r.V.q50:.2f} m/s, mean wall pressure p_mean = {s['p_mean'].q50 / 1e6:.1f} MPa.",
+        f"The lab's point estimate (eq. 17 with nu = {r.lab.nu:g}): f = {r.lab.f:.4f}, "
+        f"F_eo/F_io = {r.lab.ratio:.4f}, equilibrium error {100 * r.lab.equilibrium_error:+.1f} %.",
+        f"Hoop gauge term: {'used' if r.samples.hoop else 'not used'}. Convergence: "
+        f"{'OK' if r.convergence.ok else 'NOT REACHED'} (R-hat max {r.convergence.r_hat_max:.3f}, "
+        f"ESS min {min(r.convergence.ess_bulk_min, r.convergence.ess_tail_min):.0f}).",
+        f"Posterior predictive check: the observed ratio lies in the 90 % band {100 * r.ppc.coverage:.0f} % of "
+        "the window" + (" - the constant-ratio model misses something here (page 7)." if r.ppc.coverage < 0.7 else "."),
+    ]
+    y = 0.97
+    for line in lines:
+        ax.text(0.0, y, line, fontsize=11, va="top", wrap=True, transform=ax.transAxes)
+        y -= 0.065
+    rows = []
+    for name, v in list(s.items()) + [("V", r.V)]:
+        unit, scale = UNITS.get(name, ("", 1.0))
+        rows.append([name, unit, _fmt(v.mean * scale), _fmt(v.sd * scale), _fmt(v.q05 * scale), _fmt(v.q50 * scale),
+                     _fmt(v.q95 * scale), f"{v.r_hat:.4f}" if np.isfinite(v.r_hat) else "-",
+                     f"{v.ess_bulk:.0f}" if np.isfinite(v.ess_bulk) else "-"])
+    tab = ax.table(cellText=rows, colLabels=["quantity", "unit", "mean", "sd", "q05", "q50", "q95", "R-hat", "ESS"],
+                   loc="lower left", bbox=[0.0, 0.05, 0.75, 0.42])
+    tab.auto_set_font_size(False)
+    tab.set_fontsize(9)
+    prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
+            f"seed {r.samples.seed}, friction-uq {r.version}")
+    ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
+    ax.text(0.77, 0.47, "Pages\n 1 raw gauges\n 2 waves, forces, equilibrium\n 3 window and noise\n"
+            " 4 posterior vs prior\n 5 nu -> f\n 6 convergence\n 7 predictive check",
+            fontsize=10, va="top", transform=ax.transAxes, family="monospace")
+    return fig
+
+
+def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
+    """Write the PDF (summary page, then pages 1-7) atomically."""
+    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    p = r.prepared
+    out = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".pdf", dir=out.parent)
+    os.close(fd)
+    try:
+        with PdfPages(tmp, metadata={"Title": f"friction-uq {p.record.campaign} {p.record.test_id}",
+                                     "Creator": f"friction-uq {r.version}"}) as pdf:
+            builders = [
+                lambda: page_summary(r),
+                lambda: page_raw(p.record),
+                lambda: page_forces(p.record, p.forces, p.window),
+                lambda: page_window(p.record, p.forces, p.window),
+                lambda: page_corner(r.samples, r.datatree),
+                lambda: page_propagation(r.samples, r.band, r.sensitivity, r.nu_share, nu_assumed=r.lab.nu),
+                lambda: page_convergence(r.samples, r.convergence),
+                lambda: page_ppc(r.ppc),
+            ]
+            for build in builders:
+                fig = build()
+                pdf.savefig(fig)
+                plt.close(fig)
+        os.replace(tmp, out)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return out

@@ -1,0 +1,136 @@
+"""Report pages about the posterior: corner plot against the priors, nu -> f, convergence, PPC.
+
+Pages only draw what :mod:`friction_uq.diagnostics` computed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from ..diagnostics import Convergence, FNuBand, FUnderPrior, RatioPPC
+from ..sampler import PosteriorSamples
+from .style import RC, figure
+
+US = 1e6
+LABELS = {"f": "f (-)", "nu": "nu (-)", "hoop_gain": "hoop gain g (-)", "kappa": "kappa = f nu/(1-nu) (-)"}
+
+
+def _prior_lines(description: str) -> list[str]:
+    """One short line per parameter from a :meth:`Priors.describe` text (notes dropped)."""
+    out = []
+    for line in description.splitlines():
+        line = line.strip()
+        if "~" in line:
+            out.append(line.split("  --")[0].split(" -- ")[0])
+    return out
+
+
+def page_corner(samples: PosteriorSamples, dt: xr.DataTree, *, number: int = 4) -> Figure:
+    """Corner plot of the sampled parameters, prior densities on the diagonal."""
+    import corner
+    import matplotlib.pyplot as plt
+
+    names = list(samples.names)
+    data = np.column_stack([samples.flat(n) for n in names])
+    with plt.rc_context(RC):
+        fig = plt.figure(figsize=(8.27, 8.27))
+        corner.corner(
+            data, fig=fig, labels=[LABELS.get(n, n) for n in names], quantiles=[0.05, 0.5, 0.95],
+            show_titles=True, title_fmt=".4f", title_kwargs={"fontsize": 9}, label_kwargs={"fontsize": 10},
+            hist_kwargs={"density": True}, plot_datapoints=False, fill_contours=True, levels=(0.5, 0.9),
+        )
+        axes = np.array(fig.axes).reshape(len(names), len(names))
+        prior = dt["prior"] if "prior" in dt.children else None
+        for i, n in enumerate(names):
+            ax = axes[i, i]
+            if prior is not None and n in prior.data_vars:
+                x = np.asarray(prior[n].values).reshape(-1)
+                lo, hi = ax.get_xlim()
+                xs = x[(x >= lo) & (x <= hi)]
+                if xs.size > 10:
+                    frac = xs.size / x.size
+                    h, edges = np.histogram(xs, bins=30, range=(lo, hi), density=True)
+                    ax.stairs(h * frac, edges, color="C1", lw=1.2, label="prior")
+            if i == 0:
+                ax.legend(["posterior", "prior"], fontsize=8, loc="upper right")
+        fig.suptitle(f"{number}. Joint posterior of f and nu (90 % and 50 % regions) against the priors", y=0.995)
+        fig.text(0.52, 0.80, "priors (orange):\n" + "\n".join(_prior_lines(samples.prior_description)),
+                 fontsize=8, va="top")
+    return fig
+
+
+def page_propagation(
+    samples: PosteriorSamples, band: FNuBand, sensitivity: dict[str, FUnderPrior], share: float,
+    *, nu_assumed: float = 0.4, number: int = 5,
+) -> Figure:
+    """nu -> f: f against nu with its band, f under three nu priors, the variance share due to nu."""
+    fig, axes = figure(f"{number}. How the uncertainty of nu becomes the uncertainty of f", nrows=1, ncols=2)
+    ax = axes[0]
+    ax.fill_between(band.nu, band.q05, band.q95, color="C0", alpha=0.25, label="90 % band of f given nu")
+    ax.plot(band.nu, band.q50, color="C0", label="median of f given nu (eq. 17)")
+    f, nu = samples.flat("f"), samples.flat("nu")
+    step = max(1, len(f) // 2000)
+    ax.plot(nu[::step], f[::step], ".", ms=1.5, color="k", alpha=0.3, label="posterior draws (f, nu)")
+    ax.axvline(nu_assumed, color="0.5", ls=":", lw=1)
+    ax.set_xlabel("Poisson ratio of the sample nu (-)")
+    ax.set_ylabel("friction coefficient f (-)")
+    ax.set_title(f"share of Var(f) due to nu (law of total variance): {100 * share:.0f} %", loc="left")
+    ax.legend(loc="upper right")
+    ax.set_ylim(0, max(float(np.max(band.q95[band.nu >= 0.2])) * 1.1, float(np.quantile(f, 0.999)) * 1.1))
+    ax = axes[1]
+    for k, (label, s) in enumerate(sensitivity.items()):
+        hist, edges = np.histogram(s.draws, bins=60, density=True)
+        nu_line = next((ln for ln in _prior_lines(s.prior_description) if ln.startswith("nu")), "")
+        ax.stairs(hist, edges, color=f"C{k}", lw=1.5,
+                  label=f"{label}: {s.q50:.4f} [{s.q05:.4f}, {s.q95:.4f}]\n  {nu_line}")
+    ax.set_xlabel("friction coefficient f (-)")
+    ax.set_ylabel("posterior density (1/-)")
+    ax.set_title("f under three priors for nu: median [90 % interval]", loc="left")
+    ax.legend(loc="upper right", fontsize=8)
+    return fig
+
+
+def page_convergence(samples: PosteriorSamples, conv: Convergence, *, number: int = 6) -> Figure:
+    """Traces per chain (independent ensembles), R-hat, ESS, autocorrelation times."""
+    names = list(samples.names)
+    fig, axes = figure(f"{number}. Convergence: {'OK' if conv.ok else 'NOT CONVERGED - read with care'}",
+                       nrows=len(names), ncols=1, sharex=True)
+    axes = np.atleast_1d(axes)
+    for ax, n in zip(axes, names):
+        d = samples.draws[n]
+        for c in range(d.shape[0]):
+            ax.plot(d[c], lw=0.4, alpha=0.8, label=f"ensemble {c + 1}")
+        ax.set_ylabel(LABELS.get(n, n))
+    axes[0].legend(loc="upper right", ncols=4, fontsize=8)
+    axes[-1].set_xlabel(f"draw (after {samples.burn} burn-in steps, thinned by {samples.thin}; "
+                        f"walkers pooled within each ensemble)")
+    text = (
+        f"R-hat max {conv.r_hat_max:.4f} (across {samples.n_chains} independent ensembles; < 1.01 wanted)   "
+        f"ESS bulk min {conv.ess_bulk_min:.0f}, tail min {conv.ess_tail_min:.0f} (>= 400 wanted)   "
+        f"steps {conv.n_steps} per walker, {samples.nwalkers} walkers x {samples.n_chains} ensembles   "
+        f"tau max {conv.tau_max:.1f} steps (chain > 50 tau: {'yes' if conv.converged else 'no'})   "
+        f"acceptance {conv.acceptance:.2f}   {conv.seconds:.1f} s, {conv.ess_per_second:.0f} ESS/s"
+    )
+    fig.text(0.01, 0.01, text, fontsize=8, wrap=True)
+    fig.subplots_adjust(bottom=0.12)
+    return fig
+
+
+def page_ppc(ppc: RatioPPC, *, number: int = 7) -> Figure:
+    """Posterior predictive check of F_eo/F_io over the window."""
+    fig, ax = figure(f"{number}. Posterior predictive check: F_eo / F_io over the stationary window")
+    t = ppc.time * US
+    for k in range(min(30, len(ppc.replicated))):
+        ax.plot(t, ppc.replicated[k], color="C0", lw=0.3, alpha=0.3)
+    ax.fill_between(t, ppc.q05, ppc.q95, color="C0", alpha=0.25, label="90 % band of replicated data")
+    ax.plot(t, ppc.q50, color="C0", lw=1, label="median of replicated data")
+    ax.plot(t, ppc.observed, color="k", lw=1.2, label="observed")
+    ax.axhspan(ppc.model_q05, ppc.model_q95, color="C3", alpha=0.15, label="90 % interval of the model ratio")
+    ax.set_xlabel("time (us)")
+    ax.set_ylabel(f"F_eo / F_io, {ppc.smooth * US:.0f} us smoothing (-)")
+    ax.set_title(f"observed inside the 90 % band {100 * ppc.coverage:.0f} % of the time "
+                 "(about 90 % if the constant-ratio model and the noise model hold)", loc="left")
+    ax.legend(loc="upper right")
+    return fig
