@@ -1,0 +1,101 @@
+"""The main job end to end, as a user runs it: outputs, their content, refusals, atomicity."""
+
+import json
+
+import pytest
+import xarray as xr
+
+from friction_uq.cli import main
+from friction_uq.synthetic import ClosedFormTest, write_closed_form_record
+
+JSON_KEYS = ("f", "nu", "kappa", "p_mean", "tau_mean", "V", "ratio")
+STATS = ("mean", "sd", "q05", "q50", "q95")
+
+
+@pytest.fixture(scope="module")
+def paper_run(tmp_path_factory):
+    """The paper's case (V_s = 10 m/s, f = 0.05, nu = 0.4) run through the CLI with the default priors."""
+    d = tmp_path_factory.mktemp("run")
+    rec = write_closed_form_record(d / "paper.h5", ClosedFormTest(f=0.05, nu=0.4), seed=2016,
+                                   test_id="P-01", campaign="paper")
+    out = d / "reports"
+    code = main(["run", str(rec), "--out", str(out), "--seed", "7", "--quiet"])
+    return code, out, rec
+
+
+def test_run_writes_the_three_outputs(paper_run):
+    code, out, _ = paper_run
+    assert code == 0
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["paper_P-01.json", "paper_P-01.nc", "paper_P-01.pdf"]  # no temporary or backend left
+
+
+def test_json_has_the_contract_keys(paper_run):
+    _, out, _ = paper_run
+    doc = json.loads((out / "paper_P-01.json").read_text())
+    for k in JSON_KEYS:
+        assert set(STATS) <= set(doc[k]), k
+        assert doc[k]["q05"] <= doc[k]["q50"] <= doc[k]["q95"]
+    for k in ("window", "rhat_max", "ess_min", "seed", "seconds"):
+        assert k in doc
+    assert doc["seed"] == 7
+    assert doc["rhat_max"] < 1.01 and doc["ess_min"] > 400
+    # kappa is the product the forces fix
+    assert doc["kappa"]["q50"] == pytest.approx(doc["f"]["q50"] * doc["nu"]["q50"] / (1 - doc["nu"]["q50"]), rel=0.02)
+
+
+def test_the_papers_case_contains_0049(paper_run):
+    """physics.md: F_eo/F_io ~ 0.14 gives f ~ 0.049 with nu = 0.4; the 90 % interval must contain it."""
+    _, out, _ = paper_run
+    f = json.loads((out / "paper_P-01.json").read_text())["f"]
+    assert f["q05"] <= 0.049 <= f["q95"]
+
+
+def test_netcdf_is_an_arviz_datatree(paper_run):
+    _, out, _ = paper_run
+    dt = xr.open_datatree(out / "paper_P-01.nc", engine="h5netcdf")
+    for group in ("posterior", "log_likelihood", "observed_data", "sample_stats", "prior"):
+        assert group in dt.children, group
+    post = dt["posterior"]
+    assert post["f"].dims[:2] == ("chain", "draw")
+    assert {"f", "nu", "kappa", "ratio", "p_mean", "tau_mean"} <= set(post.data_vars)
+    assert dt.attrs["seed"] == 7
+
+
+def test_pdf_is_a_multipage_report(paper_run):
+    _, out, _ = paper_run
+    data = (out / "paper_P-01.pdf").read_bytes()
+    assert data[:4] == b"%PDF"
+    pages = data.count(b"/Type /Page") - data.count(b"/Type /Pages")
+    assert pages == 8  # summary + pages 1-7
+
+
+def test_a_prior_file_with_a_typo_is_refused_and_nothing_is_written(paper_run, tmp_path, capsys):
+    _, _, rec = paper_run
+    bad = tmp_path / "bad.toml"
+    bad.write_text('material = "I1"\n[f]\ndistribution = "halfnormal"\nscael = 0.3\n'
+                   '[nu]\ndistribution = "uniform"\nlower = 0.2\nupper = 0.45\n')
+    out = tmp_path / "out"
+    assert main(["run", str(rec), "--priors", str(bad), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("friction-uq: error:")
+    assert "bad.toml" in err[0] and "scael" in err[0]
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_no_stationary_phase_is_refused(tmp_path, capsys):
+    import numpy as np
+
+    from friction_uq.record import paper_apparatus
+    from friction_uq.synthetic import closed_form_strains
+
+    test = ClosedFormTest()
+    t, strains, _ = closed_form_strains(test, paper_apparatus())
+    ramp = np.clip((t - 0.2e-3) / 0.5e-3, 0, None)
+    rec = write_closed_form_record(tmp_path / "drift.h5", test, seed=4,
+                                   strains_override={"external_output_bar": strains["external_output_bar"] * (0.3 + 4 * ramp)})
+    out = tmp_path / "out"
+    assert main(["run", str(rec), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "no stationary phase" in err and "Traceback" not in err
+    assert not out.exists() or not any(out.iterdir())
