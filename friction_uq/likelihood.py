@@ -43,9 +43,10 @@ The tube gauge reads (package convention, compression positive, so negative whil
 
 with Lame = 2 a^2 / (E_t (b^2 - a^2)); s the position from the sample's middle, positive toward the
 output side; z_g(t) = gauge_offset - slip(t) the gauge's position (the sample slides toward the
-output side, so the gauge moves toward the input face); K_w the tube kernel K averaged over the
-gauge width; p(s, t) the eq. 20 wall pressure, written as p = nu/(1-nu) sigma(z) (eq. 8) with
-sigma(z) = F_io(t) e^{f beta (L - z)/L} / (pi R^2) from eq. 11-13 (z = s + L/2), identical to
+output side, so the gauge moves toward the input face); K_w the tube kernel K (point gauge, as in
+physics.md section 6; ``gauge_averaging=True`` averages K over the gauge width, which changes the
+reading by ~0.4 %, well inside the kernel's own 2.4 % fit error); p(s, t) the eq. 20 wall
+pressure, written as p = nu/(1-nu) sigma(z) (eq. 8) with sigma(z) = F_io(t) e^{f beta (L - z)/L} / (pi R^2) from eq. 11-13 (z = s + L/2), identical to
 eq. 20 and regular at f = 0. F_io(t) is the observed internal force smoothed over ``smooth``
 (10 us): its noise (~0.2 % per sample, less after smoothing) is negligible beside the hoop noise.
 
@@ -58,6 +59,13 @@ the pressure term, so in the package's convention both terms enter with the minu
 local N at the gauge is used (no Saint-Venant spreading), an approximation for a term ~4 % of the
 reading. g, the calibration factor, scales the whole reading. Noise: the hoop channel's pre-pulse
 sd and AR(1) coefficient, exact AR(1) likelihood.
+
+Caveat: the hoop signal is ~75 noise sds per sample over ~2000 samples, so the term also reads
+nu from the *shape* of the reading (the Poisson term scales with g, the pressure term with
+g nu/(1-nu)). A shape error of the model that the noise does not describe biases nu: a 0.4 %
+position-dependent mismatch (gauge-width averaging on in the model, off in the generator) moved
+nu by ~1 posterior sd in a simulation-based calibration. The kernel itself is only good to 2.4 %
+of its peak, so on real records a model-discrepancy term (or a wider g prior) is advisable.
 
 Parameter vectors are rows (f, nu) or (f, nu, hoop_gain); SI units, forces in N, strains in
 strain.
@@ -336,6 +344,8 @@ class HoopTerm:
         Moving-average length applied to F_io for the wall pressure (s).
     knot_step : float
         Spacing of the prediction knots (s); 0 puts a knot on every sample.
+    gauge_averaging : bool
+        Average the kernel over ``tube.gauge_width`` (default: point gauge, physics.md section 6).
     n_nodes : int
         Gauss-Legendre nodes over the sample length.
     kernel_beta : float
@@ -344,7 +354,7 @@ class HoopTerm:
 
     def __init__(
         self, data: StationaryData, *, axial_poisson: bool = True, smooth: float = 10e-6, knot_step: float = 4e-6,
-        n_nodes: int = 16, kernel_beta: float = tube.BETA_EFF_PAPER_TUBE,
+        gauge_averaging: bool = False, n_nodes: int = 16, kernel_beta: float = tube.BETA_EFF_PAPER_TUBE,
     ) -> None:
         if data.hoop is None or data.sd_hoop is None or data.rho_hoop is None:
             raise SignalError("hoop term requested but the data have no tube_hoop channel (or no noise estimate for it)")
@@ -358,8 +368,8 @@ class HoopTerm:
         self.rho = float(data.rho_hoop)
         self.radius, self.length = R, L
         self.axial_poisson = axial_poisson
-        width = max(1, int(round(smooth * data.sample_rate)))
-        F_io = uniform_filter1d(np.asarray(data.F_io, float), width, mode="nearest")
+        n_smooth = max(1, int(round(smooth * data.sample_rate)))
+        F_io = uniform_filter1d(np.asarray(data.F_io, float), n_smooth, mode="nearest")
         z_g = tb.gauge_offset - np.asarray(data.slip, float)
         self.gauge_position = z_g
 
@@ -374,7 +384,8 @@ class HoopTerm:
 
         x, w = np.polynomial.legendre.leggauss(n_nodes)
         self.nodes = 0.5 * L * x  # s, from the sample's middle (m)
-        kern = gauge_kernel(z_k[:, None] - self.nodes[None, :], gauge_width=tb.gauge_width, beta=kernel_beta)
+        width = tb.gauge_width if gauge_averaging else 0.0
+        kern = gauge_kernel(z_k[:, None] - self.nodes[None, :], gauge_width=width, beta=kernel_beta)
         # (n_nodes, m): weight * K_w * Lame * F_io / (pi R^2); pressure term = lat * exp(fb c) @ this
         self._kmat = (0.5 * L * w[:, None]) * kern.T * (F_k / (math.pi * R**2))[None, :] * tb.lame_hoop_strain_per_pressure
         self._c = 0.5 - self.nodes / L
@@ -519,13 +530,14 @@ class Likelihood:
 
         Returns
         -------
-        array, shape (nwalkers,)
+        array, shape (nwalkers,); -inf where the model overflows (f beta beyond ~700).
         """
         theta = np.atleast_2d(np.asarray(theta, float))
-        out = self.force.loglike(self.ratio(theta))
-        if self.hoop is not None:
-            out = out + self.hoop.loglike(theta[:, 0], theta[:, 1], theta[:, 2])
-        return out
+        with np.errstate(over="ignore", invalid="ignore"):  # far-out proposals (f beta > 700) overflow
+            out = self.force.loglike(self.ratio(theta))
+            if self.hoop is not None:
+                out = out + self.hoop.loglike(theta[:, 0], theta[:, 1], theta[:, 2])
+        return np.where(np.isfinite(out), out, -np.inf)
 
     def pointwise(self, theta: np.ndarray, *, segment: int | None = None) -> dict[str, np.ndarray]:
         """Log-likelihood per sample time (or per segment of ``segment`` consecutive samples).

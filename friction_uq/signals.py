@@ -10,7 +10,12 @@ Conventions
 is at rest there, so its mean is the amplifier offset and its spread is the electrical noise of
 the channel; this is the segment the whole package uses to estimate noise, because it is the only
 part of a record where the true signal is known (zero). The noise is summarised by its standard
-deviation and lag-1 autocorrelation (an AR(1) description of coloured noise).
+deviation, its lag-1 autocorrelation, and the *effective* AR(1) coefficient: the one whose AR(1)
+process has the same long-run variance (sum of all autocorrelations) as the measured noise.
+Real gauge noise is a mixture (white electronics plus coloured amplifier noise), whose lag-1
+coefficient understates the variance of a mean; the effective coefficient does not. The
+long-run variance is estimated with Geyer's initial positive sequence on the autocorrelation
+of the segment.
 
 *Arrival*: the foot of the first pulse, where the line through the front's 10 % and 50 %
 crossings (linearly interpolated between samples) meets the baseline. Exact for a linear front,
@@ -19,9 +24,11 @@ sub-sample for any smooth one.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.fft as scipy_fft
 
 from .dispersion import propagate
 from .errors import SignalError
@@ -45,7 +52,10 @@ class NoiseEstimate:
     sd : float
         Standard deviation of the segment (strain).
     rho : float
-        Lag-1 autocorrelation of the segment (AR(1) coefficient), in (-1, 1).
+        Lag-1 autocorrelation of the segment, in (-1, 1).
+    rho_eff : float
+        AR(1) coefficient with the segment's long-run variance, (tau - 1) / (tau + 1) with tau
+        the integrated autocorrelation (1 + 2 sum of autocorrelations), in [0, 1).
     start, stop : int
         Sample indices of the segment, ``x[start:stop]``.
     """
@@ -55,6 +65,7 @@ class NoiseEstimate:
     rho: float
     start: int
     stop: int
+    rho_eff: float = 0.0
 
     @property
     def n(self) -> int:
@@ -62,8 +73,13 @@ class NoiseEstimate:
 
     @property
     def effective_fraction(self) -> float:
-        """(1 - rho) / (1 + rho): effective independent samples per sample of AR(1) noise (mean)."""
-        return (1.0 - self.rho) / (1.0 + self.rho)
+        """(1 - rho_eff) / (1 + rho_eff): independent samples per sample for a mean (1 / tau)."""
+        return (1.0 - self.rho_eff) / (1.0 + self.rho_eff)
+
+    @property
+    def offset_sd(self) -> float:
+        """Standard error of ``offset`` (the segment's mean): sd sqrt(tau / n)."""
+        return self.sd / math.sqrt(self.n * self.effective_fraction)
 
 
 def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate:
@@ -86,7 +102,32 @@ def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate
     sd = float(np.sqrt(var * seg.size / (seg.size - 1)))
     rho = float(np.sum(d[1:] * d[:-1]) / (var * seg.size)) if var > 0 else 0.0
     rho = float(np.clip(rho, -0.99, 0.99))
-    return NoiseEstimate(offset=offset, sd=sd, rho=rho, start=int(start), stop=int(stop))
+    tau = integrated_autocorrelation(d)
+    rho_eff = float(np.clip((tau - 1.0) / (tau + 1.0), 0.0, 0.99))
+    return NoiseEstimate(offset=offset, sd=sd, rho=rho, start=int(start), stop=int(stop), rho_eff=rho_eff)
+
+
+def integrated_autocorrelation(d: np.ndarray) -> float:
+    """tau = 1 + 2 sum_k rho_k of a zero-mean series, Geyer's initial positive sequence (>= 1).
+
+    Autocorrelations from the FFT; pairs rho_{2m} + rho_{2m+1} are summed while positive, at lags
+    below a quarter of the length.
+    """
+    n = len(d)
+    var = float(np.dot(d, d)) / n
+    if var == 0.0 or n < 8:
+        return 1.0
+    m = scipy_fft.next_fast_len(2 * n)
+    spec = np.fft.rfft(d, m)
+    acov = np.fft.irfft(spec * np.conj(spec), m)[: n // 4] / n
+    r = acov / var
+    total = -1.0  # r[0] = 1 counted once in 1 + 2 sum_{k>=1}: pairs start at lag 0
+    for k in range(0, len(r) - 1, 2):
+        pair = r[k] + r[k + 1]
+        if pair <= 0.0:
+            break
+        total += 2.0 * pair
+    return max(1.0, total)
 
 
 def first_crossing(y: np.ndarray, level: float, *, start: int = 0) -> float | None:

@@ -98,8 +98,8 @@ def _steadiness(
         r_s = feo_s / fio_s
     sd_io = io.area * io.young_modulus * ch["internal_output_bar"].noise.sd
     sd_eo = eo.area * eo.young_modulus * ch["external_output_bar"].noise.sd
-    k_io = _mean_noise_factor(ch["internal_output_bar"].noise.rho, w)
-    k_eo = _mean_noise_factor(ch["external_output_bar"].noise.rho, w)
+    k_io = _mean_noise_factor(ch["internal_output_bar"].noise.rho_eff, w)
+    k_eo = _mean_noise_factor(ch["external_output_bar"].noise.rho_eff, w)
     with np.errstate(divide="ignore", invalid="ignore"):
         sd_r = np.sqrt((sd_eo * k_eo) ** 2 + (r_s * sd_io * k_io) ** 2) / np.abs(fio_s)
 
@@ -118,7 +118,7 @@ def _steadiness(
     dv_s = moving_average(V_i - V_io, w)
     vio_s = moving_average(V_io, w)
     sd_dv = math.hypot(
-        ib.wave_speed * math.sqrt(2.0) * ch["input_bar"].noise.sd * _mean_noise_factor(ch["input_bar"].noise.rho, w),
+        ib.wave_speed * math.sqrt(2.0) * ch["input_bar"].noise.sd * _mean_noise_factor(ch["input_bar"].noise.rho_eff, w),
         io.wave_speed * ch["internal_output_bar"].noise.sd * k_io,
     )
     vel_ok = np.abs(dv_s) <= np.maximum(criterion.sigmas * sd_dv, criterion.velocity_tol * np.abs(vio_s))
@@ -234,7 +234,10 @@ class StationaryData:
     """What a likelihood sees: the stationary-phase force signals and their noise. SI units.
 
     Noise of the forces comes from each output bar's pre-pulse segment (the gauge at rest, before
-    any wave): sd = A E sd(strain), rho = lag-1 autocorrelation of that segment.
+    any wave): sd = A E sd(strain); rho = the effective AR(1) coefficient of that segment (same
+    long-run variance, :class:`~friction_uq.signals.NoiseEstimate`). ``sd_offset_*`` are the
+    standard errors of the offsets removed (the segment means): one constant error per channel
+    over the whole window, which the likelihood integrates out.
 
     ``hoop`` is the tube gauge's strain in the package's convention (compression positive, so it
     is negative while the tube swells), baseline removed. ``slip`` is the sample's sliding
@@ -261,6 +264,9 @@ class StationaryData:
     sd_hoop: float | None = None
     rho_hoop: float | None = None
     striker_velocity: float | None = None
+    sd_offset_io: float = 0.0
+    sd_offset_eo: float = 0.0
+    sd_offset_hoop: float = 0.0
 
     @property
     def n(self) -> int:
@@ -285,7 +291,7 @@ def stationary_data(
     if forces.hoop is not None:
         hoop = np.array(forces.hoop[seg])
         sd_h = ch["tube_hoop"].noise.sd
-        rho_h = ch["tube_hoop"].noise.rho
+        rho_h = ch["tube_hoop"].noise.rho_eff
     return StationaryData(
         test_id=test_id,
         campaign=campaign,
@@ -296,8 +302,8 @@ def stationary_data(
         slip=np.array(slip[seg]),
         sd_io=io.area * io.young_modulus * ch["internal_output_bar"].noise.sd,
         sd_eo=eo.area * eo.young_modulus * ch["external_output_bar"].noise.sd,
-        rho_io=ch["internal_output_bar"].noise.rho,
-        rho_eo=ch["external_output_bar"].noise.rho,
+        rho_io=ch["internal_output_bar"].noise.rho_eff,
+        rho_eo=ch["external_output_bar"].noise.rho_eff,
         radius=apparatus.sample.radius,
         length=apparatus.sample.length,
         tube=apparatus.tube,
@@ -307,4 +313,7 @@ def stationary_data(
         sd_hoop=sd_h,
         rho_hoop=rho_h,
         striker_velocity=striker_velocity,
+        sd_offset_io=io.area * io.young_modulus * ch["internal_output_bar"].noise.offset_sd,
+        sd_offset_eo=eo.area * eo.young_modulus * ch["external_output_bar"].noise.offset_sd,
+        sd_offset_hoop=ch["tube_hoop"].noise.offset_sd if forces.hoop is not None else 0.0,
     )

@@ -12,7 +12,7 @@ from scipy import integrate, stats
 from scipy.linalg import toeplitz
 
 from friction_uq.errors import SignalError
-from friction_uq.likelihood import HoopTerm, Likelihood, ar1_loglike, ar1_noise, ar1_pointwise
+from friction_uq.likelihood import HoopTerm, Likelihood, ar1_loglike, ar1_noise, ar1_pointwise, offset_sd
 from friction_uq.physics import cell, tube
 from test_sbc import closed_form_data
 
@@ -32,6 +32,27 @@ def test_ar1_loglike_equals_dense_gaussian(rho):
     ref = stats.multivariate_normal(np.zeros(40), ar1_cov(40, 1.7, rho)).logpdf(e)
     np.testing.assert_allclose(mine, ref, rtol=1e-10)
     np.testing.assert_allclose(ar1_pointwise(e, 1.7, rho).sum(-1), ref, rtol=1e-10)
+
+
+@pytest.mark.parametrize("rho", [0.0, 0.5, -0.3])
+def test_ar1_with_offset_equals_dense_gaussian_with_rank_one_term(rho):
+    rng = np.random.default_rng(1)
+    e = rng.normal(size=(3, 40)) + 0.8
+    cov = ar1_cov(40, 1.7, rho) + 0.6**2
+    ref = stats.multivariate_normal(np.zeros(40), cov).logpdf(e)
+    np.testing.assert_allclose(ar1_loglike(e, 1.7, rho, 0.6), ref, rtol=1e-10)
+    np.testing.assert_allclose(ar1_pointwise(e, 1.7, rho, 0.6).sum(-1), ref, rtol=1e-10)
+    # per-row offsets, one of them zero
+    off = np.array([0.6, 0.0, 0.2])
+    rows = [stats.multivariate_normal(np.zeros(40), ar1_cov(40, 1.7, rho) + o**2).logpdf(e[i]) for i, o in enumerate(off)]
+    np.testing.assert_allclose(ar1_pointwise(e, 1.7, rho, off).sum(-1), rows, rtol=1e-10)
+
+
+def test_offset_sd_is_sd_of_an_ar1_mean():
+    """Against the dense covariance: Var(mean) = 1' S 1 / n^2 -> the large-n AR(1) form within 1/n."""
+    n, sd, rho = 2000, 2.0, 0.5
+    exact = math.sqrt(ar1_cov(n, sd, rho).sum()) / n
+    assert offset_sd(sd, rho, n) == pytest.approx(exact, rel=2.0 / n * (1 + rho) / (1 - rho))
 
 
 def test_ar1_noise_has_requested_sd_and_lag1():
@@ -75,6 +96,28 @@ def test_equal_rho_force_likelihood_is_exact_dense_marginal():
         cov = ar1_cov(60, d.sd_eo, 0.6) + r**2 * ar1_cov(60, d.sd_io, 0.6)
         ref = stats.multivariate_normal(np.zeros(60), cov).logpdf(d.F_eo - r * d.F_io)
         assert lk.force.loglike(np.array(r)) == pytest.approx(ref, rel=1e-10)
+
+
+def test_force_term_with_offset_errors_is_exact_dense_marginal():
+    """Offsets delta_io, delta_eo: u's covariance gains (sd_off_eo^2 + r^2 sd_off_io^2) 1 1'."""
+    d = closed_form_data(0.05, 0.4, seed=4, hoop=False, n=60, rho=(0.6, 0.6, 0.5), n_baseline=50)
+    assert d.sd_offset_eo > 0
+    lk = Likelihood(d, hoop=False)
+    for r in (0.1, 0.3):
+        cov = ar1_cov(60, d.sd_eo, 0.6) + r**2 * ar1_cov(60, d.sd_io, 0.6) + d.sd_offset_eo**2 + r**2 * d.sd_offset_io**2
+        ref = stats.multivariate_normal(np.zeros(60), cov).logpdf(d.F_eo - r * d.F_io)
+        assert lk.force.loglike(np.array(r)) == pytest.approx(ref, rel=1e-10)
+        assert lk.force.pointwise(np.array(r)).sum() == pytest.approx(ref, rel=1e-10)
+
+
+def test_hoop_term_with_offset_error():
+    d = closed_form_data(0.05, 0.4, 0.97, seed=8, n_baseline=300)
+    h = HoopTerm(d)
+    assert h.offset == pytest.approx(offset_sd(d.sd_hoop, d.rho_hoop, 300))
+    theta = np.array([[0.05, 0.4, 0.97], [0.06, 0.35, 1.05]])
+    ref = ar1_loglike(d.hoop - h.predict(*theta.T), h.sd, h.rho, h.offset)
+    np.testing.assert_allclose(h.loglike(*theta.T), ref, rtol=1e-9)
+    np.testing.assert_allclose(h.pointwise(*theta.T).sum(-1), ref, rtol=1e-9)
 
 
 def test_unequal_rho_uses_variance_weighted_lag1():
@@ -149,7 +192,7 @@ def test_hoop_prediction_equals_quadrature_of_eq20(f, nu, width):
     """Independent path: p(z) from eq. 20 (p_mean = F_eo/(2 pi R L f)) times K, integrated by scipy quad."""
     z = np.linspace(-8e-3, 8e-3, 17)
     d = _hoop_data(f, nu, z, width=width)
-    h = HoopTerm(d, axial_poisson=False, knot_step=0.0)
+    h = HoopTerm(d, axial_poisson=False, knot_step=0.0, gauge_averaging=width > 0)
     R, L = d.radius, d.length
     p_mean = np.mean(d.F_eo) / (2 * math.pi * R * L * f)
 
@@ -233,3 +276,21 @@ def test_bad_data_are_refused():
     bad[3] = np.nan
     with pytest.raises(SignalError, match="F_eo has non-finite values"):
         Likelihood(replace(d, F_eo=bad))
+
+
+def test_hoop_prediction_matches_whole_closed_form_record(tmp_path):
+    """Cross-check with friction_uq.synthetic's independent hoop model, through the whole pipeline
+    (record -> forces -> window -> slip): at the true parameters the prediction follows the
+    noise-free hoop strain within the noise of the smoothed F_io it is built on."""
+    from friction_uq.analysis import prepare
+    from friction_uq.record import paper_apparatus, read_record
+    from friction_uq.synthetic import ClosedFormTest, closed_form_strains, write_closed_form_record
+
+    test = ClosedFormTest(f=0.3, nu=0.4)
+    d = prepare(read_record(write_closed_form_record(tmp_path / "r.h5", test, seed=5))).data
+    t, strains, _ = closed_form_strains(test, paper_apparatus())
+    truth = strains["tube_hoop"][np.searchsorted(t, d.time)]
+    pred = HoopTerm(d, knot_step=0.0).predict(0.3, 0.4, 1.0)[0]
+    # relative sd of F_io averaged over 10 us (50 samples) of AR(1) noise, times 4
+    rel = 4 * offset_sd(d.sd_io, d.rho_io, 50) / np.mean(d.F_io)
+    assert np.max(np.abs(pred - truth)) < rel * np.max(np.abs(truth)) + 0.05 * d.sd_hoop

@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from friction_uq.likelihood import Likelihood
+from friction_uq.likelihood import Likelihood, offset_sd
 from friction_uq.physics import cell, design
 from friction_uq.priors import default_prior_path, load_priors
 from friction_uq.record import paper_apparatus
@@ -48,12 +48,15 @@ def closed_form_data(
     f: float, nu: float, gain: float = 1.0, *, seed: int, n: int = 1500, sample_rate: float = 5e6,
     hoop: bool = True, strain_sd: tuple[float, float, float] = STRAIN_SD, rho: tuple[float, float, float] = RHO,
     t_start: float = 100e-6, striker_velocity: float = 10.0, axial_poisson: bool = True,
+    n_baseline: int | None = None,
 ) -> StationaryData:
     """A stationary phase of the paper's set-up with true (f, nu, g) and AR(1) noise (SI units).
 
     Levels from eq. 15-16 (:mod:`friction_uq.physics.design`), slip = V t from the start of loading
     (``t_start`` before the first sample), noise and hoop reading from the likelihood's generative
-    model (:meth:`friction_uq.likelihood.Likelihood.simulate`).
+    model (:meth:`friction_uq.likelihood.Likelihood.simulate`). With ``n_baseline``, each channel
+    also gets the offset error of a baseline removed with the mean of ``n_baseline`` noise samples
+    (the ``sd_offset_*`` fields).
     """
     app = paper_apparatus()
     io, eo = app.internal_output_bar, app.external_output_bar
@@ -64,12 +67,17 @@ def closed_form_data(
     F_eo = float(design.stationary_external_force(f, nu, **kw))
     V = float(design.stationary_sliding_velocity(f, nu, z_external=eo.impedance, **kw))
     t = t_start + np.arange(n) / sample_rate
+    sd_io, sd_eo = io.area * io.young_modulus * strain_sd[0], eo.area * eo.young_modulus * strain_sd[1]
+    extra = {}
+    if n_baseline is not None:
+        extra = {"sd_offset_io": offset_sd(sd_io, rho[0], n_baseline), "sd_offset_eo": offset_sd(sd_eo, rho[1], n_baseline),
+                 "sd_offset_hoop": offset_sd(strain_sd[2], rho[2], n_baseline) if hoop else 0.0}
     template = StationaryData(
         test_id="synthetic", campaign="S", time=t, F_io=np.full(n, F_io), F_eo=np.full(n, F_eo), V=np.full(n, V),
-        slip=V * t, sd_io=io.area * io.young_modulus * strain_sd[0], sd_eo=eo.area * eo.young_modulus * strain_sd[1],
+        slip=V * t, sd_io=sd_io, sd_eo=sd_eo,
         rho_io=rho[0], rho_eo=rho[1], radius=R, length=L, tube=app.tube, window=(float(t[0]), float(t[-1])),
         sample_rate=sample_rate, hoop=np.zeros(n) if hoop else None, sd_hoop=strain_sd[2] if hoop else None,
-        rho_hoop=rho[2] if hoop else None, striker_velocity=striker_velocity,
+        rho_hoop=rho[2] if hoop else None, striker_velocity=striker_velocity, **extra,
     )
     lk = Likelihood(template, hoop=hoop, axial_poisson=axial_poisson)
     theta = np.array([[f, nu] + ([gain] if hoop else [])])
@@ -98,7 +106,8 @@ class Replica:
 
 
 def record_data(f: float, nu: float, gain: float, *, seed: int) -> StationaryData:
-    """Stationary data of a whole closed-form record (friction_uq.synthetic -> record -> analysis.prepare)."""
+    """Stationary data of a whole closed-form record (friction_uq.synthetic -> record -> analysis.prepare);
+    noise, its effective AR(1) coefficient and the offset-error sds come from the pre-pulse segments."""
     from friction_uq.analysis import prepare
     from friction_uq.record import read_record
     from friction_uq.synthetic import ClosedFormTest, write_closed_form_record
@@ -107,7 +116,8 @@ def record_data(f: float, nu: float, gain: float, *, seed: int) -> StationaryDat
         path = write_closed_form_record(
             os.path.join(tmp, "r.h5"), ClosedFormTest(f=f, nu=nu, gains={"tube_hoop": gain}), seed=seed
         )
-        return prepare(read_record(path)).data
+        prep = prepare(read_record(path))
+    return prep.data
 
 
 def run_replica(args: tuple[int, bool, int, str]) -> Replica:
@@ -123,7 +133,7 @@ def run_replica(args: tuple[int, bool, int, str]) -> Replica:
     if source == "records":
         data = record_data(f, nu, g, seed=seed + 1_000_000)
     else:
-        data = closed_form_data(f, nu, g, seed=seed + 1_000_000, hoop=hoop)
+        data = closed_form_data(f, nu, g, seed=seed + 1_000_000, hoop=hoop, n_baseline=2000)
     s = sample_posterior(data, priors, seed=seed, hoop=hoop, n_ensembles=n_ensembles)
     fd = s.flat("f")
     kd = fd * cell.lateral_ratio(s.flat("nu"))
