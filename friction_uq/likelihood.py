@@ -43,9 +43,10 @@ The tube gauge reads (package convention, compression positive, so negative whil
 
 with Lame = 2 a^2 / (E_t (b^2 - a^2)); s the position from the sample's middle, positive toward the
 output side; z_g(t) = gauge_offset - slip(t) the gauge's position (the sample slides toward the
-output side, so the gauge moves toward the input face); K_w the tube kernel K (point gauge, as in
-physics.md section 6; ``gauge_averaging=True`` averages K over the gauge width, which changes the
-reading by ~0.4 %, well inside the kernel's own 2.4 % fit error); p(s, t) the eq. 20 wall
+output side, so the gauge moves toward the input face); K_w the tube kernel K averaged over the gauge's
+width (a strain gauge reads the mean strain under its grid; ``gauge_averaging=False`` gives the
+point gauge of physics.md section 6, ~0.4 % higher, well inside the kernel's own 2.4 % fit error;
+the simulator and the closed-form records average too); p(s, t) the eq. 20 wall
 pressure, written as p = nu/(1-nu) sigma(z) (eq. 8) with sigma(z) = F_io(t) e^{f beta (L - z)/L} / (pi R^2) from eq. 11-13 (z = s + L/2), identical to
 eq. 20 and regular at f = 0. F_io(t) is the observed internal force smoothed over ``smooth``
 (10 us): its noise (~0.2 % per sample, less after smoothing) is negligible beside the hoop noise.
@@ -345,7 +346,7 @@ class HoopTerm:
     knot_step : float
         Spacing of the prediction knots (s); 0 puts a knot on every sample.
     gauge_averaging : bool
-        Average the kernel over ``tube.gauge_width`` (default: point gauge, physics.md section 6).
+        Average the kernel over ``tube.gauge_width`` (default; False: point gauge, physics.md section 6).
     n_nodes : int
         Gauss-Legendre nodes over the sample length.
     kernel_beta : float
@@ -354,7 +355,7 @@ class HoopTerm:
 
     def __init__(
         self, data: StationaryData, *, axial_poisson: bool = True, smooth: float = 10e-6, knot_step: float = 4e-6,
-        gauge_averaging: bool = False, n_nodes: int = 16, kernel_beta: float = tube.BETA_EFF_PAPER_TUBE,
+        gauge_averaging: bool = True, n_nodes: int = 16, kernel_beta: float = tube.BETA_EFF_PAPER_TUBE,
     ) -> None:
         if data.hoop is None or data.sd_hoop is None or data.rho_hoop is None:
             raise SignalError("hoop term requested but the data have no tube_hoop channel (or no noise estimate for it)")

@@ -121,7 +121,9 @@ def closed_form_strains(test: ClosedFormTest, apparatus: Apparatus) -> tuple[np.
         shape = cell.pressure_profile(s + L / 2, p_mean=1.0, f=test.f, nu=test.nu, radius=R, length=L) \
             if test.f > 0 else np.ones_like(s)
         z_g = tb.gauge_offset - slip
-        kern = tube.hoop_kernel(z_g[:, None] - s[None, :], beta=test.hoop_beta)
+        # the gauge reads the kernel averaged over its width
+        kern = tube.band_response(z_g[:, None] - s[None, :], band_length=tb.gauge_width,
+                                  beta=test.hoop_beta) / tb.gauge_width
         seen = np.trapezoid(shape[None, :] * kern, s, axis=1)
         lame = tb.lame_hoop_strain_per_pressure
         # friction carried by the tube at the gauge: the wall force between the input face and
