@@ -63,3 +63,26 @@ def test_bad_window_is_a_usage_error(record, capsys):
 def test_console_script_runs():
     r = subprocess.run([sys.executable, "-m", "friction_uq.cli", "--version"], capture_output=True, text=True)
     assert r.returncode == 0 and __version__ in r.stdout
+
+
+def test_simulate_writes_a_record_that_analyze_reads(tmp_path, capsys):
+    cfg = tmp_path / "t.toml"
+    cfg.write_text('[record]\ntest_id = "T-1"\ncampaign = "T"\nseed = 5\n[friction]\nlaw = "coulomb"\nf = 0.1\n')
+    out = tmp_path / "t.h5"
+    assert main(["simulate", str(cfg), "-o", str(out)]) == 0
+    assert main(["analyze", str(out), "--nu", "0.4", "--json"]) == 0
+    import json
+
+    doc = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    # default simulator physics: Coulomb f = 0.1, nu = 0.4, no gap, rigid tube -> eq. 17 recovers f
+    assert doc["f"] == pytest.approx(0.1, rel=0.05)
+
+
+def test_simulate_refuses_a_config_with_a_typo(tmp_path, capsys):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text('[friction]\nlaw = "colomb"\n')
+    out = tmp_path / "never.h5"
+    assert main(["simulate", str(cfg), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bad.toml" in err[0] and "colomb" in err[0] and "coulomb" in err[0]
+    assert not out.exists()
