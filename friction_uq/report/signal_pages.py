@@ -34,7 +34,8 @@ def page_raw(record: Record) -> Figure:
         ax.plot(t, ch.strain * US, lw=0.7, color="k")
         ax.set_ylabel("strain (ue)")
         stored = ch.units + (f", {ch.strain_per_volt:g} strain/V" if ch.strain_per_volt else "")
-        ax.set_title(f"{LABELS[name]} (stored in {stored}); compression positive", loc="left", fontsize=10)
+        sign = "compression positive" + ("; the tube swelling reads negative" if name == "tube_hoop" else "")
+        ax.set_title(f"{LABELS[name]} (stored in {stored}); {sign}", loc="left", fontsize=10)
     np.atleast_1d(axes)[-1].set_xlabel("time on the record's time base (us)")
     fig.text(0.01, 0.01, f"file {record.path}  sha256 {record.sha256[:16]}...", fontsize=8)
     return fig
