@@ -72,6 +72,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-o", "--output", type=Path, required=True, help="record to write (test.h5)")
     s.add_argument("--seed", type=int, help="noise seed (default: the config's)")
 
+    s = sub.add_parser("compare", help="compare tests across campaigns from run results (JSON)",
+                       description="Table and figure of kappa and f against sliding velocity and wall "
+                       "pressure for several tests, with weighted trend fits.")
+    s.add_argument("results", type=Path, nargs="+", help="<campaign>_<test_id>.json files written by run")
+    s.add_argument("-o", "--output", type=Path, help="figure file (PDF or PNG)")
+
     s = sub.add_parser("run", help="joint posterior of f and nu, uncertainty propagation, PDF report",
                        description="The main job: sample the posterior of f and nu for one record and "
                        "write <campaign>_<test_id>.nc, .json and .pdf.")
@@ -135,6 +141,16 @@ def _dispatch(args: argparse.Namespace) -> int:
         cfg = load_config(args.config)
         path = simulate_to_file(cfg, args.output, seed=args.seed)
         print(f"wrote {path}")
+        return 0
+    if args.command == "compare":
+        from .campaign import compare, comparison_table
+
+        comp = compare(args.results)
+        print(comparison_table(comp))
+        if args.output:
+            from .report.campaign_figure import campaign_figure
+
+            print(f"wrote {campaign_figure(comp, args.output)}")
         return 0
     if args.command == "run":
         from .run import run_file

@@ -122,7 +122,7 @@ def build_datatree(
     observed = {"F_io": np.asarray(data.F_io), "F_eo": np.asarray(data.F_eo)}
     if samples.hoop and data.hoop is not None:
         observed["hoop"] = np.asarray(data.hoop)
-    dims = {k: ["segment"] for k in pw}
+    dims = {k: (["segment"] if v.shape[-1] == len(seg_t) else [f"{k}_observation"]) for k, v in pw.items()}
     coords = {"segment": seg_t, "time": np.asarray(data.time)}
     dt = arviz_base.from_dict(
         {
@@ -131,7 +131,7 @@ def build_datatree(
             "sample_stats": {"lp": samples.log_likelihood + samples.log_prior, "log_likelihood": samples.log_likelihood},
             "prior": prior,
         },
-        coords={"segment": seg_t},
+        coords={"segment": seg_t} | {d[0]: np.arange(pw[k].shape[-1]) for k, d in dims.items() if d[0] != "segment"},
         dims=dims,
     )
     dt["observed_data"] = xr.DataTree(xr.Dataset({k: ("time", v) for k, v in observed.items()}, coords={"time": coords["time"]}))

@@ -68,6 +68,17 @@ position-dependent mismatch (gauge-width averaging on in the model, off in the g
 nu by ~1 posterior sd in a simulation-based calibration. The kernel itself is only good to 2.4 %
 of its peak, so on real records a model-discrepancy term (or a wider g prior) is advisable.
 
+Level, not series (default). The hoop reading is ~75 noise standard deviations per sample, so
+the per-sample ("series") likelihood reads parameters off the *shape* of the signal as the gauge
+slides past the pressure band. That shape carries no information on nu that the forces lack (it
+depends on f beta = 2 kappa L / R); only the small axial Poisson term is not scaled by nu/(1-nu),
+and a shape error of a few percent in the kernel (fitted to 2.4 %) then drives g and nu far from
+the truth (seen on simulated records at 14 m/s: g = 2, nu = 0.24 for a true 1, 0.4). The "level"
+mode compares the window mean of the reading with the window mean of the model, with sd^2 =
+sd^2 tau / n (AR(1) noise of the mean) + sd_offset^2 + (discrepancy x model mean)^2. It gives g
+nu/(1-nu) to the precision of the model (3 %) and the gain prior, which is what the gauge can
+honestly say.
+
 Parameter vectors are rows (f, nu) or (f, nu, hoop_gain); SI units, forces in N, strains in
 strain.
 """
@@ -90,6 +101,13 @@ FORCE_PARAMETERS = ("f", "nu")
 HOOP_PARAMETERS = ("f", "nu", "hoop_gain")
 
 _LOG_2PI = math.log(2.0 * math.pi)
+
+#: How the hoop reading enters the likelihood (HoopTerm).
+HOOP_MODES = ("level", "series")
+#: Relative standard deviation of the hoop model's error on the level: the kernel's fit of the
+#: exact tube solution (2.4 % of peak, physics.md section 6) and the local axial-force
+#: approximation of the Poisson term.
+HOOP_DISCREPANCY = 0.03
 
 
 # ----------------------------------------------------------------------------------------------
@@ -351,12 +369,23 @@ class HoopTerm:
         Gauss-Legendre nodes over the sample length.
     kernel_beta : float
         Decay rate of the tube kernel (1/m).
+    mode : {"level", "series"}
+        "level" (default): the window mean of the reading against the window mean of the model,
+        with the model's relative ``discrepancy`` as an extra standard deviation; "series": every
+        sample, exact AR(1) (see the module docstring for why "level" is the default).
+    discrepancy : float
+        Relative standard deviation of the model's error on the level (default 3 %).
     """
 
     def __init__(
         self, data: StationaryData, *, axial_poisson: bool = True, smooth: float = 10e-6, knot_step: float = 4e-6,
         gauge_averaging: bool = True, n_nodes: int = 16, kernel_beta: float = tube.BETA_EFF_PAPER_TUBE,
+        mode: str = "level", discrepancy: float = HOOP_DISCREPANCY,
     ) -> None:
+        if mode not in HOOP_MODES:
+            raise ValueError(f"hoop mode {mode!r} is not understood, allowed values: {', '.join(HOOP_MODES)}")
+        self.mode = mode
+        self.discrepancy = float(discrepancy)
         if data.hoop is None or data.sd_hoop is None or data.rho_hoop is None:
             raise SignalError("hoop term requested but the data have no tube_hoop channel (or no noise estimate for it)")
         if not (data.sd_hoop > 0.0 and -1.0 < data.rho_hoop < 1.0):
@@ -429,9 +458,22 @@ class HoopTerm:
         c = self.predict_knots(f, nu, gain)
         return c[:, self._left] * (1.0 - self._w) + c[:, self._left + 1] * self._w
 
+    def level_sd(self, predicted_mean: np.ndarray) -> np.ndarray:
+        """Standard deviation of (observed - predicted) window means: noise, offset, model discrepancy."""
+        tau = (1.0 + self.rho) / (1.0 - self.rho)
+        return np.sqrt(self.sd**2 * tau / self._n + self.offset**2 + (self.discrepancy * predicted_mean) ** 2)
+
     def loglike(self, f: np.ndarray, nu: np.ndarray, gain: np.ndarray) -> np.ndarray:
-        """Exact AR(1) log-likelihood of the hoop residuals (offset error integrated out), shape (len(f),)."""
+        """Log-likelihood of the hoop reading, shape (len(f),): level or series (class docstring).
+
+        "series": exact AR(1) log-likelihood of the residuals, offset error integrated out.
+        """
         c = self.predict_knots(f, nu, gain)
+        if self.mode == "level":
+            mean_pred = (c @ self._b_sum) / self._n
+            sd = self.level_sd(mean_pred)
+            z = (self._h_sum / self._n - mean_pred) / sd
+            return -0.5 * (_LOG_2PI + z * z) - np.log(sd)
         q = self._hh - 2.0 * (c @ self._hb) + np.einsum("wi,wi->w", c @ self._bb, c)
         out = self._const - q / self._scale
         if self.offset > 0.0:
@@ -440,7 +482,10 @@ class HoopTerm:
         return out
 
     def pointwise(self, f: np.ndarray, nu: np.ndarray, gain: np.ndarray) -> np.ndarray:
-        """Per-sample conditional log densities, shape (len(f), n)."""
+        """Per-sample conditional log densities, shape (len(f), n); in "level" mode the one
+        observation (the window mean), shape (len(f), 1)."""
+        if self.mode == "level":
+            return self.loglike(f, nu, gain)[:, None]
         return ar1_pointwise(self.observed - self.predict(f, nu, gain), self.sd, self.rho, self.offset)
 
 
@@ -503,13 +548,15 @@ class Likelihood:
         Column names of parameter vectors: ("f", "nu") or ("f", "nu", "hoop_gain").
     """
 
-    def __init__(self, data: StationaryData, *, hoop: bool | None = None, axial_poisson: bool = True) -> None:
+    def __init__(
+        self, data: StationaryData, *, hoop: bool | None = None, axial_poisson: bool = True, hoop_mode: str = "level",
+    ) -> None:
         _check_data(data)
         if hoop is None:
             hoop = data.hoop is not None and data.sd_hoop is not None
         self.data = data
         self.force = ForceTerm(data)
-        self.hoop = HoopTerm(data, axial_poisson=axial_poisson) if hoop else None
+        self.hoop = HoopTerm(data, axial_poisson=axial_poisson, mode=hoop_mode) if hoop else None
         self.names = HOOP_PARAMETERS if hoop else FORCE_PARAMETERS
 
     @property
@@ -544,7 +591,8 @@ class Likelihood:
         """Log-likelihood per sample time (or per segment of ``segment`` consecutive samples).
 
         Keys "F_eo" (the force term: F_eo given F_io) and "hoop" (with the hoop term). Values have
-        shape (ndraw, n) or (ndraw, ceil(n / segment)); per draw they sum to :meth:`__call__`.
+        shape (ndraw, n) or (ndraw, ceil(n / segment)) (the "level" hoop term: (ndraw, 1), one
+        observation); per draw they sum to :meth:`__call__`.
         The AR(1) conditionals make the per-time split exact.
         """
         theta = np.atleast_2d(np.asarray(theta, float))
@@ -553,7 +601,7 @@ class Likelihood:
             out["hoop"] = self.hoop.pointwise(theta[:, 0], theta[:, 1], theta[:, 2])
         if segment is not None:
             idx = np.arange(0, self.data.n, segment)
-            out = {k: np.add.reduceat(v, idx, axis=-1) for k, v in out.items()}
+            out = {k: np.add.reduceat(v, idx, axis=-1) if v.shape[-1] == self.data.n else v for k, v in out.items()}
         return out
 
     def simulate(self, theta: np.ndarray, *, rng: np.random.Generator) -> dict[str, np.ndarray]:

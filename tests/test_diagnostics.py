@@ -53,7 +53,7 @@ def test_datatree_groups_dims_and_provenance(tree, run_hoop, data):
     assert tree["observed_data"]["hoop"].shape == (data.n,)
     assert tree.attrs["seed"] == 7 and tree.attrs["prior_path"].endswith("I1.toml")
     # per draw, the segments add up to the total log-likelihood
-    ll = tree["log_likelihood"]["F_eo"].sum("segment") + tree["log_likelihood"]["hoop"].sum("segment")
+    ll = tree["log_likelihood"]["F_eo"].sum("segment") + tree["log_likelihood"]["hoop"].sum("hoop_observation")
     np.testing.assert_allclose(ll.values, run_hoop.log_likelihood, rtol=1e-9)
 
 

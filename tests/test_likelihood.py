@@ -112,7 +112,7 @@ def test_force_term_with_offset_errors_is_exact_dense_marginal():
 
 def test_hoop_term_with_offset_error():
     d = closed_form_data(0.05, 0.4, 0.97, seed=8, n_baseline=300)
-    h = HoopTerm(d)
+    h = HoopTerm(d, mode="series")
     assert h.offset == pytest.approx(offset_sd(d.sd_hoop, d.rho_hoop, 300))
     theta = np.array([[0.05, 0.4, 0.97], [0.06, 0.35, 1.05]])
     ref = ar1_loglike(d.hoop - h.predict(*theta.T), h.sd, h.rho, h.offset)
@@ -132,7 +132,7 @@ def test_unequal_rho_uses_variance_weighted_lag1():
 
 def test_vectorised_call_equals_row_calls_and_pointwise_sums():
     d = closed_form_data(0.05, 0.4, 1.02, seed=6)
-    lk = Likelihood(d)
+    lk = Likelihood(d, hoop_mode="series")
     assert lk.names == ("f", "nu", "hoop_gain")
     theta = np.column_stack([np.linspace(0.03, 0.08, 7), np.linspace(0.3, 0.45, 7), np.linspace(0.9, 1.1, 7)])
     full = lk(theta)
@@ -228,7 +228,7 @@ def test_axial_poisson_term_beyond_the_output_face():
 
 def test_hoop_quadratic_form_equals_explicit_residuals():
     d = closed_form_data(0.05, 0.4, 0.97, seed=8)
-    h = HoopTerm(d)
+    h = HoopTerm(d, mode="series")
     theta = np.array([[0.05, 0.4, 0.97], [0.06, 0.35, 1.05], [0.04, 0.45, 0.9]])
     ref = ar1_loglike(d.hoop - h.predict(*theta.T), h.sd, h.rho)
     np.testing.assert_allclose(h.loglike(*theta.T), ref, rtol=1e-9)
@@ -294,3 +294,22 @@ def test_hoop_prediction_matches_whole_closed_form_record(tmp_path):
     # relative sd of F_io averaged over 10 us (50 samples) of AR(1) noise, times 4
     rel = 4 * offset_sd(d.sd_io, d.rho_io, 50) / np.mean(d.F_io)
     assert np.max(np.abs(pred - truth)) < rel * np.max(np.abs(truth)) + 0.05 * d.sd_hoop
+
+
+def test_level_hoop_term_is_one_gaussian_observation_with_model_discrepancy():
+    """Default hoop term: window mean vs model mean, sd^2 = noise of the mean + offset^2 + (3 % of model)^2."""
+    d = closed_form_data(0.05, 0.4, 1.0, seed=9, n_baseline=400)
+    h = HoopTerm(d)
+    assert h.mode == "level"
+    theta = np.array([[0.05, 0.4, 1.0], [0.05, 0.3, 1.1]])
+    mean_pred = h.predict(*theta.T).mean(axis=1)
+    tau = (1 + d.rho_hoop) / (1 - d.rho_hoop)
+    sd = np.sqrt(d.sd_hoop**2 * tau / d.n + d.sd_offset_hoop**2 + (0.03 * mean_pred) ** 2)
+    ref = -0.5 * np.log(2 * np.pi) - np.log(sd) - 0.5 * ((d.hoop.mean() - mean_pred) / sd) ** 2
+    np.testing.assert_allclose(h.loglike(*theta.T), ref, rtol=1e-9)
+    lk = Likelihood(d)
+    pw = lk.pointwise(theta, segment=50)
+    assert pw["hoop"].shape == (2, 1)
+    np.testing.assert_allclose(pw["F_eo"].sum(-1) + pw["hoop"].sum(-1), lk(theta), rtol=1e-9)
+    with pytest.raises(ValueError, match="hoop mode 'shape' is not understood, allowed values: level, series"):
+        HoopTerm(d, mode="shape")

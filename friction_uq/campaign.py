@@ -1,0 +1,131 @@
+"""Compare tests across campaigns from the JSON summaries that ``friction-uq run`` writes.
+
+Per test: the posterior of f and of kappa = f nu/(1-nu) (what the forces fix without nu), the
+sliding velocity V and the mean wall pressure p_mean. Across tests: weighted least-squares fits
+of kappa against V alone, p_mean alone, and both together (weights 1/sd^2 of each test's
+posterior). In one set-up V and p_mean both scale with the striker speed, so a trend against
+either is confounded; a second campaign with another impedance ratio puts the tests at other
+(V, p) pairs, and the joint fit then separates a velocity effect from a pressure effect
+(physics.md section 5). Fits on kappa do not depend on the nu prior; f's scale does.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import FrictionUQError
+
+REQUIRED = ("f", "kappa", "nu", "V", "p_mean", "test_id", "campaign")
+
+
+@dataclass(frozen=True)
+class TestResult:
+    """One test's posterior summary (SI units)."""
+
+    campaign: str
+    test_id: str
+    f: dict[str, float]
+    kappa: dict[str, float]
+    nu: dict[str, float]
+    V: dict[str, float]
+    p_mean: dict[str, float]
+    path: str
+
+
+@dataclass(frozen=True)
+class TrendFit:
+    """kappa = c0 + sum_j c_j x_j, weighted least squares; coefficients, standard errors, chi2/dof."""
+
+    regressors: tuple[str, ...]
+    coef: np.ndarray
+    se: np.ndarray
+    chi2_dof: float
+    n: int
+
+    def slope_z(self, name: str) -> float:
+        """Slope of ``name`` in standard errors (|z| > 3: a trend the noise does not explain)."""
+        j = 1 + self.regressors.index(name)
+        return float(self.coef[j] / self.se[j])
+
+
+def load_result(path: str | os.PathLike[str]) -> TestResult:
+    """Read one ``<campaign>_<test_id>.json`` written by ``friction-uq run``."""
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise FrictionUQError(f"{p}: not a friction-uq result file ({exc})") from None
+    missing = [k for k in REQUIRED if k not in doc]
+    if missing:
+        raise FrictionUQError(f"{p}: not a friction-uq run result: key(s) {', '.join(missing)} missing")
+    return TestResult(doc["campaign"], doc["test_id"], doc["f"], doc["kappa"], doc["nu"], doc["V"], doc["p_mean"],
+                      str(p))
+
+
+def fit_trend(results: list[TestResult], regressors: tuple[str, ...]) -> TrendFit:
+    """Weighted least squares of kappa (posterior median, weight 1/sd^2) on V and/or p_mean."""
+    y = np.array([r.kappa["q50"] for r in results])
+    w = 1.0 / np.array([r.kappa["sd"] for r in results]) ** 2
+    cols = [np.ones_like(y)] + [np.array([getattr(r, x)["mean"] for r in results]) for x in regressors]
+    X = np.column_stack(cols)
+    n, k = X.shape
+    if n <= k:
+        raise FrictionUQError(f"{n} tests cannot fit kappa against {' and '.join(regressors)} ({k} coefficients)")
+    sw = np.sqrt(w)
+    coef, *_ = np.linalg.lstsq(X * sw[:, None], y * sw, rcond=None)
+    resid = (y - X @ coef) * sw
+    chi2_dof = float(resid @ resid / (n - k))
+    cov = np.linalg.inv((X * w[:, None]).T @ X)
+    # scatter beyond the posterior widths widens the standard errors (never narrows them)
+    se = np.sqrt(np.diag(cov) * max(1.0, chi2_dof))
+    return TrendFit(regressors, coef, se, chi2_dof, n)
+
+
+@dataclass(frozen=True)
+class Comparison:
+    results: list[TestResult]
+    fits: dict[str, TrendFit]
+
+    @property
+    def campaigns(self) -> list[str]:
+        return sorted({r.campaign for r in self.results})
+
+
+def compare(paths: list[str | os.PathLike[str]]) -> Comparison:
+    """Load the results and fit the trends that the number of tests allows."""
+    results = sorted((load_result(p) for p in paths), key=lambda r: (r.campaign, r.test_id))
+    if not results:
+        raise FrictionUQError("no result files given")
+    fits: dict[str, TrendFit] = {}
+    for name, regs in (("V", ("V",)), ("p_mean", ("p_mean",)), ("V+p_mean", ("V", "p_mean"))):
+        if len(results) > len(regs) + 1:
+            fits[name] = fit_trend(results, regs)
+    return Comparison(results, fits)
+
+
+def comparison_table(c: Comparison) -> str:
+    """Plain-text table of the tests and the trend fits."""
+    lines = [f"{'campaign':<9} {'test':<8} {'V m/s':>7} {'p_mean MPa':>10} {'kappa q50':>10} {'kappa sd':>9} "
+             f"{'f q50':>7} {'f q05':>7} {'f q95':>7} {'nu q50':>7}"]
+    for r in c.results:
+        lines.append(f"{r.campaign:<9} {r.test_id:<8} {r.V['mean']:>7.2f} {r.p_mean['q50'] / 1e6:>10.1f} "
+                     f"{r.kappa['q50']:>10.5f} {r.kappa['sd']:>9.5f} {r.f['q50']:>7.4f} {r.f['q05']:>7.4f} "
+                     f"{r.f['q95']:>7.4f} {r.nu['q50']:>7.3f}")
+    units = {"V": ("per m/s", 1.0), "p_mean": ("per MPa", 1e6)}
+    for name, fit in c.fits.items():
+        parts = []
+        for j, reg in enumerate(fit.regressors, start=1):
+            u, s = units[reg]
+            parts.append(f"d kappa/d {reg} = {fit.coef[j] * s:+.2e} +- {fit.se[j] * s:.1e} {u} "
+                         f"({fit.slope_z(reg):+.1f} se)")
+        lines.append(f"fit kappa ~ {name}: " + "; ".join(parts) + f"; chi2/dof {fit.chi2_dof:.2f} ({fit.n} tests)")
+    if len(c.campaigns) < 2 and "V" in c.fits:
+        lines.append("one campaign: V and p_mean rise together with the striker speed, so a trend cannot be "
+                     "assigned to one of them (physics.md section 5)")
+    return "\n".join(lines)
+
