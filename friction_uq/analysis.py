@@ -12,6 +12,7 @@ import numpy as np
 
 from .forces import Forces, compute_forces
 from .physics import cell
+from .errors import SignalError
 from .record import Record
 from .signals import moving_average
 from .window import (
@@ -51,7 +52,28 @@ def prepare(
         forces, record.apparatus, win, test_id=record.test_id, campaign=record.campaign,
         striker_velocity=record.striker_velocity,
     )
+    _check_polarity(record, data)
     return Prepared(record, forces, win, data)
+
+
+def _check_polarity(record: Record, data: StationaryData) -> None:
+    """Refuse an output force that is negative (tensile) over the window beyond 3 standard errors.
+
+    Friction and the transmitted load can only push: a negative stationary force means a gauge
+    wired or converted with the wrong sign.
+    """
+    for name, channel, F, sd, rho, off in (
+        ("F_eo", "external_output_bar", data.F_eo, data.sd_eo, data.rho_eo, data.sd_offset_eo),
+        ("F_io", "internal_output_bar", data.F_io, data.sd_io, data.rho_io, data.sd_offset_io),
+    ):
+        se = float(np.hypot(sd * np.sqrt((1 + rho) / ((1 - rho) * len(F))), off))
+        mean = float(np.mean(F))
+        if mean < -3.0 * se:
+            raise SignalError(
+                f"{record.path}: /signals/{channel}: {name} is tensile over the stationary window (mean "
+                f"{mean:.0f} N, standard error {se:.0f} N): the gauge looks reversed; check its wiring, "
+                "its sign convention (elongation positive) or its strain_per_volt"
+            )
 
 
 @dataclass(frozen=True)

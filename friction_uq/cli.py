@@ -55,7 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Deterministic identification of f from eq. 17 over the stationary window.")
     s.add_argument("file", type=Path, help="test record (test.h5)")
     s.add_argument("--nu", type=_nu, default=0.4, help="sample Poisson ratio (default 0.4)")
-    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds (default: automatic)")
+    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds on the record's time base (default: automatic); write --window=T0:T1 when T0 is negative")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of a table")
 
@@ -85,7 +85,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--priors", type=Path, help="prior file (TOML; default: priors/<material>.toml)")
     s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
     s.add_argument("--seed", type=int, default=20161, help="random seed (default 20161)")
-    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds (default: automatic)")
+    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds on the record's time base (default: automatic); write --window=T0:T1 when T0 is negative")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
     s.add_argument("--no-pdf", action="store_true", help="skip the PDF report")

@@ -34,6 +34,7 @@ class ChannelInfo:
     noise: NoiseEstimate
     arrival: float
     valid_until: float
+    detected: bool = True
 
 
 @dataclass(frozen=True)
@@ -86,12 +87,11 @@ class Forces:
         """Time (s) the incident wave reaches the plug."""
         return float(np.interp(self.channels["incident"].arrival, np.arange(len(self.time)), self.time))
 
-    def force_noise_sd(self, bar: Bar, channel: str) -> float:
-        """Noise standard deviation of a transmitted force, A E sd(strain) (N)."""
-        return bar.area * bar.young_modulus * self.channels[channel].noise.sd
 
 
-def _noise_and_arrival(x: np.ndarray, *, earliest: float, span: int, polarity: int) -> tuple[NoiseEstimate, float]:
+def _noise_and_arrival(
+    x: np.ndarray, *, earliest: float, span: int, polarity: int
+) -> tuple[NoiseEstimate, float, bool]:
     """Pre-pulse noise and arrival of a channel whose pulse cannot come before ``earliest`` (index).
 
     A channel whose pulse stays below its noise (a tiny friction force, say) still has a valid
@@ -102,10 +102,10 @@ def _noise_and_arrival(x: np.ndarray, *, earliest: float, span: int, polarity: i
         nz, arr = prepulse_noise(x, span=span, polarity=polarity)
     except SignalError:
         stop = int(np.floor(earliest)) - 8
-        return noise_estimate(x, stop=stop), float(earliest)
+        return noise_estimate(x, stop=stop), float(earliest), False
     if nz.stop > earliest:  # a pulse "before" the earliest possible arrival: keep to physics
         nz = noise_estimate(x, stop=int(np.floor(earliest)) - 8)
-    return nz, arr
+    return nz, arr, True
 
 
 def _transported(x: np.ndarray, bar: Bar, distance: float, dt: float, dispersion: bool) -> np.ndarray:
@@ -142,7 +142,10 @@ def compute_forces(record: Record, *, dispersion: bool = False) -> Forces:
     # --- input bar: incident then reflected on one gauge
     ib = app.input_bar
     x = record.strain("input_bar")
-    noise_in, arr_inc = prepulse_noise(x, span=span, polarity=+1)
+    try:
+        noise_in, arr_inc = prepulse_noise(x, span=span, polarity=+1)
+    except SignalError as exc:
+        raise SignalError(f"{record.path}: /signals/input_bar: {exc} (no incident wave found)") from None
     y = x - noise_in.offset
     sep = arr_inc + 2.0 * ib.gauge_delay * fs  # reflected wave's front at the gauge
     margin = 0.02 * app.pulse_duration * fs
@@ -165,21 +168,21 @@ def compute_forces(record: Record, *, dispersion: bool = False) -> Forces:
         bar = app.bars[name]
         x = record.strain(name)
         d = bar.gauge_delay * fs
-        nz, arr = _noise_and_arrival(x, earliest=arr_inc + d_in + d, span=span, polarity=+1)
+        nz, arr, found = _noise_and_arrival(x, earliest=arr_inc + d_in + d, span=span, polarity=+1)
         echo = arr + 2.0 * (bar.length - bar.gauge_distance) / bar.wave_speed * fs
         y = np.where(window_mask(n, 0, echo - margin), x - nz.offset, 0.0)
         eps = _transported(y, bar, -bar.gauge_distance, dt, dispersion)
         valid_until = echo - d - margin
         out[name] = np.where(window_mask(n, 0, valid_until), eps, np.nan)
-        info[name] = ChannelInfo(name, nz, arr - d, valid_until)
+        info[name] = ChannelInfo(name, nz, arr - d, valid_until, found)
 
     hoop = None
     if record.has_hoop:
         x = record.strain("tube_hoop")
         # the tube swells: compression-positive hoop strain goes negative
-        nz, arr = _noise_and_arrival(x, earliest=arr_inc + d_in, span=span, polarity=-1)
+        nz, arr, found = _noise_and_arrival(x, earliest=arr_inc + d_in, span=span, polarity=-1)
         hoop = x - nz.offset
-        info["tube_hoop"] = ChannelInfo("tube_hoop", nz, arr, float(n))
+        info["tube_hoop"] = ChannelInfo("tube_hoop", nz, arr, float(n), found)
 
     io, eo = app.internal_output_bar, app.external_output_bar
     eps_io, eps_eo = out["internal_output_bar"], out["external_output_bar"]

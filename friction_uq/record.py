@@ -18,7 +18,6 @@ from __future__ import annotations
 import hashlib
 import math
 import os
-import tempfile
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from datetime import datetime
@@ -28,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from ._atomic import atomic_path
 from .errors import RecordError
 
 FORMAT = "friction-uq/test"
@@ -746,10 +746,7 @@ def write_record(
     units = dict(units or {})
     strain_per_volt = dict(strain_per_volt or {})
     p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-    os.close(fd)
-    try:
+    with atomic_path(p) as tmp:
         with h5py.File(tmp, "w") as fh:
             fh.attrs["format"] = FORMAT
             fh.attrs["format_version"] = FORMAT_VERSION
@@ -790,14 +787,6 @@ def write_record(
                 tg = fh.create_group("truth")
                 for k, v in truth.items():
                     tg.attrs[k] = v
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a record is an ordinary file
-        os.replace(tmp, p)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return p
 
 

@@ -8,12 +8,12 @@ removed once the outputs are written.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
 import re
 import sys
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +22,7 @@ import numpy as np
 from scipy import stats
 
 from . import __version__
+from ._atomic import atomic_path
 from .analysis import Identification, Prepared, identify, prepare
 from .diagnostics import (
     Convergence,
@@ -34,7 +35,8 @@ from .diagnostics import (
     ratio_ppc,
     summarize,
 )
-from .priors import Priors, default_prior_path, load_priors
+from .errors import FrictionUQError
+from .priors import PRIORS_DIR, Priors, default_prior_path, load_priors
 from .record import read_record
 from .sampler import PosteriorSamples, sample_posterior, stderr_progress
 
@@ -58,10 +60,11 @@ def safe_stem(campaign: str, test_id: str) -> str:
 
 
 def sliding_velocity_summary(p: Prepared) -> VariableSummary:
-    """V over the window: mean and its standard error (AR(1) effective sample size), normal quantiles.
+    """V over the window: mean and its standard error, normal quantiles.
 
     V = V_io - V_eo (eq. 7) is measured, not a model parameter; its uncertainty is the noise of
-    the two output gauges (pre-pulse estimates) averaged over the window.
+    the two output gauges averaged over the window (effective AR(1) sample size) plus the error
+    of the offsets removed from them (pre-pulse estimates).
     """
     app = p.record.apparatus
     ch = p.forces.channels
@@ -71,7 +74,8 @@ def sliding_velocity_summary(p: Prepared) -> VariableSummary:
     var = 0.0
     for bar, nz in ((io, n_io), (eo, n_eo)):
         sd = bar.wave_speed * nz.sd
-        var += sd**2 / (len(v) * nz.effective_fraction)
+        var += sd**2 / (len(v) * nz.effective_fraction)  # noise of the window mean
+        var += (bar.wave_speed * nz.offset_sd) ** 2  # the offset removed, constant over the window
     sd = math.sqrt(var)
     m = float(np.mean(v))
     q = stats.norm.ppf([0.05, 0.5, 0.95], loc=m, scale=sd)
@@ -79,31 +83,52 @@ def sliding_velocity_summary(p: Prepared) -> VariableSummary:
 
 
 def alternative_nu_priors(default_path: Path, priors: Priors) -> dict[str, Priors]:
-    """The default priors and the nu alternatives shipped beside them (``<material>-nu-*.toml``).
+    """The priors used and the nu alternatives shipped in ``priors/`` (``<material>-nu-*.toml``).
 
-    Each alternative keeps the default's f (and hoop gain) prior and swaps nu only, so the three
-    posteriors of f differ by the nu prior alone.
+    Each alternative keeps the used f (and hoop gain) prior and swaps nu only, so the posteriors
+    of f differ by the nu prior alone. A material without alternatives gets none (the report then
+    shows f under the one prior used).
     """
     out: dict[str, Priors] = {"default": priors}
     material = priors.material or default_path.stem
-    for alt in sorted(default_prior_path(material).parent.glob(f"{material}-nu-*.toml")):
+    for alt in sorted(PRIORS_DIR.glob(f"{material}-nu-*.toml")):
         if alt.resolve() == Path(default_path).resolve():
             continue
         other = load_priors(alt)
         label = alt.stem.removeprefix(f"{material}-")
-        out[label] = priors.replace(other["nu"])
+        out[label] = dataclasses.replace(priors.replace(other["nu"]), path=str(alt), description=other.description)
     return out
 
 
 def _atomic_write_bytes(path: Path, write) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+
+
+def hoop_unusable(p: Prepared) -> str | None:
+    """Why the hoop gauge cannot enter the likelihood for this record, or None if it can.
+
+    * the channel shows no pulse above its noise (a dead or disconnected gauge);
+    * its window mean is not a swelling beyond 3 standard errors (noise of the mean and offset);
+    * the tube differs from the one the influence function was fitted to (bore 10 mm, outer
+      24 mm, nu_t 0.29; physics.md section 6): the kernel would be wrong.
+    """
+    t = p.record.apparatus.tube
+    if not (abs(t.inner_diameter - 0.010) < 1e-6 and abs(t.outer_diameter - 0.024) < 1e-6
+            and abs(t.poisson_ratio - 0.29) < 1e-3):
+        return (f"the tube influence function is fitted to a 10/24 mm tube with nu_t = 0.29, this record's tube is "
+                f"{t.inner_diameter * 1e3:g}/{t.outer_diameter * 1e3:g} mm with nu_t = {t.poisson_ratio:g}")
+    info = p.forces.channels["tube_hoop"]
+    if not info.detected:
+        return "tube_hoop shows no pulse above its noise (a dead or disconnected gauge?)"
+    d = p.data
+    nz = info.noise
+    se = math.hypot(nz.sd / math.sqrt(d.n * nz.effective_fraction), nz.offset_sd)
+    mean = float(np.mean(d.hoop))
+    if not mean < -3.0 * se:  # compression positive: a swelling tube reads negative
+        return (f"tube_hoop shows no swelling over the window (mean {mean * 1e6:+.2f} microstrain, standard "
+                f"error {se * 1e6:.2f})")
+    return None
 
 
 def run_file(
@@ -124,28 +149,36 @@ def run_file(
     prep = prepare(record, window=window, dispersion=dispersion)
     p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
     priors = load_priors(p_path)
-    use_hoop = bool(hoop and prep.data.hoop is not None)
+    alternatives = alternative_nu_priors(p_path, priors)
+    left_out = hoop_unusable(prep) if hoop and prep.data.hoop is not None else None
+    use_hoop = bool(hoop and prep.data.hoop is not None and left_out is None)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    if out.exists() and not out.is_dir():
+        raise FrictionUQError(f"{out}: --out must be a directory, and this is a file")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FrictionUQError(f"{out}: cannot create the output directory ({exc.strerror or exc})") from None
     stem = safe_stem(record.campaign, record.test_id)
     backend = out / f".{stem}.chains.h5"
     say = (lambda msg: print(msg, file=sys.stderr)) if progress else (lambda msg: None)
     say(f"friction-uq: {record.campaign} {record.test_id}: window {prep.window.t0 * 1e6:.1f}-"
         f"{prep.window.t1 * 1e6:.1f} us, hoop term {'on' if use_hoop else 'off'}, priors {p_path}")
+    if left_out:
+        print(f"friction-uq: note: the hoop gauge is left out of the likelihood: {left_out}", file=sys.stderr)
 
     samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
                                progress=stderr_progress if progress else None)
     dt = build_datatree(samples, prep.data, priors, seed=seed)
     conv = convergence(dt, samples)
     summary = summarize(dt)
-    say("friction-uq: sensitivity to the nu prior (two more runs)")
-    alternatives = alternative_nu_priors(p_path, priors)
+    say(f"friction-uq: sensitivity to the nu prior ({len(alternatives) - 1} more runs)")
     sens = nu_sensitivity(prep.data, alternatives, seed=seed, hoop=use_hoop, done={"default": samples})
     band = f_given_nu(samples, np.linspace(0.15, 0.49, 69))
     share = nu_variance_share(samples)
     ppc = ratio_ppc(samples, prep.data, seed=seed)
-    nu_lab = float(np.clip(summary["nu"].q50, 0.01, 0.49)) if "nu" in summary else 0.4
-    lab = identify(prep, nu=round(nu_lab, 2))
+    # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
+    lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
     V = sliding_velocity_summary(prep)
 
     dt.attrs.update({
@@ -186,11 +219,12 @@ def run_file(
         "record_sha256": record.sha256,
         "prior_file": str(p_path),
         "hoop_term": use_hoop,
+        "hoop_left_out": left_out,
         "dispersion_correction": dispersion,
         "nu_variance_share_of_f": share,
         "f_under_nu_priors": {k: s.to_json() for k, s in sens.items()},
         "ppc_ratio_coverage_90": ppc.coverage,
-        "lab_point_estimate": {"nu": lab.nu, "f": lab.f, "ratio": lab.ratio},
+        "lab_point_estimate_nominal_nu": {"nu": lab.nu, "f": lab.f, "ratio": lab.ratio},
         "ess_per_second": conv.ess_per_second,
         "friction_uq_version": __version__,
     }

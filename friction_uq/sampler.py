@@ -460,12 +460,19 @@ def sample_posterior(
 
     converged = False
     prev_tau: np.ndarray | None = None
+    # a resumed run whose stored chains end on a check point is checked before stepping, so that
+    # resuming a finished run gives back the same draws instead of stepping one block further
+    done0 = [s.backend.iteration for s in samplers]
+    check_first = min(done0) > 0 and len(set(done0)) == 1 and done0[0] % check_every == 0
     while True:
         for k, s in enumerate(samplers):
+            if check_first:
+                break
             done = s.backend.iteration
             target = min(max_steps, (done // check_every + 1) * check_every)
             if target > done:
                 states[k] = s.run_mcmc(states[k], target - done, progress=False, skip_initial_state_check=True)
+        check_first = False
         n = min(s.backend.iteration for s in samplers)
         chains = np.concatenate([s.backend.get_chain()[:n] for s in samplers], axis=1)  # all walkers
         tau = integrated_time(chains)

@@ -105,3 +105,12 @@ def test_analyze_json_cli(paper_record, capsys):
         assert key in out
     assert out["f"] == pytest.approx(0.05, abs=0.003)
     assert len(out["window"]) == 2
+
+
+def test_a_reversed_output_gauge_is_refused(tmp_path):
+    test = ClosedFormTest()
+    _, strains, _ = closed_form_strains(test, paper_apparatus())
+    p = write_closed_form_record(tmp_path / "rev.h5", test, seed=3,
+                                 strains_override={"external_output_bar": -strains["external_output_bar"]})
+    with pytest.raises(SignalError, match=r"rev\.h5: /signals/external_output_bar: F_eo is tensile .* looks reversed"):
+        prepare(read_record(p))

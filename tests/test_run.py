@@ -99,3 +99,28 @@ def test_no_stationary_phase_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "no stationary phase" in err and "Traceback" not in err
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_dead_hoop_gauge_is_left_out_with_a_note(tmp_path, capsys):
+    """A tube_hoop channel with only noise must not drive the fit (it would read as nu -> 0)."""
+    import numpy as np
+
+    test = ClosedFormTest(f=0.05, nu=0.4)
+    n = int(round(test.duration * test.sample_rate))
+    rec = write_closed_form_record(tmp_path / "dead.h5", test, seed=8, test_id="D-01", campaign="dead",
+                                   strains_override={"tube_hoop": np.zeros(n)})
+    out = tmp_path / "out"
+    assert main(["run", str(rec), "--out", str(out), "--quiet", "--no-pdf"]) == 0
+    assert "hoop gauge is left out of the likelihood: tube_hoop shows no" in capsys.readouterr().err
+    doc = json.loads((out / "dead_D-01.json").read_text())
+    assert doc["hoop_term"] is False and doc["hoop_left_out"]
+    assert doc["f"]["q05"] <= 0.05 <= doc["f"]["q95"]
+
+
+def test_out_that_is_a_file_is_refused(paper_run, tmp_path, capsys):
+    _, _, rec = paper_run
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    assert main(["run", str(rec), "--out", str(afile), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "must be a directory" in err and "Traceback" not in err

@@ -203,9 +203,13 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(paper_data, tmp_pat
         sample_posterior(paper_data, DEFAULT, backend_path=path, progress=stop_at_300, **kw)
     steps = []
     resumed = sample_posterior(paper_data, DEFAULT, backend_path=path, progress=lambda p: steps.append(p.steps), **kw)
-    assert steps[0] == 400  # continued from the saved 300 steps, not from scratch
+    assert steps[:2] == [300, 400]  # checked the saved 300 steps, then continued (not from scratch)
     assert resumed.n_steps == full.n_steps and resumed.converged
     np.testing.assert_array_equal(resumed.array(), full.array())
+    # resuming a finished run steps no further and gives the same draws
+    again = sample_posterior(paper_data, DEFAULT, backend_path=tmp_path / "full.h5", **kw)
+    assert again.n_steps == full.n_steps
+    np.testing.assert_array_equal(again.array(), full.array())
     # and the in-memory run gives the same numbers as the HDF5-backed one
     mem = sample_posterior(paper_data, DEFAULT, **kw)
     np.testing.assert_array_equal(mem.array(), full.array())

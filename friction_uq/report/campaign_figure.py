@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from .._atomic import atomic_path
 
 from ..campaign import Comparison
 from .style import RC, figure
@@ -45,14 +46,9 @@ def campaign_figure(c: Comparison, path: str | os.PathLike[str]) -> Path:
         for ax in axes:
             ax.legend(loc="best")
         out = Path(path)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=out.suffix or ".pdf", dir=out.parent)
-        os.close(fd)
         try:
-            fig.savefig(tmp)
-            os.replace(tmp, out)
+            with atomic_path(out) as tmp:
+                fig.savefig(tmp, format=out.suffix.lstrip(".") or "pdf")
         finally:
             plt.close(fig)
-            if os.path.exists(tmp):
-                os.unlink(tmp)
     return out

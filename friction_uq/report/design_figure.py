@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from .._atomic import atomic_path
 
 from ..errors import SignalError
 from ..physics import design
@@ -57,14 +58,9 @@ def design_figure(record: Record, path: str | os.PathLike[str], *, nu: float = 0
         ax.legend(h1 + h2, l1 + l2, loc="center right")
         ax.set_xlim(0, 0.5)
         out = Path(path)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=out.suffix or ".pdf", dir=out.parent)
-        os.close(fd)
         try:
-            fig.savefig(tmp)
-            os.replace(tmp, out)
+            with atomic_path(out) as tmp:
+                fig.savefig(tmp, format=out.suffix.lstrip(".") or "pdf")
         finally:
             plt.close(fig)
-            if os.path.exists(tmp):
-                os.unlink(tmp)
     return out

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -11,6 +10,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
+from .._atomic import atomic_path
 from ..analysis import Identification, Prepared
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
@@ -99,27 +99,20 @@ def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
 
     p = r.prepared
     out = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".pdf", dir=out.parent)
-    os.close(fd)
-    try:
-        with PdfPages(tmp, metadata={"Title": f"friction-uq {p.record.campaign} {p.record.test_id}",
-                                     "Creator": f"friction-uq {r.version}"}) as pdf:
-            builders = [
-                lambda: page_summary(r),
-                lambda: page_raw(p.record),
-                lambda: page_forces(p.record, p.forces, p.window),
-                lambda: page_window(p.record, p.forces, p.window),
-                lambda: page_corner(r.samples, r.datatree),
-                lambda: page_propagation(r.samples, r.band, r.sensitivity, r.nu_share, nu_assumed=r.lab.nu),
-                lambda: page_convergence(r.samples, r.convergence),
-                lambda: page_ppc(r.ppc),
-            ]
-            for build in builders:
-                fig = build()
-                pdf.savefig(fig)
-                plt.close(fig)
-        os.replace(tmp, out)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    meta = {"Title": f"friction-uq {p.record.campaign} {p.record.test_id}", "Creator": f"friction-uq {r.version}"}
+    with atomic_path(out) as tmp, PdfPages(tmp, metadata=meta) as pdf:
+        builders = [
+            lambda: page_summary(r),
+            lambda: page_raw(p.record),
+            lambda: page_forces(p.record, p.forces, p.window),
+            lambda: page_window(p.record, p.forces, p.window),
+            lambda: page_corner(r.samples, r.datatree),
+            lambda: page_propagation(r.samples, r.band, r.sensitivity, r.nu_share, nu_assumed=r.lab.nu),
+            lambda: page_convergence(r.samples, r.convergence),
+            lambda: page_ppc(r.ppc),
+        ]
+        for build in builders:
+            fig = build()
+            pdf.savefig(fig)
+            plt.close(fig)
     return out
