@@ -41,10 +41,11 @@ def campaign_figure(c: Comparison, path: str | os.PathLike[str]) -> Path:
                 continue
             lo, hi = ax.get_xlim()
             xx = np.linspace(lo, hi, 50)
-            ax.plot(xx, fit.coef[0] + fit.coef[1] * xx / xs, "k--", lw=1,
-                    label=f"weighted fit: slope {fit.slope_z(name):+.1f} se, chi2/dof {fit.chi2_dof:.1f}")
+            ax.plot(xx, fit.coef[0] + fit.coef[1] * xx / xs, "k--", lw=1, label="weighted fit")
+            ax.set_title(f"slope {fit.slope_z(name):+.1f} se, chi2/dof {fit.chi2_dof:.1f}", loc="left", fontsize=9)
         for ax in axes:
-            ax.legend(loc="best")
+            ax.legend(loc="upper right", fontsize=8)
+        fig.subplots_adjust(wspace=0.4)
         out = Path(path)
         try:
             with atomic_path(out) as tmp:
