@@ -7,10 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_path
 
 from ..campaign import Comparison
-from .style import RC, figure
+from .style import RC, figure, save_figure
 
 
 def campaign_figure(c: Comparison, path: str | os.PathLike[str]) -> Path:
@@ -46,10 +45,4 @@ def campaign_figure(c: Comparison, path: str | os.PathLike[str]) -> Path:
         for ax in axes:
             ax.legend(loc="upper right", fontsize=8)
         fig.subplots_adjust(wspace=0.4)
-        out = Path(path)
-        try:
-            with atomic_path(out) as tmp:
-                fig.savefig(tmp, format=out.suffix.lstrip(".") or "pdf")
-        finally:
-            plt.close(fig)
-    return out
+    return save_figure(fig, path)

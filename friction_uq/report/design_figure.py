@@ -7,13 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_path
 
 from ..errors import SignalError
 from ..physics import design
 from ..record import Record
 from ..signals import prepulse_noise
-from .style import RC, figure
+from .style import RC, figure, save_figure
 
 
 def striker_velocity_from_incident(record: Record) -> float:
@@ -57,10 +56,4 @@ def design_figure(record: Record, path: str | os.PathLike[str], *, nu: float = 0
         h2, l2 = ax2.get_legend_handles_labels()
         ax.legend(h1 + h2, l1 + l2, loc="center right")
         ax.set_xlim(0, 0.5)
-        out = Path(path)
-        try:
-            with atomic_path(out) as tmp:
-                fig.savefig(tmp, format=out.suffix.lstrip(".") or "pdf")
-        finally:
-            plt.close(fig)
-    return out
+    return save_figure(fig, path)

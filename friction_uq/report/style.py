@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import matplotlib
+
+from .._atomic import atomic_path
 
 matplotlib.use("Agg")
 
@@ -29,3 +34,14 @@ def figure(title: str, *, nrows: int = 1, ncols: int = 1, **kw):
         fig, axes = plt.subplots(nrows, ncols, figsize=A4_LANDSCAPE, **kw)
     fig.suptitle(title)
     return fig, axes
+
+
+def save_figure(fig, path: str | os.PathLike[str]) -> Path:
+    """Save ``fig`` atomically (format from the suffix, PDF by default) and close it."""
+    out = Path(path)
+    try:
+        with atomic_path(out) as tmp:
+            fig.savefig(tmp, format=out.suffix.lstrip(".") or "pdf")
+    finally:
+        plt.close(fig)
+    return out
