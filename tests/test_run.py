@@ -67,7 +67,7 @@ def test_pdf_is_a_multipage_report(paper_run):
     data = (out / "paper_P-01.pdf").read_bytes()
     assert data[:4] == b"%PDF"
     pages = data.count(b"/Type /Page") - data.count(b"/Type /Pages")
-    assert pages == 8  # summary + pages 1-7
+    assert pages == 9  # summary + pages 1-7 + page 8 (hoop gauge vs model: the hoop term was used)
 
 
 def test_a_prior_file_with_a_typo_is_refused_and_nothing_is_written(paper_run, tmp_path, capsys):

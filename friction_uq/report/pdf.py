@@ -14,7 +14,7 @@ from .._atomic import atomic_path
 from ..analysis import Identification, Prepared
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
-from .posterior_pages import page_convergence, page_corner, page_ppc, page_propagation
+from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
 from .style import figure
 
@@ -87,13 +87,14 @@ def page_summary(r: ReportInputs) -> Figure:
             f"seed {r.samples.seed}, friction-uq {r.version}")
     ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
     ax.text(0.77, 0.47, "Pages\n 1 raw gauges\n 2 waves, forces, equilibrium\n 3 window and noise\n"
-            " 4 posterior vs prior\n 5 nu -> f\n 6 convergence\n 7 predictive check",
+            " 4 posterior vs prior\n 5 nu -> f\n 6 convergence\n 7 predictive check"
+            + ("\n 8 hoop gauge vs model" if r.samples.hoop else ""),
             fontsize=10, va="top", transform=ax.transAxes, family="monospace")
     return fig
 
 
 def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
-    """Write the PDF (summary page, then pages 1-7) atomically."""
+    """Write the PDF (summary page, pages 1-7, and page 8 when the hoop term was used) atomically."""
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
@@ -111,6 +112,8 @@ def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
             lambda: page_convergence(r.samples, r.convergence),
             lambda: page_ppc(r.ppc),
         ]
+        if r.samples.hoop:
+            builders.append(lambda: page_hoop(r.samples, p.data, p.forces, seed=r.samples.seed))
         for build in builders:
             fig = build()
             pdf.savefig(fig)

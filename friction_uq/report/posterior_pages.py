@@ -134,3 +134,44 @@ def page_ppc(ppc: RatioPPC, *, number: int = 7) -> Figure:
                  "(about 90 % if the constant-ratio model and the noise model hold)", loc="left")
     ax.legend(loc="upper right")
     return fig
+
+
+def page_hoop(samples: PosteriorSamples, data, forces, *, number: int = 8, n_draws: int = 200, seed: int = 0) -> Figure:
+    """The hoop gauge against the model: whole record, window prediction band, residual shape.
+
+    The likelihood uses the window level only (3 % model discrepancy); this page shows what the
+    level hides: the shape of the reading as the sample slides past the gauge, against the
+    shape the Janssen pressure and the tube kernel predict.
+    """
+    from ..likelihood import Likelihood
+
+    fig, axes = figure(f"{number}. Tube hoop gauge against the model (posterior draws)", nrows=1, ncols=2)
+    lk = Likelihood(data, hoop=True)
+    rng = np.random.default_rng(seed)
+    flat = samples.array().reshape(-1, len(samples.names))
+    pick = flat[rng.choice(len(flat), size=min(n_draws, len(flat)), replace=False)]
+    pred = lk.hoop.predict(pick[:, 0], pick[:, 1], pick[:, 2])
+    q = np.quantile(pred, [0.05, 0.5, 0.95], axis=0)
+    t = np.asarray(data.time) * US
+    ax = axes[0]
+    ax.plot(forces.time * US, forces.hoop * US, color="k", lw=0.6, label="hoop gauge (compression positive)")
+    ax.fill_between(t, q[0] * US, q[2] * US, color="C1", alpha=0.4, label="model, 90 % band (window)")
+    ax.plot(t, q[1] * US, color="C1", lw=1.2)
+    ax.set_xlabel("time (us)")
+    ax.set_ylabel("hoop strain (ue); the swelling tube reads negative")
+    ax.set_title("whole record; model over the window", loc="left")
+    ax.legend(loc="lower right")
+    ax = axes[1]
+    resid = (np.asarray(data.hoop) - q[1]) * US
+    sd = float(data.sd_hoop) * US
+    ax.plot(t, resid, color="k", lw=0.6, label="observed - model median")
+    ax.axhspan(-2 * sd, 2 * sd, color="0.8", alpha=0.6, label="+- 2 sd of the gauge noise")
+    level = 0.03 * float(np.mean(np.abs(q[1]))) * US
+    ax.axhline(level, color="C3", ls="--", lw=1, label="+- 3 % of the level (model discrepancy)")
+    ax.axhline(-level, color="C3", ls="--", lw=1)
+    ax.set_xlabel("time (us)")
+    ax.set_ylabel("residual (ue)")
+    ax.set_title(f"residual: mean {np.mean(resid):+.2f} ue,\ntrend {np.polyfit(t, resid, 1)[0] * 100:+.2f} ue "
+                 "per 100 us", loc="left")
+    ax.legend(loc="upper right")
+    return fig
