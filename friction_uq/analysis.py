@@ -6,6 +6,8 @@ starting point of the Bayesian one.
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,7 +16,7 @@ from .forces import Forces, compute_forces
 from .physics import cell
 from .errors import SignalError
 from .record import Record
-from .signals import moving_average
+from .signals import ar1_mean_sd, moving_average
 from .window import (
     StationaryData,
     Window,
@@ -66,7 +68,7 @@ def _check_polarity(record: Record, data: StationaryData) -> None:
         ("F_eo", "external_output_bar", data.F_eo, data.sd_eo, data.rho_eo, data.sd_offset_eo),
         ("F_io", "internal_output_bar", data.F_io, data.sd_io, data.rho_io, data.sd_offset_io),
     ):
-        se = float(np.hypot(sd * np.sqrt((1 + rho) / ((1 - rho) * len(F))), off))
+        se = math.hypot(ar1_mean_sd(sd, rho, len(F)), off)
         mean = float(np.mean(F))
         if mean < -3.0 * se:
             raise SignalError(

@@ -94,6 +94,7 @@ from scipy.signal import lfilter
 
 from .errors import SignalError
 from .physics import cell, tube
+from .signals import ar1_mean_sd
 from .window import StationaryData
 
 #: Parameter names without / with the hoop term.
@@ -190,8 +191,8 @@ def ar1_noise(shape: tuple[int, ...], *, sd: float, rho: float, rng: np.random.G
 
 def offset_sd(sd: float, rho: float, n_baseline: int) -> float:
     """Standard deviation of the mean of ``n_baseline`` AR(1) samples: the error of an offset removed
-    with the mean of a pre-pulse segment, sd sqrt((1 + rho) / ((1 - rho) n_baseline))."""
-    return sd * math.sqrt((1.0 + rho) / ((1.0 - rho) * n_baseline))
+    with the mean of a pre-pulse segment (:func:`friction_uq.signals.ar1_mean_sd`)."""
+    return ar1_mean_sd(sd, rho, n_baseline)
 
 
 def ar1_offset_correction(

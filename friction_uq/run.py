@@ -71,12 +71,7 @@ def sliding_velocity_summary(p: Prepared) -> VariableSummary:
     io, eo = app.internal_output_bar, app.external_output_bar
     n_io, n_eo = ch["internal_output_bar"].noise, ch["external_output_bar"].noise
     v = np.asarray(p.data.V, float)
-    var = 0.0
-    for bar, nz in ((io, n_io), (eo, n_eo)):
-        sd = bar.wave_speed * nz.sd
-        var += sd**2 / (len(v) * nz.effective_fraction)  # noise of the window mean
-        var += (bar.wave_speed * nz.offset_sd) ** 2  # the offset removed, constant over the window
-    sd = math.sqrt(var)
+    sd = math.hypot(n_io.window_mean_sd(len(v), scale=io.wave_speed), n_eo.window_mean_sd(len(v), scale=eo.wave_speed))
     m = float(np.mean(v))
     q = stats.norm.ppf([0.05, 0.5, 0.95], loc=m, scale=sd)
     return VariableSummary(m, sd, float(q[0]), float(q[1]), float(q[2]), float("nan"), float("nan"))
@@ -121,10 +116,8 @@ def hoop_unusable(p: Prepared) -> str | None:
     info = p.forces.channels["tube_hoop"]
     if not info.detected:
         return "tube_hoop shows no pulse above its noise (a dead or disconnected gauge?)"
-    d = p.data
-    nz = info.noise
-    se = math.hypot(nz.sd / math.sqrt(d.n * nz.effective_fraction), nz.offset_sd)
-    mean = float(np.mean(d.hoop))
+    se = info.noise.window_mean_sd(p.data.n)
+    mean = float(np.mean(p.data.hoop))
     if not mean < -3.0 * se:  # compression positive: a swelling tube reads negative
         return (f"tube_hoop shows no swelling over the window (mean {mean * 1e6:+.2f} microstrain, standard "
                 f"error {se * 1e6:.2f})")

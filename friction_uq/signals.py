@@ -72,14 +72,26 @@ class NoiseEstimate:
         return self.stop - self.start
 
     @property
-    def effective_fraction(self) -> float:
-        """(1 - rho_eff) / (1 + rho_eff): independent samples per sample for a mean (1 / tau)."""
-        return (1.0 - self.rho_eff) / (1.0 + self.rho_eff)
-
-    @property
     def offset_sd(self) -> float:
         """Standard error of ``offset`` (the segment's mean): sd sqrt(tau / n)."""
-        return self.sd / math.sqrt(self.n * self.effective_fraction)
+        return ar1_mean_sd(self.sd, self.rho_eff, self.n)
+
+    def window_mean_sd(self, n: int, *, scale: float = 1.0) -> float:
+        """Standard error of the mean of ``n`` offset-corrected samples, times ``scale`` (units).
+
+        Noise of the mean (effective AR(1)) and the error of the removed offset, which is
+        constant over the window.
+        """
+        return scale * math.hypot(ar1_mean_sd(self.sd, self.rho_eff, n), self.offset_sd)
+
+
+def ar1_mean_sd(sd: float, rho: float, n: int) -> float:
+    """Standard deviation of the mean of ``n`` AR(1) samples, sd sqrt((1 + rho) / ((1 - rho) n)) (large n).
+
+    >>> round(ar1_mean_sd(2.0, 0.0, 100), 6)
+    0.2
+    """
+    return sd * math.sqrt((1.0 + rho) / ((1.0 - rho) * max(n, 1)))
 
 
 def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate:

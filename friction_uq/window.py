@@ -31,7 +31,7 @@ import numpy as np
 from .errors import NoStationaryPhase, SignalError
 from .forces import Forces
 from .record import Apparatus, Tube
-from .signals import moving_average
+from .signals import ar1_mean_sd, moving_average
 
 
 @dataclass(frozen=True)
@@ -68,11 +68,6 @@ class Window:
         return slice(self.i0, self.i1)
 
 
-def _mean_noise_factor(rho: float, width: int) -> float:
-    """Standard deviation of the mean of ``width`` AR(1) samples, per unit sample sd (large-n form)."""
-    return math.sqrt((1.0 + rho) / ((1.0 - rho) * max(width, 1)))
-
-
 def steady_mask(forces: Forces, apparatus: Apparatus, criterion: WindowCriterion = WindowCriterion()) -> np.ndarray:
     """Boolean array: True where the record is steady by the criterion of this module."""
     return _steadiness(forces, apparatus, criterion)[0]
@@ -98,8 +93,8 @@ def _steadiness(
         r_s = feo_s / fio_s
     sd_io = io.area * io.young_modulus * ch["internal_output_bar"].noise.sd
     sd_eo = eo.area * eo.young_modulus * ch["external_output_bar"].noise.sd
-    k_io = _mean_noise_factor(ch["internal_output_bar"].noise.rho_eff, w)
-    k_eo = _mean_noise_factor(ch["external_output_bar"].noise.rho_eff, w)
+    k_io = ar1_mean_sd(1.0, ch["internal_output_bar"].noise.rho_eff, w)
+    k_eo = ar1_mean_sd(1.0, ch["external_output_bar"].noise.rho_eff, w)
     with np.errstate(divide="ignore", invalid="ignore"):
         sd_r = np.sqrt((sd_eo * k_eo) ** 2 + (r_s * sd_io * k_io) ** 2) / np.abs(fio_s)
 
@@ -118,7 +113,7 @@ def _steadiness(
     dv_s = moving_average(V_i - V_io, w)
     vio_s = moving_average(V_io, w)
     sd_dv = math.hypot(
-        ib.wave_speed * math.sqrt(2.0) * ch["input_bar"].noise.sd * _mean_noise_factor(ch["input_bar"].noise.rho_eff, w),
+        ib.wave_speed * math.sqrt(2.0) * ar1_mean_sd(ch["input_bar"].noise.sd, ch["input_bar"].noise.rho_eff, w),
         io.wave_speed * ch["internal_output_bar"].noise.sd * k_io,
     )
     vel_ok = np.abs(dv_s) <= np.maximum(criterion.sigmas * sd_dv, criterion.velocity_tol * np.abs(vio_s))
