@@ -34,6 +34,7 @@ from . import bars, cell
 from .config import SimulationConfig
 from .friction import LAWS
 from .hoop import hoop_strain
+from .loading import Loading
 
 
 @dataclass(frozen=True)
@@ -79,16 +80,26 @@ class ModelOutput:
     substeps: int
 
 
-def run_model(config: SimulationConfig) -> ModelOutput:
-    """Integrate the test described by ``config`` (deterministic, no noise)."""
+def run_model(config: SimulationConfig, *, loading: Loading | None = None) -> ModelOutput:
+    """Integrate the test described by ``config`` (deterministic, no noise).
+
+    With ``loading`` (a measured incident wave, :mod:`.loading`), the cell is driven by that wave
+    on the loading's time grid instead of the configuration's trapezoid (striker velocity and rise
+    time are then unused; sample rate, duration and pre-trigger come from the loading's grid).
+    """
     app = config.apparatus
     ib, iob, eob, tube, sample = app.input_bar, app.internal_output_bar, app.external_output_bar, app.tube, app.sample
     plug = app.plug
     assert plug is not None  # the configuration always sets one
     nu, n_el = config.poisson_ratio, config.elements
-    dt_out = 1.0 / config.sample_rate
-    n_out = int(round(config.duration * config.sample_rate))
-    t_start = -config.pretrigger
+    if loading is None:
+        dt_out = 1.0 / config.sample_rate
+        n_out = int(round(config.duration * config.sample_rate))
+        t_start = -config.pretrigger
+    else:
+        dt_out = loading.sample_interval
+        n_out = len(loading.time)
+        t_start = float(loading.time[0])
 
     # sample column, tube, plug
     h = sample.length / n_el
@@ -120,11 +131,15 @@ def run_model(config: SimulationConfig) -> ModelOutput:
     fpar = law.pack(config.friction_params)
 
     # incident wave
-    eps_i = bars.incident_amplitude(config.striker_velocity, striker=app.striker, input_bar=ib)
     pulse = app.pulse_duration
     disp = config.dispersion
-    inc_cell, inc_gauge = bars.incident_waves(amplitude=eps_i, pulse_duration=pulse, rise_time=config.rise_time,
-                                              input_bar=ib, t_start=t_start, dt=dt, n=n, dispersive=disp)
+    if loading is None:
+        eps_i = bars.incident_amplitude(config.striker_velocity, striker=app.striker, input_bar=ib)
+        inc_cell, inc_gauge = bars.incident_waves(amplitude=eps_i, pulse_duration=pulse, rise_time=config.rise_time,
+                                                  input_bar=ib, t_start=t_start, dt=dt, n=n, dispersive=disp)
+    else:
+        inc_cell, inc_gauge = loading.on_grid(t_start + np.arange(n) * dt)
+        eps_i = float(np.max(loading.at_cell))
 
     # state and outputs
     u, v, slip, st = np.zeros(n_el + 1), np.zeros(n_el + 1), np.zeros(n_el + 1), np.zeros(cell.N_STATE)

@@ -1,0 +1,1 @@
+"""What the model gets wrong: whole-record comparison, misfit decision, mechanisms, model comparison."""

@@ -1,0 +1,131 @@
+"""Named model parameters: one type for the priors, the sampler's transforms, the outputs and the report.
+
+A forward model declares its parameters as :class:`Parameter` objects; everything downstream
+addresses a parameter by its name (never by a column position): a parameter vector is turned into
+a mapping with :meth:`ParameterSet.as_dict` and back with :meth:`ParameterSet.vector`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One physical parameter of a forward model.
+
+    Attributes
+    ----------
+    name : str
+        Identifier used in priors, outputs and reports (``f``, ``nu``, ``gap``, ...).
+    unit : str
+        SI unit, ``"-"`` for a dimensionless number.
+    low, high : float
+        Physical support (open interval); the sampler's transform maps it to the real line.
+    meaning : str
+        One line for the report.
+    """
+
+    name: str
+    unit: str
+    low: float
+    high: float
+    meaning: str
+
+    def __post_init__(self) -> None:
+        if not self.low < self.high:
+            raise ValueError(f"parameter {self.name}: empty support [{self.low}, {self.high}]")
+
+    def contains(self, value: np.ndarray | float) -> np.ndarray:
+        """True where ``value`` lies strictly inside the support."""
+        v = np.asarray(value, float)
+        return (v > self.low) & (v < self.high)
+
+    def to_unbounded(self, value: np.ndarray | float) -> np.ndarray:
+        """Map the support to the real line (log for a half-line, logit for an interval)."""
+        v = np.asarray(value, float)
+        if math.isinf(self.high) and math.isinf(self.low):
+            return v
+        if math.isinf(self.high):
+            return np.log(v - self.low)
+        if math.isinf(self.low):
+            return -np.log(self.high - v)
+        u = (v - self.low) / (self.high - self.low)
+        return np.log(u) - np.log1p(-u)
+
+    def from_unbounded(self, z: np.ndarray | float) -> np.ndarray:
+        """Inverse of :meth:`to_unbounded`."""
+        z = np.asarray(z, float)
+        if math.isinf(self.high) and math.isinf(self.low):
+            return z
+        if math.isinf(self.high):
+            return self.low + np.exp(z)
+        if math.isinf(self.low):
+            return self.high - np.exp(-z)
+        return self.low + (self.high - self.low) / (1.0 + np.exp(-z))
+
+    def log_jacobian(self, z: np.ndarray | float) -> np.ndarray:
+        """log |d value / d z| of :meth:`from_unbounded`."""
+        z = np.asarray(z, float)
+        if math.isinf(self.high) and math.isinf(self.low):
+            return np.zeros_like(z)
+        if math.isinf(self.high) or math.isinf(self.low):
+            return z if math.isinf(self.high) else -z
+        return math.log(self.high - self.low) - np.logaddexp(0.0, -z) - np.logaddexp(0.0, z)
+
+    def to_json(self) -> dict[str, object]:
+        return {"name": self.name, "unit": self.unit, "low": self.low, "high": self.high, "meaning": self.meaning}
+
+
+class ParameterSet:
+    """An ordered set of :class:`Parameter` with lookup by name."""
+
+    def __init__(self, parameters: Iterable[Parameter]) -> None:
+        self._params = tuple(parameters)
+        names = [p.name for p in self._params]
+        if len(set(names)) != len(names):
+            raise ValueError(f"parameter names must be unique, got {names}")
+        self._index = {p.name: i for i, p in enumerate(self._params)}
+
+    def __iter__(self) -> Iterator[Parameter]:
+        return iter(self._params)
+
+    def __len__(self) -> int:
+        return len(self._params)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._index
+
+    def __getitem__(self, name: str) -> Parameter:
+        return self._params[self._index[name]]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self._params)
+
+    def __add__(self, other: Iterable[Parameter]) -> ParameterSet:
+        return ParameterSet((*self._params, *other))
+
+    def as_dict(self, theta: np.ndarray) -> dict[str, np.ndarray]:
+        """Columns of ``theta`` (shape (..., len(self))) by name."""
+        theta = np.asarray(theta, float)
+        if theta.shape[-1] != len(self):
+            raise ValueError(f"parameter vectors have {theta.shape[-1]} entries, the model has {len(self)}: {self.names}")
+        return {p.name: theta[..., i] for i, p in enumerate(self._params)}
+
+    def vector(self, values: Mapping[str, np.ndarray | float]) -> np.ndarray:
+        """Stack named values into vectors (last axis in this set's order)."""
+        missing = [n for n in self.names if n not in values]
+        if missing:
+            raise KeyError(f"missing parameter(s) {', '.join(missing)}")
+        return np.stack([np.asarray(values[n], float) for n in self.names], axis=-1)
+
+
+#: The baseline's parameters (eq. 17 and the hoop gauge).
+F = Parameter("f", "-", 0.0, 2.0, "Coulomb friction coefficient of the sample on the tube wall")
+NU = Parameter("nu", "-", 0.0, 0.5, "Poisson ratio of the sample")
+HOOP_GAIN = Parameter("hoop_gain", "-", 0.0, 10.0, "calibration factor of the tube hoop gauge")

@@ -1,0 +1,116 @@
+"""The simulator of the whole test as a forward model with named parameters.
+
+:class:`SimulatorModel` wraps :func:`friction_uq.simulate.model.run_model`: given a record's
+apparatus and a loading (the measured incident wave, :func:`.loading.measured_loading`, or a
+trapezoid), it predicts what each gauge reads over the whole record for given parameter values:
+the input-bar gauge (incident as given plus the simulated reflected wave), both output-bar gauges
+and the tube hoop gauge, compression positive, on the record's time grid.
+
+Parameters are addressed by name. The baseline (the paper's model: Coulomb friction, elastic
+sample, rigid tube, frictionless plug, exact gauges, non-dispersive bars) has ``f``, ``nu`` and
+``hoop_gain``. An extension adds parameters through ``extra`` and ``apply``: a function that
+turns the parameter values into simulator settings (a friction law, a gap, a plug friction, a
+gauge gain ...) — see :mod:`friction_uq.discrepancy.mechanisms`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from ..record import Apparatus
+from ..simulate.config import DEFAULT_PLUG, ChannelSpec, SimulationConfig
+from ..simulate.loading import Loading
+from ..simulate.model import run_model
+from .parameters import F, HOOP_GAIN, NU, Parameter, ParameterSet
+
+#: Gauge channels the simulator predicts.
+GAUGES = ("input_bar", "internal_output_bar", "external_output_bar", "tube_hoop")
+
+#: Settings -> (config, gains) hook of an extension.
+Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, float]], None]
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """Simulated gauge strains (compression positive, channel -> array on the record grid) and the
+    cell's interface forces (N) and sliding velocity (m/s) behind them."""
+
+    strains: dict[str, np.ndarray]
+    force_internal: np.ndarray
+    force_external: np.ndarray
+    force_input: np.ndarray
+    sliding_velocity: np.ndarray
+
+
+class SimulatorModel:
+    """Forward model of the whole test (module docstring).
+
+    Parameters
+    ----------
+    apparatus : Apparatus
+        The record's apparatus (a plug of 10 mm of steel is assumed when the record has none).
+    loading : Loading
+        The incident wave driving the test.
+    hoop : bool
+        Predict the tube hoop gauge.
+    dispersion : bool
+        Pochhammer-Chree dispersion on every bar leg.
+    elements : int
+        Sample elements of the simulator.
+    extra : sequence of Parameter
+        Parameters of an extension, after f, nu, hoop_gain.
+    apply : callable
+        ``apply(values, settings, gains)`` edits the simulator settings (a dict of
+        :class:`~friction_uq.simulate.config.SimulationConfig` fields) and the per-channel gauge
+        gains for the values of the extension's parameters.
+    """
+
+    name = "simulator"
+
+    def __init__(self, apparatus: Apparatus, loading: Loading, *, hoop: bool = True, dispersion: bool = False,
+                 elements: int = 20, extra: tuple[Parameter, ...] = (), apply: Apply | None = None) -> None:
+        self.loading = loading
+        self.hoop = hoop
+        self.parameters = ParameterSet((F, NU, HOOP_GAIN, *extra))
+        self._apply = apply
+        app = apparatus if apparatus.plug is not None else replace(apparatus, plug=DEFAULT_PLUG)
+        channels = {name: ChannelSpec(enabled=(name != "tube_hoop" or hoop)) for name in GAUGES}
+        dt = loading.sample_interval
+        self._base = dict(
+            apparatus=app, channels=MappingProxyType(channels), dispersion=dispersion, elements=elements,
+            sample_rate=1.0 / dt, duration=len(loading.time) * dt, pretrigger=-float(loading.time[0]),
+        )
+
+    def config(self, values: Mapping[str, float]) -> tuple[SimulationConfig, dict[str, float]]:
+        """Simulator configuration and gauge gains for one set of parameter values."""
+        settings: dict[str, Any] = dict(self._base)
+        settings["poisson_ratio"] = float(values["nu"])
+        settings["friction_law"] = "coulomb"
+        settings["friction_params"] = MappingProxyType({"f": float(values["f"])})
+        gains = {name: 1.0 for name in GAUGES}
+        gains["tube_hoop"] = float(values.get("hoop_gain", 1.0))
+        if self._apply is not None:
+            self._apply(values, settings, gains)
+        return SimulationConfig(**settings), gains
+
+    def predict(self, values: Mapping[str, float]) -> Prediction:
+        """Gauge strains over the whole record for one set of parameter values."""
+        cfg, gains = self.config(values)
+        out = run_model(cfg, loading=self.loading)
+        strains = {k: gains[k] * v for k, v in out.strains.items()}
+        return Prediction(strains, out.force_internal, out.force_external, out.force_input, out.sliding_velocity)
+
+    def predict_draws(self, draws: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Gauge strains for each draw: channel -> array (ndraw, n)."""
+        n_draw = len(next(iter(draws.values())))
+        rows: dict[str, list[np.ndarray]] = {}
+        for k in range(n_draw):
+            pred = self.predict({name: float(v[k]) for name, v in draws.items()})
+            for ch, s in pred.strains.items():
+                rows.setdefault(ch, []).append(s)
+        return {ch: np.array(v) for ch, v in rows.items()}
