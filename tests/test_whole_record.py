@@ -1,0 +1,109 @@
+"""Whole-record comparison and the misfit decision."""
+
+from __future__ import annotations
+
+import math
+from types import MappingProxyType
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from friction_uq.analysis import prepare
+from friction_uq.discrepancy.check import check_whole_record
+from friction_uq.discrepancy.misfit import THRESHOLD, predictive_quadratic, tolerated
+from friction_uq.discrepancy.whole_record import longest_sign_run, whiten
+from friction_uq.likelihood import ar1_noise
+from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.record import read_record
+from friction_uq.simulate import SimulationConfig, simulate_to_file
+from friction_uq.simulate.config import ChannelSpec
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.floats(0.0, 0.9), st.floats(1e-7, 1e-4), st.integers(0, 2**32 - 1))
+def test_whitened_ar1_noise_is_unit_white_noise(rho, sd, seed):
+    e = ar1_noise((4000,), sd=sd, rho=rho, rng=np.random.default_rng(seed))
+    w = whiten(e, sd=sd, rho=rho)
+    # mean of w^2 ~ 1 +- sqrt(2/n) = 0.022; lag-1 correlation ~ 0 +- 1/sqrt(n) = 0.016
+    assert abs(np.mean(w * w) - 1.0) < 5 * math.sqrt(2 / 4000)
+    assert abs(np.corrcoef(w[1:], w[:-1])[0, 1]) < 5 / math.sqrt(4000)
+
+
+def test_longest_sign_run():
+    assert longest_sign_run(np.array([1, 2, -1, -2, -3, 4])) == 3
+    assert longest_sign_run(np.array([-1.0])) == 1
+    assert longest_sign_run(np.array([1, 0, 1, 1])) == 2
+    assert longest_sign_run(np.array([])) == 0
+
+
+def test_predictive_quadratic_matches_the_dense_covariance():
+    rng = np.random.default_rng(3)
+    n, k, sd, rho = 60, 7, 2.0, 0.6
+    e = rng.normal(size=n)
+    draws = rng.normal(size=(k, n)) * 0.8 + np.linspace(0, 1, n)
+    i = np.arange(n)
+    S = sd**2 * rho ** np.abs(i[:, None] - i[None, :])
+    U = (draws - draws.mean(axis=0)).T / math.sqrt(k - 1)
+    dense = float(e @ np.linalg.solve(S + U @ U.T, e))
+    assert predictive_quadratic(e, draws, sd=sd, rho=rho) == pytest.approx(dense, rel=1e-9)
+
+
+def test_tolerance_forgives_only_what_lies_inside_it():
+    r = np.array([0.5, -0.5, 2.0, -3.0])
+    y = np.array([100.0, 100.0, 100.0, 100.0])
+    np.testing.assert_allclose(tolerated(r, y, 0.01), [0.0, 0.0, 1.0, -2.0])
+
+
+def _config(**kw) -> SimulationConfig:
+    ch = {
+        "input_bar": ChannelSpec(white=3e-6, ar1=2e-6, ar1_coef=0.5, offset=1e-5),
+        "internal_output_bar": ChannelSpec(white=2e-6, ar1=2e-6, ar1_coef=0.4, offset=-5e-6),
+        "external_output_bar": ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, offset=1e-6),
+        "tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3),
+    }
+    return SimulationConfig(channels=MappingProxyType(ch), **kw)
+
+
+def _check(path):
+    rec = read_record(path)
+    prep = prepare(rec)
+    priors = load_priors(default_prior_path("I1"))
+    log_prior = lambda v: float(priors.logpdf(np.array([[v["f"], v["nu"], 1.0]]))[0])  # noqa: E731
+    from friction_uq.analysis import identify
+
+    lab = identify(prep, nu=0.4)
+    return check_whole_record(prep, log_prior, {"f": lab.f, "nu": 0.4}, hoop=True, seed=1)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_clean_record_has_no_misfit(tmp_path, seed):
+    path = tmp_path / "clean.h5"
+    simulate_to_file(_config(striker_velocity=8.0 + seed, poisson_ratio=0.41,
+                             friction_params=MappingProxyType({"f": 0.06})), path, seed=seed)
+    chk = _check(path)
+    assert not chk.decision.detected, chk.decision.sentence()
+    assert "reproduces all 4 gauges" in chk.decision.sentence()
+    assert chk.fit.mode["nu"] == pytest.approx(0.41, abs=0.01)
+
+
+def test_plug_friction_is_a_misfit(tmp_path):
+    path = tmp_path / "plug.h5"
+    simulate_to_file(_config(plug_friction_force=400.0, plug_friction_coefficient=0.02), path, seed=4)
+    chk = _check(path)
+    assert chk.decision.detected
+    assert chk.decision.statistic > THRESHOLD
+    assert "above" in chk.decision.sentence() or "below" in chk.decision.sentence()
+
+
+def test_external_gauge_gain_is_a_misfit_on_the_external_channel(tmp_path):
+    cfg = _config()
+    ch = dict(cfg.channels)
+    ch["external_output_bar"] = ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, gain=1.15)
+    path = tmp_path / "gain.h5"
+    simulate_to_file(SimulationConfig(channels=MappingProxyType(ch)), path, seed=5)
+    chk = _check(path)
+    assert chk.decision.detected
+    assert chk.decision.worst.channel == "external_output_bar"
+    assert chk.decision.worst.relative_level > 0.05
