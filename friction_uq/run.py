@@ -24,6 +24,7 @@ from scipy import stats
 from . import __version__
 from ._atomic import atomic_path
 from .analysis import Identification, Prepared, identify, prepare
+from .discrepancy.check import WholeRecordCheck, check_whole_record
 from .diagnostics import (
     Convergence,
     VariableSummary,
@@ -52,6 +53,7 @@ class RunResult:
     lab: Identification
     outputs: dict[str, Path]
     seconds: float
+    whole_record: WholeRecordCheck | None = None
 
 
 def safe_stem(campaign: str, test_id: str) -> str:
@@ -135,6 +137,7 @@ def run_file(
     hoop: bool = True,
     pdf: bool = True,
     progress: bool = True,
+    whole_record: bool = True,
 ) -> RunResult:
     """The main job (see the module docstring); prints a summary table at the end."""
     t_start = time.perf_counter()
@@ -173,6 +176,11 @@ def run_file(
     # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
     lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
     V = sliding_velocity_summary(prep)
+    wrc = None
+    if whole_record:
+        say("friction-uq: the whole test simulated with the posterior, against every gauge")
+        wrc = whole_record_check(prep, priors, summary, hoop=use_hoop, seed=seed)
+        add_whole_record(dt, wrc)
 
     dt.attrs.update({
         "friction_uq_version": __version__, "record": str(record.path), "record_sha256": record.sha256,
@@ -188,7 +196,8 @@ def run_file(
     if pdf:
         from .report.pdf import ReportInputs, write_report
 
-        inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__)
+        inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
+                              whole_record=wrc)
         outputs["pdf"] = write_report(inputs, out / f"{stem}.pdf")
 
     seconds = time.perf_counter() - t_start
@@ -221,17 +230,51 @@ def run_file(
         "ess_per_second": conv.ess_per_second,
         "friction_uq_version": __version__,
     }
+    if wrc is not None:
+        doc["misfit"] = wrc.to_json()
     js = out / f"{stem}.json"
     _atomic_write_bytes(js, lambda tmp: Path(tmp).write_text(json.dumps(doc, indent=2) + "\n"))
     outputs["json"] = js
     if backend.exists():
         backend.unlink()
-    print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds))
-    return RunResult(prep, samples, summary, conv, lab, outputs, seconds)
+    print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, wrc,
+                        page=(9 if use_hoop else 8) if pdf else None))
+    return RunResult(prep, samples, summary, conv, lab, outputs, seconds, wrc)
+
+
+def whole_record_check(prep: Prepared, priors: Priors, summary: dict[str, VariableSummary], *, hoop: bool,
+                       seed: int) -> WholeRecordCheck:
+    """The whole-record check (:mod:`friction_uq.discrepancy.check`) with this run's f and nu priors,
+    started from the stationary posterior's medians."""
+
+    def log_prior(v) -> float:
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    return check_whole_record(prep, log_prior, {"f": summary["f"].q50, "nu": summary["nu"].q50},
+                              hoop=hoop or prep.record.has_hoop, seed=seed)
+
+
+def add_whole_record(dt, wrc: WholeRecordCheck) -> None:
+    """Simulated gauges of the posterior draws over the whole record (``posterior_predictive``) and
+    the measured ones (``whole_record_observed``), on the record's time base."""
+    import xarray as xr
+
+    comp = wrc.comparison
+    pp = {ch: (("chain", "draw", "time_record"), v[None]) for ch, v in comp.predicted.items()}
+    obs = {ch: (("time_record",), v) for ch, v in comp.measured.items()}
+    coords = {"time_record": comp.time}
+    dt["posterior_predictive"] = xr.DataTree(xr.Dataset(pp, coords=coords | {"chain": [0], "draw": np.arange(
+        len(next(iter(comp.predicted.values()))))}, attrs={
+        "description": "gauge strains (compression positive) simulated for draws of the whole-record fit of the "
+                       "simulator driven by the measured incident wave", "misfit_statistic": wrc.decision.statistic,
+        "misfit_threshold": wrc.decision.threshold, "misfit_detected": int(wrc.decision.detected)}))
+    dt["whole_record_observed"] = xr.DataTree(xr.Dataset(obs, coords=coords, attrs={
+        "description": "measured gauge strains, offset removed, compression positive"}))
 
 
 def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,
-                  outputs: dict[str, Path], seconds: float) -> str:
+                  outputs: dict[str, Path], seconds: float, wrc: WholeRecordCheck | None = None, *,
+                  page: int | None = None) -> str:
     """The table the terminal ends with."""
     units = {"p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
     lines = [f"{campaign} {test_id}: posterior (90 % credible intervals)",
@@ -246,6 +289,8 @@ def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary],
     lines.append(f"convergence {'OK' if conv.ok else 'NOT REACHED'}: R-hat max {conv.r_hat_max:.4f}, "
                  f"ESS min {min(conv.ess_bulk_min, conv.ess_tail_min):.0f}, {conv.ess_per_second:.0f} ESS/s; "
                  f"{seconds:.1f} s in all")
+    if wrc is not None:
+        lines.append(wrc.decision.sentence(page=page))
     for k, pth in outputs.items():
         lines.append(f"wrote {pth}")
     return "\n".join(lines)

@@ -54,6 +54,7 @@ class CellTest:
     level_z: float
     shape_z: float
     relative_level: float
+    chi2_dof: float = float("nan")
 
     @property
     def statistic(self) -> float:
@@ -61,7 +62,7 @@ class CellTest:
 
     def to_json(self) -> dict[str, float | str]:
         return {"channel": self.channel, "phase": self.phase, "level_z": self.level_z, "shape_z": self.shape_z,
-                "statistic": self.statistic, "relative_level": self.relative_level}
+                "statistic": self.statistic, "relative_level": self.relative_level, "chi2_dof": self.chi2_dof}
 
 
 @dataclass(frozen=True)
@@ -93,12 +94,16 @@ class MisfitDecision:
         w = self.worst
         assert w is not None
         where = f": see page {page}" if page is not None else ""
-        direction = "above" if w.relative_level > 0 else "below"
         more = len(self.flagged()) - 1
         also = f"; {more} more channel/phase pairs over the threshold" if more > 0 else ""
-        return (f"The {CHANNEL_LABELS[w.channel]} gauge is {abs(w.relative_level) * 100:.1f} % {direction} the model "
-                f"over the {w.phase} phase (level z {w.level_z:+.1f}, shape z {w.shape_z:.1f}; threshold "
-                f"{self.threshold:g}){also}{where}.")
+        if abs(w.level_z) >= w.shape_z:
+            direction = "above" if w.relative_level > 0 else "below"
+            what = (f"is {abs(w.relative_level) * 100:.1f} % {direction} the model over the {w.phase} phase "
+                    f"(level z {w.level_z:+.1f}")
+        else:
+            what = (f"departs from the model's shape over the {w.phase} phase (chi2/dof {w.chi2_dof:.1f}, "
+                    f"shape z {w.shape_z:.0f}")
+        return f"The {CHANNEL_LABELS[w.channel]} gauge {what}; threshold {self.threshold:g}){also}{where}."
 
     def to_json(self) -> dict[str, object]:
         return {"detected": self.detected, "statistic": self.statistic, "threshold": self.threshold,
@@ -143,6 +148,7 @@ def decide(wr: WholeRecord, *, threshold: float = THRESHOLD, tolerance: dict[str
             shape = (predictive_quadratic(e, draws, sd=nz.sd, rho=nz.rho) - n) / math.sqrt(2.0 * n)
             m_meas = float(np.mean(wr.measured[ch][a:b]))
             rel = float(np.mean(resid[a:b])) / m_meas if abs(m_meas) > 0 else 0.0
-            cells.append(CellTest(ch, phase, float(np.mean(e)) / se, shape, rel))
+            w_plain = whiten(resid[a:b], sd=nz.sd, rho=nz.rho)
+            cells.append(CellTest(ch, phase, float(np.mean(e)) / se, shape, rel, float(np.mean(w_plain**2))))
     stat = max((c.statistic for c in cells), default=0.0)
     return MisfitDecision(statistic=stat, threshold=threshold, cells=tuple(cells))

@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 
 from .._atomic import atomic_path
 from ..analysis import Identification, Prepared
+from ..discrepancy.check import WholeRecordCheck
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
@@ -38,6 +39,7 @@ class ReportInputs:
     lab: Identification
     V: VariableSummary
     version: str
+    whole_record: WholeRecordCheck | None = None
 
 
 def _fmt(v: float) -> str:
@@ -69,6 +71,8 @@ def page_summary(r: ReportInputs) -> Figure:
         f"Posterior predictive check: the observed ratio lies in the 90 % band {100 * r.ppc.coverage:.0f} % of "
         "the window" + (" - the constant-ratio model misses something here (page 7)." if r.ppc.coverage < 0.7 else "."),
     ]
+    if r.whole_record is not None:
+        lines.append("Whole record: " + r.whole_record.decision.sentence(page=whole_record_page(r)))
     y = 0.97
     for line in lines:
         ax.text(0.0, y, line, fontsize=11, va="top", wrap=True, transform=ax.transAxes)
@@ -88,9 +92,15 @@ def page_summary(r: ReportInputs) -> Figure:
     ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
     ax.text(0.77, 0.47, "Pages\n 1 raw gauges\n 2 waves, forces, equilibrium\n 3 window and noise\n"
             " 4 posterior vs prior\n 5 nu -> f\n 6 convergence\n 7 predictive check"
-            + ("\n 8 hoop gauge vs model" if r.samples.hoop else ""),
+            + ("\n 8 hoop gauge vs model" if r.samples.hoop else "")
+            + (f"\n{whole_record_page(r):2d} whole test vs gauges" if r.whole_record is not None else ""),
             fontsize=10, va="top", transform=ax.transAxes, family="monospace")
     return fig
+
+
+def whole_record_page(r: ReportInputs) -> int:
+    """Number of the first whole-record page (after page 7, or 8 with the hoop page)."""
+    return 9 if r.samples.hoop else 8
 
 
 def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
@@ -118,4 +128,10 @@ def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
             fig = build()
             pdf.savefig(fig)
             plt.close(fig)
+        if r.whole_record is not None:
+            from .whole_record_pages import pages_whole_record
+
+            for fig in pages_whole_record(r.whole_record, test=f"{p.record.campaign} {p.record.test_id}"):
+                pdf.savefig(fig)
+                plt.close(fig)
     return out
