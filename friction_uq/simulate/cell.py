@@ -55,8 +55,8 @@ from ._jit import njit
 from .friction import shear_strength
 
 # indices of the parameter vector ``par``
-DT, H, AREA, WALL, E, NU, DEN, EGR, SIGSTAR, ZI, CI, ZIO, CIO, ZEO, CEO, MT, PF_FORCE, PF_COEF, MPLUG, ETA = range(20)
-N_PAR = 20
+DT, H, AREA, WALL, E, NU, DEN, EGR, SIGSTAR, ZI, CI, ZIO, CIO, ZEO, CEO, MT, PF_FORCE, PF_COEF, MPLUG, ETA, END_F = range(21)
+N_PAR = 21
 # indices of the state vector ``st`` (carried from one block of steps to the next)
 UT, VT, SEP_I, SEP_IO, SEP_EO, IMPULSE, FI_PREV = range(7)
 N_STATE = 7
@@ -86,6 +86,22 @@ def wall_pressure(sigma: float, nu: float, den: float, egr: float) -> float:
     """Wall pressure (Pa): p = max(0, (nu sigma - E g / R) / D). Eq. 8 when g = 0 and D = 1 - nu."""
     p = (nu * sigma - egr) / den
     return p if p > 0.0 else 0.0
+
+
+@njit
+def end_face_relief(p: float, sigma: float, end_f: float, z: float, length: float, radius: float) -> float:
+    """Wall pressure (Pa) lowered near the sample's end faces by their friction (physics.md section 5).
+
+    Shear on an end face (coefficient ``end_f``, at most end_f sigma) holds back the sample's radial
+    expansion there; the relief decays into the sample over about one radius:
+    p = max(0, p - end_f sigma [exp(-z / R) + exp(-(L - z) / R)]), z from the input face. The
+    cell's equilibrium (eq. 5) is unchanged; F_eo / F_io falls below eq. 13 for the same f.
+
+    >>> round(end_face_relief(1e8, 1.5e8, 0.05, 0.0, 0.01, 0.005) / 1e6, 3)
+    91.485
+    """
+    q = p - end_f * sigma * (math.exp(-z / radius) + math.exp(-(length - z) / radius))
+    return q if q > 0.0 else 0.0
 
 
 @njit
@@ -120,6 +136,8 @@ def run_block(k0: int, k1: int, stride: int, par: np.ndarray, law: int, fpar: np
     young, nu, den, egr, sigstar = par[E], par[NU], par[DEN], par[EGR], par[SIGSTAR]
     zi, ci, zio, cio, zeo, ceo = par[ZI], par[CI], par[ZIO], par[CIO], par[ZEO], par[CEO]
     mt, mplug, eta = par[MT], par[MPLUG], par[ETA]
+    end_f = par[END_F]
+    radius = math.sqrt(area / math.pi)
     sig = np.empty(n_el)
     pres = np.empty(n_el)
     force = np.empty(n_el + 1)
@@ -135,6 +153,8 @@ def run_block(k0: int, k1: int, stride: int, par: np.ndarray, law: int, fpar: np
             s = element_stress((u[e] - u[e + 1]) / h, young, nu, den, egr, sigstar)
             sig[e] = s
             pres[e] = wall_pressure(s, nu, den, egr)
+            if end_f > 0.0 and pres[e] > 0.0:
+                pres[e] = end_face_relief(pres[e], s, end_f, (e + 0.5) * h, n_el * h, radius)
             if s > 0.0:  # viscous stress while the element is in contact, never tensile in total
                 s = max(0.0, s + eta * (v[e] - v[e + 1]) / h)
             force[e] -= area * s
