@@ -36,6 +36,7 @@ file and the key.
     hoop_axial_term = true      # add nu_t x (axial tube force) / (E_t A_t) to the hoop strain (physics.md section 6)
     plug_friction_force = 0.0   # N, constant part of the plug/tube friction strength
     plug_friction_coefficient = 0.0   # plug/tube friction strength per newton of F_i, [0, 1]
+    end_friction = 0.0          # friction coefficient of the sample's end faces (PTFE sheets), [0, 1]
 
     [bars]
     dispersion = false          # Pochhammer-Chree dispersion on every bar leg
@@ -140,6 +141,7 @@ class SimulationConfig:
     hoop_axial_term: bool = True
     plug_friction_force: float = 0.0
     plug_friction_coefficient: float = 0.0
+    end_friction: float = 0.0
     dispersion: bool = False
     sample_rate: float = 5e6
     duration: float = 1.3e-3
@@ -207,7 +209,7 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
 
     s = Section(source, "cell", data.get("cell", {}), (
         "gap", "tube_compliance", "tube_density", "hoop_beta", "hoop_axial_term",
-        "plug_friction_force", "plug_friction_coefficient"))
+        "plug_friction_force", "plug_friction_coefficient", "end_friction"))
     kw["gap"] = s.number("gap", d.gap, low=0.0, high=1e-4)
     kw["tube_compliance"] = s.boolean("tube_compliance", d.tube_compliance)
     kw["tube_density"] = s.number("tube_density", d.tube_density, low=0.0, high=3e4, low_open=True)
@@ -216,6 +218,7 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
     kw["plug_friction_force"] = s.number("plug_friction_force", d.plug_friction_force, low=0.0, high=1e6)
     kw["plug_friction_coefficient"] = s.number("plug_friction_coefficient", d.plug_friction_coefficient,
                                                low=0.0, high=1.0)
+    kw["end_friction"] = s.number("end_friction", d.end_friction, low=0.0, high=1.0)
 
     s = Section(source, "bars", data.get("bars", {}), ("dispersion",))
     kw["dispersion"] = s.boolean("dispersion", d.dispersion)

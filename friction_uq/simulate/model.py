@@ -127,7 +127,7 @@ def run_model(config: SimulationConfig, *, loading: Loading | None = None) -> Mo
     par[[cell.PF_FORCE, cell.PF_COEF, cell.MPLUG]] = (
         config.plug_friction_force, config.plug_friction_coefficient, m_plug)
     par[cell.ETA] = config.damping * sample.density * c_max * h
-    par[cell.END_F] = getattr(config, "end_friction", 0.0)
+    par[cell.END_F] = config.end_friction
     law = LAWS[config.friction_law]
     fpar = law.pack(config.friction_params)
 

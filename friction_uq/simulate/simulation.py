@@ -100,6 +100,8 @@ def truth_attributes(config: SimulationConfig, *, seed: int, model: ModelOutput)
         "plateau_end": model.plateau[1],
         "config_source": Path(config.source).name,
     }
+    if config.end_friction > 0.0:  # written only when present, so older records regenerate bit for bit
+        t["end_friction"] = config.end_friction
     for k, v in config.friction_params.items():
         t[f"friction_{k}"] = float(v)
     if config.friction_law == "coulomb":
