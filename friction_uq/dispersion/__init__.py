@@ -1,6 +1,6 @@
 """Frequency-domain wave transport along elastic bars (physics.md sections 2 and 7).
 
-Everything that moves a strain wave along a bar goes through this module: the transport of the
+Everything that moves a strain wave along a bar goes through this package: the transport of the
 gauge signals to the bar ends that touch the cell (section 2), the dispersion correction of those
 signals (section 7, Tyas and Pope 2005) and the dispersive bar legs of the simulator.
 
@@ -39,10 +39,14 @@ bin is corrected (and bins beyond the first-mode cut-off are removed). M1 tends 
 frequency; the error of leaving it out grows towards the cut-off.
 """
 
-
-from .hollow import CUTOFF_D_OVER_LAMBDA, RING_FREQUENCY_FRACTION
+from .hollow import RING_FREQUENCY_FRACTION
 from .phase import first_mode_cutoff, phase_velocity
-from .pochhammer import CURVE_MAX_D_OVER_LAMBDA, phase_velocity_curve, pochhammer_phase_velocity_ratio
+from .pochhammer import (
+    CURVE_MAX_D_OVER_LAMBDA,
+    CUTOFF_D_OVER_LAMBDA,
+    phase_velocity_curve,
+    pochhammer_phase_velocity_ratio,
+)
 from .transport import CUTOFF_TAPER_FRACTION, delay, propagate
 
 __all__ = [

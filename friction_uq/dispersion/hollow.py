@@ -10,9 +10,7 @@ import math
 
 import numpy as np
 
-#: d/Lambda beyond which the first-mode correction is not trusted (physics.md section 7:
-#: f a / c0 = 0.2619 at d/Lambda = 0.6 for a solid bar with nu = 0.29).
-CUTOFF_D_OVER_LAMBDA = 0.6
+from .pochhammer import CUTOFF_D_OVER_LAMBDA
 
 #: Fraction of a hollow bar's ring frequency c0 / (2 pi r_m) above which its Love estimate is not
 #: trusted (see ``first_mode_cutoff``).
@@ -45,4 +43,3 @@ def hollow_cutoff(*, c0: float, outer_radius: float, inner_radius: float, nu: fl
     f_love = CUTOFF_D_OVER_LAMBDA * ratio_cut * c0 / (2.0 * math.sqrt(mean_square_radius))
     f_ring = c0 / (2.0 * math.pi * 0.5 * (inner_radius + outer_radius))
     return min(f_love, RING_FREQUENCY_FRACTION * f_ring)
-

@@ -10,8 +10,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._checks import check_geometry, check_nu, check_positive
-from .hollow import CUTOFF_D_OVER_LAMBDA, hollow_cutoff, love_hollow_ratio
-from .pochhammer import phase_velocity_curve
+from .hollow import hollow_cutoff, love_hollow_ratio
+from .pochhammer import CUTOFF_D_OVER_LAMBDA, phase_velocity_curve
 
 
 def _solid_ratio_at(fd_over_c0: np.ndarray, nu: float) -> np.ndarray:
@@ -140,4 +140,3 @@ def first_mode_cutoff(*, c0: float, diameter: float, nu: float, inner_diameter: 
         ratio_cut = float(np.interp(CUTOFF_D_OVER_LAMBDA, dl, ratio))
         return CUTOFF_D_OVER_LAMBDA * ratio_cut * c0_v / d
     return hollow_cutoff(c0=c0_v, outer_radius=d / 2.0, inner_radius=di / 2.0, nu=nu_v)
-

@@ -19,6 +19,10 @@ from ._checks import check_nu
 #: Upper end of the tabulated first-mode curve, d/Lambda (dimensionless).
 CURVE_MAX_D_OVER_LAMBDA = 2.5
 
+#: d/Lambda beyond which the first-mode correction is not trusted (physics.md section 7:
+#: f a / c0 = 0.2619 at d/Lambda = 0.6 for a solid bar with nu = 0.29).
+CUTOFF_D_OVER_LAMBDA = 0.6
+
 #: Largest d/Lambda for which the Pochhammer root finder is run (the first mode is close to its
 #: high-frequency limit, the Rayleigh wave velocity, well before that).
 _MAX_D_OVER_LAMBDA = 10.0
@@ -236,4 +240,3 @@ def phase_velocity_curve(nu: float, *, n: int = 1001) -> tuple[np.ndarray, np.nd
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 11:
         raise ValueError(f"n must be an integer >= 11, received {n!r}")
     return _cached_curve(round(nu_v, _NU_DECIMALS), int(n))
-

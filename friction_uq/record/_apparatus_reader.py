@@ -131,5 +131,3 @@ def read_apparatus(app: Any, r: Reader) -> Apparatus:
         sample=Sample(**sample),
         plug=plug,
     )
-
-

@@ -34,11 +34,6 @@ CLIP_RUN = 8
 MIN_SAMPLES = 64
 
 
-# ----------------------------------------------------------------------------------------------
-# Record
-# ----------------------------------------------------------------------------------------------
-
-
 @dataclass(frozen=True)
 class Channel:
     """One gauge channel, converted to strain, **positive in compression**.
@@ -93,4 +88,3 @@ class Record:
     def strain(self, name: str) -> np.ndarray:
         """Strain of channel ``name``, compression positive."""
         return self.channels[name].strain
-

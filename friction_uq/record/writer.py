@@ -121,5 +121,3 @@ def write_record(
                 for k, v in truth.items():
                     tg.attrs[k] = v
     return p
-
-
