@@ -90,9 +90,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.ndimage import uniform_filter1d
-from scipy.signal import lfilter
 
 from .errors import SignalError
+from .noise import ar1_noise
 from .physics import cell, tube
 from .signals import ar1_mean_sd
 from .window import StationaryData
@@ -180,13 +180,6 @@ def ar1_loglike(
     if np.any(np.asarray(offset) > 0.0):
         out = out + ar1_offset_correction(resid.sum(-1), resid[..., 0] + resid[..., -1], n=n, sd=sd, rho=rho, offset=offset)
     return out
-
-
-def ar1_noise(shape: tuple[int, ...], *, sd: float, rho: float, rng: np.random.Generator) -> np.ndarray:
-    """Stationary AR(1) Gaussian noise along the last axis of ``shape`` (marginal sd ``sd``)."""
-    e = rng.normal(0.0, sd * math.sqrt(1.0 - rho**2), size=shape)
-    e[..., 0] = rng.normal(0.0, sd, size=shape[:-1])
-    return lfilter([1.0], [1.0, -rho], e, axis=-1)
 
 
 def offset_sd(sd: float, rho: float, n_baseline: int) -> float:

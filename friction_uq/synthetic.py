@@ -23,7 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .physics import cell, design, tube
+from .noise import white_and_ar1_noise
+from .physics import bars, cell, design, tube
 from .record import Apparatus, paper_apparatus, write_record
 
 
@@ -55,28 +56,6 @@ class ClosedFormTest:
     hoop_beta: float = tube.BETA_EFF_PAPER_TUBE
 
 
-def trapezoid(t: np.ndarray, *, rise: float, duration: float) -> np.ndarray:
-    """Unit trapezoid starting at t = 0: linear rise over ``rise``, plateau, linear fall, total ``duration``."""
-    up = np.clip(t / rise, 0.0, 1.0)
-    down = np.clip((duration - t) / rise, 0.0, 1.0)
-    return np.minimum(up, down)
-
-
-def ar1_noise(n: int, *, sd: float, rho: float, white_fraction: float, rng: np.random.Generator) -> np.ndarray:
-    """White plus AR(1) Gaussian noise of total standard deviation ``sd``.
-
-    ``white_fraction`` of the variance is white, the rest AR(1) with coefficient ``rho``.
-    """
-    from scipy.signal import lfilter
-
-    sd_w = sd * math.sqrt(white_fraction)
-    sd_c = sd * math.sqrt(1.0 - white_fraction)
-    e = rng.normal(0.0, sd_c * math.sqrt(1.0 - rho**2), n)
-    e[0] = rng.normal(0.0, sd_c)
-    coloured = lfilter([1.0], [1.0, -rho], e, zi=[0.0])[0] if n else e
-    return coloured + rng.normal(0.0, sd_w, n)
-
-
 def closed_form_strains(test: ClosedFormTest, apparatus: Apparatus) -> tuple[np.ndarray, dict[str, np.ndarray], dict]:
     """Noise-free gauge strains (compression positive) and the stationary truth.
 
@@ -101,7 +80,7 @@ def closed_form_strains(test: ClosedFormTest, apparatus: Apparatus) -> tuple[np.
     t_cell = ib.gauge_delay
 
     def at_cell(tt: np.ndarray) -> np.ndarray:
-        return trapezoid(tt - t_cell, rise=test.rise_time, duration=T)
+        return bars.trapezoid_pulse(tt - t_cell, rise_time=test.rise_time, end=T)
 
     eps_inc = lambda tt: eps_i0 * at_cell(tt)  # noqa: E731 - incident wave at the interface
     F_io = lambda tt: F_io0 * at_cell(tt)  # noqa: E731
@@ -169,7 +148,7 @@ def write_closed_form_record(
     noisy: dict[str, np.ndarray] = {}
     for name, eps in strains.items():
         sd = test.noise_sd.get(name, 0.0)
-        noise = ar1_noise(len(t), sd=sd, rho=test.noise_rho, white_fraction=test.white_fraction, rng=rng) \
+        noise = white_and_ar1_noise(len(t), sd=sd, rho=test.noise_rho, white_fraction=test.white_fraction, rng=rng) \
             if sd > 0 else 0.0
         noisy[name] = test.gains.get(name, 1.0) * eps + noise + test.offsets.get(name, 0.0)
         truth[f"noise_sd_{name}"] = sd
@@ -194,4 +173,4 @@ def write_closed_form_record(
     )
 
 
-__all__ = ["ClosedFormTest", "closed_form_strains", "write_closed_form_record", "trapezoid", "ar1_noise", "replace"]
+__all__ = ["ClosedFormTest", "closed_form_strains", "write_closed_form_record", "replace"]

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from friction_uq.errors import SignalError
 from friction_uq.signals import noise_estimate, prepulse_noise, pulse_arrival, transport
-from friction_uq.synthetic import ar1_noise
+from friction_uq.noise import white_and_ar1_noise
 
 FS = 5e6
 DT = 1.0 / FS
@@ -35,7 +35,7 @@ def linear_front(n: int, foot: float, *, rise: int = 50, amp: float = 1e-3) -> n
 
 def test_noise_estimate_recovers_ar1_parameters():
     rng = np.random.default_rng(7)
-    x = 2e-5 + ar1_noise(200_000, sd=3e-6, rho=0.6, white_fraction=0.0, rng=rng)
+    x = 2e-5 + white_and_ar1_noise(200_000, sd=3e-6, rho=0.6, white_fraction=0.0, rng=rng)
     e = noise_estimate(x, stop=len(x))
     assert e.offset == pytest.approx(2e-5, abs=3 * 3e-6 / np.sqrt(200_000 * 0.25))
     assert e.sd == pytest.approx(3e-6, rel=0.02)
@@ -78,7 +78,7 @@ def test_transport_back_and_forth_is_identity():
 def test_prepulse_noise_on_a_noisy_record():
     rng = np.random.default_rng(3)
     n = 6000
-    x = ramp_pulse(n, 800.0) + 1e-5 + ar1_noise(n, sd=3e-6, rho=0.5, white_fraction=0.3, rng=rng)
+    x = ramp_pulse(n, 800.0) + 1e-5 + white_and_ar1_noise(n, sd=3e-6, rho=0.5, white_fraction=0.3, rng=rng)
     est, arr = prepulse_noise(x, polarity=+1)
     assert est.stop <= 800
     assert est.offset == pytest.approx(1e-5, abs=1.5e-6)

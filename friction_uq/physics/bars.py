@@ -59,3 +59,20 @@ def incident_strain(striker_velocity: float, *, wave_speed: float) -> float:
     0.001097695
     """
     return striker_velocity / (2.0 * wave_speed)
+
+
+def trapezoid_pulse(t: ArrayLike, *, rise_time: float, end: float, amplitude: float = 1.0) -> np.ndarray:
+    """Trapezoidal pulse, the closed-form incident wave of eq. 14 with finite rise and fall.
+
+    Foot at t = 0, linear rise over ``rise_time`` to ``amplitude``, plateau, linear fall over
+    ``rise_time`` that ends at ``end`` (s). A striker of length L_s and wave speed c_s gives a
+    pulse 2 L_s / c_s long between its half-amplitude points: ``end`` = 2 L_s / c_s + ``rise_time``
+    (the simulator); the closed-form records take ``end`` = 2 L_s / c_s.
+
+    >>> trapezoid_pulse(np.array([-1.0, 0.5, 2.0, 4.5, 6.0]), rise_time=1.0, end=5.0, amplitude=2.0).tolist()
+    [0.0, 1.0, 2.0, 1.0, 0.0]
+    """
+    t = np.asarray(t, float)
+    up = np.clip(t / rise_time, 0.0, 1.0)
+    down = np.clip((end - t) / rise_time, 0.0, 1.0)
+    return amplitude * np.minimum(up, down)

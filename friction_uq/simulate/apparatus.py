@@ -9,14 +9,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import fields, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import ConfigError
 from ..record import Apparatus, Bar, Plug, Sample, Tube
 from ._checks import Section
-
-if TYPE_CHECKING:
-    from .config import SimulationConfig
 
 _BAR_KEYS = ("young_modulus", "wave_speed", "diameter", "length", "gauge_distance", "poisson_ratio")
 _PARTS: dict[str, tuple[str, ...]] = {
@@ -55,9 +52,15 @@ def parse_apparatus(source: str, table: Any, app: Apparatus) -> Apparatus:
     return app
 
 
-def check_consistency(cfg: SimulationConfig) -> None:
-    """Cross-checks between keys (geometry, record length); ConfigError naming the key at fault."""
-    app, src = cfg.apparatus, cfg.source
+def check_consistency(
+    app: Apparatus, *, source: str, rise_time: float, pretrigger: float, duration: float
+) -> None:
+    """Cross-checks between keys (geometry, record length); ConfigError naming the key at fault.
+
+    ``rise_time``, ``pretrigger`` and ``duration`` (s) are the configuration's loading and
+    measurement keys; ``source`` names the configuration in the messages.
+    """
+    src = source
 
     def fail(key: str, problem: str) -> ConfigError:
         return ConfigError(f"{src}: key '{key}' {problem}.")
@@ -84,10 +87,10 @@ def check_consistency(cfg: SimulationConfig) -> None:
     if 2.0 * ib.length / ib.wave_speed <= pulse:
         raise fail("apparatus.striker.length", "makes the incident pulse longer than the input bar's "
                    "round trip; the model's free impact end needs a striker shorter than the input bar")
-    if cfg.rise_time >= pulse / 2:
-        raise fail("loading.rise_time", f"is {cfg.rise_time!r} s, not below half the pulse length {pulse:.3g} s")
-    needed = cfg.pretrigger + 2.0 * ib.gauge_delay + pulse
-    if cfg.duration < needed:
-        raise fail("measurement.duration", f"is {cfg.duration * 1e6:.0f} us, too short: the reflected wave leaves "
+    if rise_time >= pulse / 2:
+        raise fail("loading.rise_time", f"is {rise_time!r} s, not below half the pulse length {pulse:.3g} s")
+    needed = pretrigger + 2.0 * ib.gauge_delay + pulse
+    if duration < needed:
+        raise fail("measurement.duration", f"is {duration * 1e6:.0f} us, too short: the reflected wave leaves "
                    f"the input gauge at pretrigger + 2 x gauge_distance / c + 2 x striker length / c_striker "
                    f"= {needed * 1e6:.0f} us")

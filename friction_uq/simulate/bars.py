@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..dispersion import propagate
+from ..physics.bars import trapezoid_pulse
 from ..record import Bar
 
 
@@ -41,17 +42,6 @@ def incident_amplitude(striker_velocity: float, *, striker: Bar, input_bar: Bar)
     """
     zs, zi = striker.impedance, input_bar.impedance
     return striker_velocity * zs / ((zs + zi) * input_bar.wave_speed)
-
-
-def trapezoid(tau: np.ndarray, *, amplitude: float, duration: float, rise_time: float) -> np.ndarray:
-    """Trapezoidal pulse: foot at tau = 0, linear rise over ``rise_time``, plateau, linear fall.
-
-    ``duration`` (s) is the length between the half-amplitude points (2 L_s / c_s for a striker):
-    the fall starts at ``duration`` and ends at ``duration + rise_time``.
-    """
-    up = np.clip(tau / rise_time, 0.0, 1.0)
-    down = np.clip((duration + rise_time - tau) / rise_time, 0.0, 1.0)
-    return amplitude * np.minimum(up, down)
 
 
 def transport(signal: np.ndarray, *, dt: float, distance: float, bar: Bar, dispersive: bool) -> np.ndarray:
@@ -81,7 +71,7 @@ def incident_waves(*, amplitude: float, pulse_duration: float, rise_time: float,
     t_impact = -(length - d) / input_bar.wave_speed
     lead = int(np.ceil((t_start - t_impact) / dt)) + 8  # the source grid starts 8 samples before impact
     tau = (t_start - t_impact) + (np.arange(n + lead) - lead) * dt  # time since impact
-    source = trapezoid(tau, amplitude=amplitude, duration=pulse_duration, rise_time=rise_time)
+    source = trapezoid_pulse(tau, rise_time=rise_time, end=pulse_duration + rise_time, amplitude=amplitude)
     at_cell = transport(source, dt=dt, distance=length, bar=input_bar, dispersive=dispersive)[lead:]
     at_gauge = transport(source, dt=dt, distance=length - d, bar=input_bar, dispersive=dispersive)[lead:]
     return at_cell, at_gauge

@@ -237,7 +237,8 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
 
     kw["apparatus"] = parse_apparatus(source, data.get("apparatus", {}), default_apparatus())
     cfg = SimulationConfig(**kw)
-    check_consistency(cfg)
+    check_consistency(cfg.apparatus, source=cfg.source, rise_time=cfg.rise_time,
+                      pretrigger=cfg.pretrigger, duration=cfg.duration)
     return cfg
 
 

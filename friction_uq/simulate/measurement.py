@@ -18,18 +18,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from scipy.signal import lfilter
 
+from ..noise import ar1_noise
 from ..record import CHANNELS
 from .config import ChannelSpec
-
-
-def ar1_noise(n: int, *, sd: float, coef: float, rng: np.random.Generator) -> np.ndarray:
-    """Stationary AR(1) sequence of ``n`` samples, marginal standard deviation ``sd``, coefficient ``coef``."""
-    eta = rng.standard_normal(n)
-    drive = eta * (sd * np.sqrt(1.0 - coef * coef))
-    drive[0] = eta[0] * sd
-    return lfilter([1.0], [1.0, -coef], drive)
 
 
 def measure(clean: Mapping[str, np.ndarray], channels: Mapping[str, ChannelSpec],
@@ -42,7 +34,7 @@ def measure(clean: Mapping[str, np.ndarray], channels: Mapping[str, ChannelSpec]
         spec = channels[name]
         x = np.asarray(clean[name], dtype=np.float64)
         white = rng.standard_normal(x.size) * spec.white
-        coloured = ar1_noise(x.size, sd=spec.ar1, coef=spec.ar1_coef, rng=rng)
+        coloured = ar1_noise(x.size, sd=spec.ar1, rho=spec.ar1_coef, rng=rng, start="first_draw")
         y = spec.gain * x + spec.offset + white + coloured
         if spec.quantum > 0.0:
             y = np.round(y / spec.quantum) * spec.quantum

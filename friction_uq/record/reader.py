@@ -1,0 +1,222 @@
+"""Read and check a confined friction test record (``test.h5``, format version 1).
+
+This module is the reading boundary of the package:
+
+* every rule of the contract is checked here, and a file that breaks one is refused with a
+  :class:`~friction_uq.errors.RecordError` naming the file, the path inside it and the problem;
+* gauge signals are converted to strain and **their sign is flipped here, once**: inside the
+  package strains are positive in compression (a compressive bar wave reads positive, a swelling
+  tube reads negative on the hoop channel);
+* the result is one immutable :class:`~friction_uq.record.Record` (frozen dataclasses, read-only
+  arrays).
+"""
+
+from __future__ import annotations
+
+import os
+from datetime import datetime
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from ..errors import RecordError
+from ._apparatus_reader import read_apparatus
+from ._checks import Reader, check_samples, plain, sha256_of
+from .contract import (
+    CHANNELS,
+    FORMAT,
+    FORMAT_VERSION,
+    MIN_SAMPLES,
+    REQUIRED_CHANNELS,
+    UNITS,
+    Channel,
+    Record,
+)
+
+
+def read_record(path: str | os.PathLike[str]) -> Record:
+    """Read, check and convert a ``test.h5`` record.
+
+    Parameters
+    ----------
+    path
+        The record file.
+
+    Returns
+    -------
+    Record
+        Channels in strain, compression positive; apparatus with derived quantities.
+
+    Raises
+    ------
+    RecordError
+        If the file breaks the contract; the message names the file, the path inside it and what
+        is wrong.
+    """
+    import h5py
+
+    p = Path(path)
+    r = Reader(p)
+    if not p.exists():
+        raise r.fail("/", "file not found")
+    if p.is_dir():
+        raise r.fail("/", "is a directory, not an HDF5 file")
+    try:
+        is_hdf5 = h5py.is_hdf5(p)
+    except OSError as exc:  # unreadable
+        raise r.fail("/", f"cannot be read ({exc.strerror or exc})") from None
+    if not is_hdf5:
+        raise r.fail("/", "is not an HDF5 file (no HDF5 signature); a test record must be HDF5")
+    try:
+        fh = h5py.File(p, "r")
+    except OSError as exc:
+        raise r.fail("/", f"is a damaged or truncated HDF5 file ({exc})") from None
+    try:
+        with fh:
+            return _read_open(fh, p, r)
+    except RecordError:
+        raise
+    except (OSError, KeyError, RuntimeError) as exc:
+        raise r.fail("/", f"is a damaged or truncated HDF5 file ({exc})") from None
+
+
+def _read_open(fh: Any, p: Path, r: Reader) -> Record:
+    import h5py
+
+    fmt = r.attr(fh, "/", "format", "str")
+    if fmt != FORMAT:
+        raise r.fail("/@format", f"is {fmt!r}, expected {FORMAT!r}")
+    version = r.attr(fh, "/", "format_version", "int")
+    if version > FORMAT_VERSION:
+        raise r.fail(
+            "/@format_version",
+            f"is {version}, newer than the {FORMAT_VERSION} this friction-uq reads; upgrade friction-uq",
+        )
+    if version < 1:
+        raise r.fail("/@format_version", f"is {version}, expected {FORMAT_VERSION}")
+    test_id = r.attr(fh, "/", "test_id", "str")
+    if not test_id.strip():
+        raise r.fail("/@test_id", "is empty")
+    campaign = r.attr(fh, "/", "campaign", "str")
+    if not campaign.strip():
+        raise r.fail("/@campaign", "is empty")
+    date = r.attr(fh, "/", "date", "str", required=False)
+    if date is not None:
+        try:
+            datetime.fromisoformat(date)
+        except ValueError:
+            raise r.fail(
+                "/@date", f"is {date!r}, not an ISO 8601 date such as '2016-03-01' or '2016-03-01T10:42:00'"
+            ) from None
+    description = r.attr(fh, "/", "description", "str", required=False)
+    striker_velocity = r.attr(fh, "/", "striker_velocity", "float", required=False)
+    if striker_velocity is not None and striker_velocity <= 0:
+        raise r.fail("/@striker_velocity", f"must be > 0 m/s, got {striker_velocity!r}")
+
+    # ---- apparatus ----
+    app = r.member(fh, "apparatus", "/apparatus")
+    if app is None:
+        raise r.fail("/apparatus", "required group is missing")
+    if not isinstance(app, h5py.Group):
+        raise r.fail("/apparatus", "must be a group")
+    apparatus = read_apparatus(app, r)
+
+    # ---- signals ----
+    sig = r.member(fh, "signals", "/signals")
+    if sig is None:
+        raise r.fail("/signals", "required group is missing")
+    if not isinstance(sig, h5py.Group):
+        raise r.fail("/signals", "must be a group")
+    sample_rate = r.attr(sig, "/signals", "sample_rate", "float")
+    if sample_rate <= 0:
+        raise r.fail("/signals@sample_rate", f"must be > 0 Hz, got {sample_rate!r}")
+    t0 = r.attr(sig, "/signals", "t0", "float", required=False)
+    t0 = 0.0 if t0 is None else t0
+
+    channels: dict[str, Channel] = {}
+    length: int | None = None
+    first: str | None = None
+    for name in CHANNELS:
+        where = f"/signals/{name}"
+        ds = r.member(sig, name, where)
+        if ds is None:
+            if name in REQUIRED_CHANNELS:
+                raise r.fail(where, "required channel is missing")
+            continue
+        if not isinstance(ds, h5py.Dataset):
+            raise r.fail(where, "must be a dataset")
+        if ds.ndim != 1:
+            raise r.fail(where, f"must be 1-D, got shape {ds.shape}")
+        if ds.dtype.kind != "f" or ds.dtype.itemsize not in (4, 8):
+            raise r.fail(where, f"must be float32 or float64, got {ds.dtype}")
+        if length is None:
+            length, first = ds.shape[0], name
+            if length < MIN_SAMPLES:
+                raise r.fail(where, f"has {length} samples, at least {MIN_SAMPLES} are needed")
+        elif ds.shape[0] != length:
+            raise r.fail(
+                where, f"has {ds.shape[0]} samples but /signals/{first} has {length}; channels must have equal length"
+            )
+        units = r.attr(ds, where, "units", "str")
+        if units not in UNITS:
+            raise r.fail(f"{where}@units", f"is {units!r}, allowed: {', '.join(UNITS)}")
+        spv = None
+        if units == "V":
+            spv = r.attr(ds, where, "strain_per_volt", "float", required=False)
+            if spv is None:
+                raise r.fail(where, "units are 'V' but attribute 'strain_per_volt' is missing")
+            if spv == 0:
+                raise r.fail(f"{where}@strain_per_volt", "must not be zero")
+            scale = spv
+        else:
+            scale = UNITS[units]
+        raw = np.asarray(ds[()], dtype=np.float64)
+        check_samples(raw, where, r)
+        strain = -scale * raw  # the one sign flip of the package: compression positive from here on
+        strain.setflags(write=False)
+        channels[name] = Channel(name, strain, units, spv)
+    assert length is not None  # REQUIRED_CHANNELS is not empty
+
+    # a record must be long enough for the reflected wave to pass the input-bar gauge
+    duration = length / sample_rate
+    ib = apparatus.input_bar
+    needed = 2.0 * ib.gauge_delay + apparatus.pulse_duration
+    if duration < needed:
+        raise r.fail(
+            "/signals",
+            f"lasts {duration * 1e6:.0f} us, too short to hold the reflected wave: the input-bar gauge "
+            f"needs at least 2 x gauge_distance / wave_speed + 2 x striker length / striker wave speed "
+            f"= {needed * 1e6:.0f} us",
+        )
+
+    provenance: dict[str, Any] = {}
+    prov = r.member(fh, "provenance", "/provenance")
+    if prov is not None:
+        provenance = {k: plain(v) for k, v in prov.attrs.items()}
+
+    return Record(
+        path=str(p),
+        test_id=test_id,
+        campaign=campaign,
+        sample_rate=sample_rate,
+        t0=t0,
+        channels=MappingProxyType(channels),
+        apparatus=apparatus,
+        date=date,
+        description=description,
+        striker_velocity=striker_velocity,
+        provenance=MappingProxyType(provenance),
+        sha256=sha256_of(p),
+    )
+
+
+def read_truth(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The ``/truth`` attributes of a synthetic record (validation only; the analysis never reads them)."""
+    import h5py
+
+    with h5py.File(path, "r") as fh:
+        if "truth" not in fh:
+            return {}
+        return {k: plain(v) for k, v in fh["truth"].attrs.items()}
