@@ -101,7 +101,11 @@ class SimulatorModel:
     def predict(self, values: Mapping[str, float]) -> Prediction:
         """Gauge strains over the whole record for one set of parameter values."""
         cfg, gains = self.config(values)
-        out = run_model(cfg, loading=self.loading)
+        loading = self.loading
+        g_in = gains["input_bar"]
+        if g_in != 1.0:  # the measured incident wave is g_in times the true one
+            loading = Loading(loading.time, loading.at_gauge / g_in, loading.at_cell / g_in, loading.source)
+        out = run_model(cfg, loading=loading)
         strains = {k: gains[k] * v for k, v in out.strains.items()}
         return Prediction(strains, out.force_internal, out.force_external, out.force_input, out.sliding_velocity)
 

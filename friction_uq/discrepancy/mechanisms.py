@@ -1,0 +1,206 @@
+"""The catalogue of mechanisms: what the paper's model leaves out (physics.md section 5), each an
+extension of the baseline simulator with named parameters.
+
+Every entry declares its parameters (:class:`~friction_uq.models.Parameter`: name, unit, physical
+support, meaning), their priors (scipy distributions over physical ranges, documented here), a
+starting value for the fit, what it is physically and its signature in the record, and how it acts
+on the simulator (``apply``: it edits the simulator settings and the gauge gains). The baseline's
+own parameters (f, nu and the sample's modulus factor) stay free in every fit. Adding a mechanism
+is one :func:`register` call below and its tests.
+
+A mechanism that replaces the friction law also says what "the" friction coefficient is under it
+(``f_effective``): the wall's coefficient at the stationary window's mean sliding speed, pressure
+or slip, so that f under the extended model compares with the baseline's.
+
+Priors (why these ranges):
+
+* ``velocity_friction``: f_s ~ half-normal(0.3) like f; v_c ~ lognormal(median 5 m/s, sd of log 1):
+  the speeds of the test.
+* ``pressure_friction``: p0 ~ lognormal(median 200 MPa, sd of log 1.5): f halves at p0, the
+  test's pressures are 50-200 MPa.
+* ``slip_friction``: f_s ~ half-normal(0.3); d_c ~ lognormal(median 1 mm, sd of log 1): the
+  sample slides ~5 mm.
+* ``clearance``: gap ~ half-normal(20 um): the paper quotes ~10 um of radial clearance.
+* ``plug_friction``: force ~ half-normal(500 N), coefficient ~ half-normal(0.03) of F_i.
+* ``gauge_gain``: gain ~ lognormal(0, 0.1): a bar gauge's calibration is rarely 10 % off.
+* ``dispersion``: no parameter (the bars' geometry gives it).
+* ``end_friction``: f_e ~ half-normal(0.1): PTFE on steel is 0.02-0.1.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+from scipy import stats
+
+from ..models.parameters import Parameter
+
+Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, float], str | None], None]
+"""apply(values, settings, gains, channel): edit the simulator settings and gauge gains in place."""
+
+
+@dataclass(frozen=True)
+class Context:
+    """Stationary-window means a mechanism needs to state its effective f: V (m/s), p (Pa), slip (m)."""
+
+    V: float
+    p_mean: float
+    slip: float
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """One entry of the catalogue (module docstring)."""
+
+    name: str
+    meaning: str
+    signature: str
+    parameters: tuple[Parameter, ...]
+    priors: Mapping[str, Any]
+    start: Mapping[str, float]
+    apply: Apply
+    f_effective: Callable[[Mapping[str, float], Context], float] = field(default=lambda v, c: float(v["f"]))
+    channels: tuple[str, ...] = ()  # gauge_gain: the gauges it may act on (one fit each)
+
+    def log_prior(self, values: Mapping[str, float]) -> float:
+        return float(sum(self.priors[p.name].logpdf(values[p.name]) for p in self.parameters))
+
+
+MECHANISMS: dict[str, Mechanism] = {}
+
+
+def register(mech: Mechanism) -> Mechanism:
+    """Add a mechanism to the catalogue (names are unique)."""
+    if mech.name in MECHANISMS:
+        raise ValueError(f"mechanism {mech.name!r} is registered twice")
+    missing = [p.name for p in mech.parameters if p.name not in mech.priors or p.name not in mech.start]
+    if missing:
+        raise ValueError(f"mechanism {mech.name!r}: no prior or start for {', '.join(missing)}")
+    MECHANISMS[mech.name] = mech
+    return mech
+
+
+def _law(settings: dict[str, Any], law: str, **params: float) -> None:
+    settings["friction_law"] = law
+    settings["friction_params"] = MappingProxyType({k: float(v) for k, v in params.items()})
+
+
+def _lognormal(median: float, sd_log: float) -> Any:
+    return stats.lognorm(s=sd_log, scale=median)
+
+
+F_S = Parameter("f_s", "-", 0.0, 2.0, "friction coefficient at rest (zero sliding speed, or before any slip)")
+
+register(Mechanism(
+    name="velocity_friction",
+    meaning="the wall's friction coefficient depends on the sliding speed: f(V) = f + (f_s - f) exp(-V / v_c)",
+    signature="F_eo/F_io changes with V during the rise (while the sample speeds up) and across tests at "
+              "different striker speeds",
+    parameters=(F_S, Parameter("v_c", "m/s", 0.0, math.inf, "characteristic sliding speed of the change")),
+    priors={"f_s": stats.halfnorm(scale=0.3), "v_c": _lognormal(5.0, 1.0)},
+    start={"f_s": 0.08, "v_c": 5.0},
+    apply=lambda v, s, g, ch: _law(s, "velocity", f_s=v["f_s"], f_d=v["f"], v_c=v["v_c"]),
+    f_effective=lambda v, c: float(v["f"] + (v["f_s"] - v["f"]) * math.exp(-c.V / v["v_c"])),
+))
+
+register(Mechanism(
+    name="pressure_friction",
+    meaning="the interface's shear strength saturates with pressure: tau = f p / (1 + p / p0)",
+    signature="the apparent f falls as the load rises: F_eo/F_io depends on the load level (rise vs plateau)",
+    parameters=(Parameter("p0", "Pa", 0.0, math.inf, "pressure at which the friction coefficient has halved"),),
+    priors={"p0": _lognormal(2e8, 1.5)},
+    start={"p0": 1e9},
+    apply=lambda v, s, g, ch: _law(s, "hyperbolic", f0=v["f"], p0=v["p0"]),
+    f_effective=lambda v, c: float(v["f"] / (1.0 + c.p_mean / v["p0"])),
+))
+
+register(Mechanism(
+    name="slip_friction",
+    meaning="friction changes with slip: f = f + (f_s - f) max(0, 1 - d / d_c), the friction drop at the start",
+    signature="F_eo/F_io high at the first slip, then drifting down to its plateau value",
+    parameters=(F_S, Parameter("d_c", "m", 0.0, math.inf, "slip over which the coefficient changes")),
+    priors={"f_s": stats.halfnorm(scale=0.3), "d_c": _lognormal(1e-3, 1.0)},
+    start={"f_s": 0.08, "d_c": 1e-3},
+    apply=lambda v, s, g, ch: _law(s, "slip_weakening", f_s=v["f_s"], f_d=v["f"], d_c=v["d_c"]),
+    f_effective=lambda v, c: float(v["f"] + (v["f_s"] - v["f"]) * max(0.0, 1.0 - c.slip / v["d_c"])),
+))
+
+
+def _clearance(v: Mapping[str, float], s: dict[str, Any], g: dict[str, float], ch: str | None) -> None:
+    s["gap"] = float(v["gap"])
+    s["tube_compliance"] = True
+
+
+register(Mechanism(
+    name="clearance",
+    meaning="a radial clearance between sample and tube, with the tube bore's compliance: the wall pressure "
+            "starts only once the sample has closed the gap, then is less than nu/(1-nu) sigma",
+    signature="the hoop gauge starts late and reads low; F_eo/F_io depends on the load level; eq. 17 reads f low",
+    parameters=(Parameter("gap", "m", 0.0, 1e-4, "radial clearance sample/tube"),),
+    priors={"gap": stats.halfnorm(scale=20e-6)},
+    start={"gap": 3e-6},
+    apply=_clearance,
+))
+
+
+def _plug(v: Mapping[str, float], s: dict[str, Any], g: dict[str, float], ch: str | None) -> None:
+    s["plug_friction_force"] = float(v["plug_force"])
+    s["plug_friction_coefficient"] = float(v["plug_coefficient"])
+
+
+register(Mechanism(
+    name="plug_friction",
+    meaning="parasitic friction of the plug on the tube: a force that reaches the tube and the external bar "
+            "without passing through the sample",
+    signature="F_eo too high for the sample's friction through the whole loading; the hoop gauge does not follow",
+    parameters=(Parameter("plug_force", "N", 0.0, 1e5, "constant part of the plug/tube friction"),
+                Parameter("plug_coefficient", "-", 0.0, 1.0, "plug/tube friction per newton of input force")),
+    priors={"plug_force": stats.halfnorm(scale=500.0), "plug_coefficient": stats.halfnorm(scale=0.03)},
+    start={"plug_force": 50.0, "plug_coefficient": 0.003},
+    apply=_plug,
+))
+
+
+def _gain(v: Mapping[str, float], s: dict[str, Any], g: dict[str, float], ch: str | None) -> None:
+    if ch is None:
+        raise ValueError("gauge_gain acts on one gauge: give its channel")
+    g[ch] = float(v["gain"])
+
+
+register(Mechanism(
+    name="gauge_gain",
+    meaning="a calibration error on one bar gauge: its reading is the true strain times a gain",
+    signature="the equilibrium F_i = F_eo + F_io broken by a constant factor; one channel off by a constant ratio",
+    parameters=(Parameter("gain", "-", 0.0, 10.0, "recorded / true strain of the gauge"),),
+    priors={"gain": _lognormal(1.0, 0.1)},
+    start={"gain": 1.0},
+    apply=_gain,
+    channels=("input_bar", "internal_output_bar", "external_output_bar"),
+))
+
+register(Mechanism(
+    name="dispersion",
+    meaning="Pochhammer-Chree dispersion of the waves along the bars, which the 1-D bar model ignores",
+    signature="oscillations after each front and smeared fronts, strongest on the reflected wave and the solid "
+              "bars' rise",
+    parameters=(),
+    priors={},
+    start={},
+    apply=lambda v, s, g, ch: s.__setitem__("dispersion", True),
+))
+
+register(Mechanism(
+    name="end_friction",
+    meaning="friction on the sample's end faces (the PTFE sheets not frictionless) holds back its radial "
+            "expansion near the faces",
+    signature="a lower F_eo/F_io than eq. 13 gives for the same f (eq. 17 reads f low) and a smaller hoop "
+              "signal; the cell's equilibrium unchanged",
+    parameters=(Parameter("f_e", "-", 0.0, 1.0, "friction coefficient of the end faces"),),
+    priors={"f_e": stats.halfnorm(scale=0.1)},
+    start={"f_e": 0.01},
+    apply=lambda v, s, g, ch: s.__setitem__("end_friction", float(v["f_e"])),
+))
