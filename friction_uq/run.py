@@ -138,6 +138,7 @@ def run_file(
     pdf: bool = True,
     progress: bool = True,
     whole_record: bool = True,
+    diagnose: bool = False,
 ) -> RunResult:
     """The main job (see the module docstring); prints a summary table at the end."""
     t_start = time.perf_counter()
@@ -181,6 +182,13 @@ def run_file(
         say("friction-uq: the whole test simulated with the posterior, against every gauge")
         wrc = whole_record_check(prep, priors, summary, hoop=use_hoop, seed=seed)
         add_whole_record(dt, wrc)
+    diag = None
+    if diagnose:
+        from .discrepancy import outcome
+
+        say("friction-uq: diagnose: fitting each mechanism of the catalogue to the whole record")
+        diag = run_diagnose(prep, priors, summary, hoop=use_hoop, seed=seed, say=say)
+        outcome.add_to_datatree(dt, diag)
 
     dt.attrs.update({
         "friction_uq_version": __version__, "record": str(record.path), "record_sha256": record.sha256,
@@ -197,7 +205,7 @@ def run_file(
         from .report.pdf import ReportInputs, write_report
 
         inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
-                              whole_record=wrc)
+                              whole_record=wrc, diagnosis=diag)
         outputs["pdf"] = write_report(inputs, out / f"{stem}.pdf")
 
     seconds = time.perf_counter() - t_start
@@ -232,13 +240,19 @@ def run_file(
     }
     if wrc is not None:
         doc["misfit"] = wrc.to_json()
+    if diag is not None:
+        doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json())
+        fx = diag.final.f_summary() if diag.causes else summary["f"].to_json()
+        doc["f_headline"] = {"model": diag.final.label if diag.causes else "baseline (stationary phase, eq. 17 + hoop)"}
+        doc["f_headline"].update({k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")})
     js = out / f"{stem}.json"
     _atomic_write_bytes(js, lambda tmp: Path(tmp).write_text(json.dumps(doc, indent=2) + "\n"))
     outputs["json"] = js
     if backend.exists():
         backend.unlink()
     print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, wrc,
-                        page=(9 if use_hoop else 8) if pdf else None))
+                        page=(9 if use_hoop else 8) if pdf else None,
+                        diagnosis=doc["discrepancy"]["sentence"] if diag is not None else None))
     return RunResult(prep, samples, summary, conv, lab, outputs, seconds, wrc)
 
 
@@ -252,6 +266,25 @@ def whole_record_check(prep: Prepared, priors: Priors, summary: dict[str, Variab
 
     return check_whole_record(prep, log_prior, {"f": summary["f"].q50, "nu": summary["nu"].q50},
                               hoop=hoop or prep.record.has_hoop, seed=seed)
+
+
+def run_diagnose(prep: Prepared, priors: Priors, summary: dict[str, VariableSummary], *, hoop: bool, seed: int,
+                 say=lambda msg: None):
+    """Fit every mechanism of the catalogue (:mod:`friction_uq.discrepancy.diagnose`), started from the
+    stationary posterior's medians, with this run's f and nu priors."""
+    from .discrepancy.diagnose import diagnose
+
+    def log_prior(v) -> float:
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    from .models.parameters import F, NU
+
+    scales = {}
+    for par in (F, NU):
+        lo, mid, hi = (float(par.to_unbounded(priors[par.name].ppf(q))) for q in (0.16, 0.5, 0.84))
+        scales[par.name] = (mid, max(0.5 * (hi - lo), 1e-3))
+    return diagnose(prep, log_prior, {"f": summary["f"].q50, "nu": summary["nu"].q50}, hoop=hoop or prep.record.has_hoop,
+                    seed=seed, progress=lambda m: say(f"friction-uq: diagnose: {m}"), base_scales=scales)
 
 
 def add_whole_record(dt, wrc: WholeRecordCheck) -> None:
@@ -274,7 +307,7 @@ def add_whole_record(dt, wrc: WholeRecordCheck) -> None:
 
 def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,
                   outputs: dict[str, Path], seconds: float, wrc: WholeRecordCheck | None = None, *,
-                  page: int | None = None) -> str:
+                  page: int | None = None, diagnosis: str | None = None) -> str:
     """The table the terminal ends with."""
     units = {"p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
     lines = [f"{campaign} {test_id}: posterior (90 % credible intervals)",
@@ -291,6 +324,8 @@ def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary],
                  f"{seconds:.1f} s in all")
     if wrc is not None:
         lines.append(wrc.decision.sentence(page=page))
+    if diagnosis is not None:
+        lines.append(diagnosis)
     for k, pth in outputs.items():
         lines.append(f"wrote {pth}")
     return "\n".join(lines)

@@ -9,11 +9,15 @@ for AR(1) noise). The baseline is the same simulator without extension.
 
 Rule (documented in README.md):
 
-* a mechanism is *decisive* when its dELPD over the reference model exceeds both 4 and twice its
-  standard error (below |dELPD| = 4 the normal approximation of its error is unreliable);
+* a mechanism is *decisive* when its dELPD over the reference model exceeds 4 (below that the
+  normal approximation of its error is unreliable) and either twice its standard error or 40
+  (a strong effect lives in a few blocks, the fronts, the rise: its pointwise differences are
+  heavy-tailed and their SE, which assumes exchangeable blocks, is then no measure of chance;
+  chance improvements of a nested model with a few parameters on a clean record are a few units);
 * the cause is the decisive mechanism with the largest dELPD; every other decisive mechanism whose
-  dELPD is within max(4, 2 SE of the pairwise difference) of it explains the record about as well:
-  the two are named together as ``not_separable`` from this record, with what would separate them;
+  dELPD is within the same margin of it (4, and 2 SE of the pairwise difference or
+  max(40, 10 % of the best dELPD)) explains the record about as well: the two are named together
+  as ``not_separable`` from this record, with what would separate them;
 * then the search goes on with the named cause in the model (the reference becomes baseline +
   cause), for at most three causes, so that a record with several effects gets them in order of
   evidence.
@@ -38,12 +42,12 @@ from ..models import Parameter, SimulatorModel, measured_loading
 from .elpd import Elpd, ar1_block_loo, elpd_difference, takeuchi_block_loo
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
-from .whole_record import PHASES, compare_whole_record
+from .whole_record import WholeRecord, compare_whole_record
 
 #: Block of the leave-one-block-out ELPD (s).
 BLOCK = 10e-6
-#: Decisive evidence: dELPD above both numbers (the second in standard errors).
-DECISIVE_ELPD, DECISIVE_SE = 4.0, 2.0
+#: Decisive evidence: dELPD above DECISIVE_ELPD and above DECISIVE_SE standard errors or STRONG_ELPD.
+DECISIVE_ELPD, DECISIVE_SE, STRONG_ELPD = 4.0, 2.0, 40.0
 MAX_CAUSES = 3
 SAMPLE_MODULUS_SD_LOG = 0.1
 
@@ -100,7 +104,12 @@ class Ranked:
 
     @property
     def decisive(self) -> bool:
-        return self.delpd > DECISIVE_ELPD and self.delpd > DECISIVE_SE * self.se
+        return beyond(self.delpd, self.se, STRONG_ELPD)
+
+
+def beyond(d: float, se: float, strong: float) -> bool:
+    """dELPD d (with SE se) is decisive evidence (module docstring)."""
+    return d > DECISIVE_ELPD and (d > DECISIVE_SE * se or d > strong)
 
 
 @dataclass(frozen=True)
@@ -115,6 +124,8 @@ class Diagnosis:
     final: ModelFit
     rms: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict)
     seconds: float = 0.0
+    baseline_comparison: WholeRecord | None = None
+    final_comparison: WholeRecord | None = None
 
     @property
     def cause(self) -> Variant | None:
@@ -135,7 +146,7 @@ class Diagnoser:
     """Fits and scores extended models of one record (module docstring)."""
 
     def __init__(self, prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], *, hoop: bool,
-                 seed: int, n_draws: int = 60) -> None:
+                 seed: int, n_draws: int = 60, base_scales: Mapping[str, tuple[float, float]] | None = None) -> None:
         self.prep = prep
         rec = prep.record
         self.loading = measured_loading(rec, prep.forces)
@@ -151,6 +162,7 @@ class Diagnoser:
         d = prep.data
         self.context = Context(V=float(np.mean(d.V)), p_mean=float(np.nan), slip=float(np.mean(d.slip)))
         self._n_fit = 0
+        self.base_scales = dict(base_scales or {})
 
     def _model(self, variants: tuple[Variant, ...]) -> SimulatorModel:
         extra = [self.modulus] + [p for v in variants for p in v.mechanism.parameters]
@@ -178,7 +190,11 @@ class Diagnoser:
                 st[p.name] = start.get(p.name, v.mechanism.start[p.name])
         self._n_fit += 1
         rng = np.random.default_rng(np.random.SeedSequence([self.seed, 9, self._n_fit]))
-        fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False)
+        scales = {"sample_modulus": (math.log(self.E0), SAMPLE_MODULUS_SD_LOG), **self.base_scales}
+        for v in variants:
+            scales.update(v.mechanism.prior_z())
+        fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False,
+                               prior_scale=scales)
         pred, gain = lik.strains(fit.mode)
         dens, blocks, offset = [], [], 0
         for c in lik.channels:
@@ -220,10 +236,12 @@ class Diagnoser:
 
 
 def candidates(exclude: tuple[str, ...] = ()) -> list[Variant]:
-    """Every mechanism of the catalogue as fitted (gauge_gain once per gauge), minus ``exclude``."""
+    """Every mechanism of the catalogue as fitted (gauge_gain once per gauge), minus ``exclude`` and
+    the other members of an excluded mechanism's group (one friction law at a time)."""
     out: list[Variant] = []
+    groups = {MECHANISMS[n].group for n in exclude if MECHANISMS[n].group}
     for m in MECHANISMS.values():
-        if m.name in exclude:
+        if m.name in exclude or (m.group is not None and m.group in groups):
             continue
         out += [Variant(m, ch) for ch in m.channels] if m.channels else [Variant(m)]
     return out
@@ -235,11 +253,16 @@ def rank(reference: ModelFit, fits: list[ModelFit]) -> tuple[Ranked, ...]:
 
 
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
-             hoop: bool, seed: int, n_draws: int = 60, progress: Callable[[str], None] | None = None) -> Diagnosis:
-    """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring)."""
+             hoop: bool, seed: int, n_draws: int = 60, progress: Callable[[str], None] | None = None,
+             base_scales: Mapping[str, tuple[float, float]] | None = None) -> Diagnosis:
+    """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring).
+
+    ``base_scales``: Gaussian stand-ins (centre, sd in the unbounded coordinate) of the f and nu
+    priors for the mode search.
+    """
     t0 = time.perf_counter()
     say = progress or (lambda msg: None)
-    dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws)
+    dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales)
     say("baseline")
     base = dg.fit((), start, "baseline")
     reference = base
@@ -264,7 +287,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
             close = []
             for r in decisive[1:]:
                 d, se = elpd_difference(best.fit.elpd, r.fit.elpd)
-                if d < max(DECISIVE_ELPD, DECISIVE_SE * se):
+                if not beyond(d, se, max(STRONG_ELPD, 0.1 * best.delpd)):
                     close.append(r.fit.variants[-1].mechanism.name)
             if close:
                 names = [best.fit.variants[-1].mechanism.name] + [c for c in close if c != best.fit.variants[-1].mechanism.name]
@@ -277,15 +300,15 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     say("posterior predictive of the baseline and the final model")
     base = replace(base, predicted=dg.predictive(base))
     final = replace(final, predicted=dg.predictive(final)) if causes else base
-    rms = residual_rms(prep, base, final)
+    a = compare_whole_record(prep, base.predicted)
+    b = compare_whole_record(prep, final.predicted)
     return Diagnosis(baseline=base, rounds=tuple(rounds), causes=tuple(causes), not_separable=not_sep,
-                     separate_by=separate_by, final=final, rms=rms, seconds=time.perf_counter() - t0)
+                     separate_by=separate_by, final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
+                     baseline_comparison=a, final_comparison=b)
 
 
-def residual_rms(prep: Prepared, before: ModelFit, after: ModelFit) -> dict[str, dict[str, tuple[float, float]]]:
-    """RMS of residual / noise sd per channel and phase, baseline and the final model."""
-    a = compare_whole_record(prep, before.predicted)
-    b = compare_whole_record(prep, after.predicted)
+def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:
+    """RMS of residual / noise sd per channel and phase: (baseline, final model)."""
     out: dict[str, dict[str, tuple[float, float]]] = {}
     fb = {(f.channel, f.phase): f.rms for f in b.figures}
     for f in a.figures:

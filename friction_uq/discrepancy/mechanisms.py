@@ -65,6 +65,16 @@ class Mechanism:
     apply: Apply
     f_effective: Callable[[Mapping[str, float], Context], float] = field(default=lambda v, c: float(v["f"]))
     channels: tuple[str, ...] = ()  # gauge_gain: the gauges it may act on (one fit each)
+    group: str | None = None  # mechanisms of one group replace the same thing (the friction law): one at a time
+
+    def prior_z(self) -> dict[str, tuple[float, float]]:
+        """Gaussian stand-ins of the priors in each parameter's unbounded coordinate (centre, sd), from the
+        prior's 16 % and 84 % quantiles: what the mode search uses (the exact prior weighs the draws)."""
+        out = {}
+        for p in self.parameters:
+            lo, mid, hi = (float(p.to_unbounded(self.priors[p.name].ppf(q))) for q in (0.16, 0.5, 0.84))
+            out[p.name] = (mid, max(0.5 * (hi - lo), 1e-3))
+        return out
 
     def log_prior(self, values: Mapping[str, float]) -> float:
         return float(sum(self.priors[p.name].logpdf(values[p.name]) for p in self.parameters))
@@ -105,6 +115,7 @@ register(Mechanism(
     start={"f_s": 0.08, "v_c": 5.0},
     apply=lambda v, s, g, ch: _law(s, "velocity", f_s=v["f_s"], f_d=v["f"], v_c=v["v_c"]),
     f_effective=lambda v, c: float(v["f"] + (v["f_s"] - v["f"]) * math.exp(-c.V / v["v_c"])),
+    group="friction_law",
 ))
 
 register(Mechanism(
@@ -116,6 +127,7 @@ register(Mechanism(
     start={"p0": 1e9},
     apply=lambda v, s, g, ch: _law(s, "hyperbolic", f0=v["f"], p0=v["p0"]),
     f_effective=lambda v, c: float(v["f"] / (1.0 + c.p_mean / v["p0"])),
+    group="friction_law",
 ))
 
 register(Mechanism(
@@ -127,6 +139,7 @@ register(Mechanism(
     start={"f_s": 0.08, "d_c": 1e-3},
     apply=lambda v, s, g, ch: _law(s, "slip_weakening", f_s=v["f_s"], f_d=v["f"], d_c=v["d_c"]),
     f_effective=lambda v, c: float(v["f"] + (v["f_s"] - v["f"]) * max(0.0, 1.0 - c.slip / v["d_c"])),
+    group="friction_law",
 ))
 
 

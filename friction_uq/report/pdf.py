@@ -40,6 +40,7 @@ class ReportInputs:
     V: VariableSummary
     version: str
     whole_record: WholeRecordCheck | None = None
+    diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
 
 
 def _fmt(v: float) -> str:
@@ -73,6 +74,10 @@ def page_summary(r: ReportInputs) -> Figure:
     ]
     if r.whole_record is not None:
         lines.append("Whole record: " + r.whole_record.decision.sentence(page=whole_record_page(r)))
+    if r.diagnosis is not None:
+        from ..discrepancy.outcome import sentence
+
+        lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, s["f"].to_json()))
     y = 0.97
     for line in lines:
         ax.text(0.0, y, line, fontsize=11, va="top", wrap=True, transform=ax.transAxes)
@@ -93,7 +98,9 @@ def page_summary(r: ReportInputs) -> Figure:
     ax.text(0.77, 0.47, "Pages\n 1 raw gauges\n 2 waves, forces, equilibrium\n 3 window and noise\n"
             " 4 posterior vs prior\n 5 nu -> f\n 6 convergence\n 7 predictive check"
             + ("\n 8 hoop gauge vs model" if r.samples.hoop else "")
-            + (f"\n{whole_record_page(r):2d} whole test vs gauges" if r.whole_record is not None else ""),
+            + (f"\n{whole_record_page(r):2d} whole test vs gauges" if r.whole_record is not None else "")
+            + (f"\n{whole_record_page(r) + 2:2d} mechanisms ranked\n{whole_record_page(r) + 3:2d} extended fit"
+               if r.diagnosis is not None else ""),
             fontsize=10, va="top", transform=ax.transAxes, family="monospace")
     return fig
 
@@ -132,6 +139,16 @@ def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
             from .whole_record_pages import pages_whole_record
 
             for fig in pages_whole_record(r.whole_record, test=f"{p.record.campaign} {p.record.test_id}"):
+                pdf.savefig(fig)
+                plt.close(fig)
+        if r.diagnosis is not None:
+            from ..discrepancy.outcome import sentence
+            from .diagnose_pages import page_extended_fit, page_ranking
+
+            test = f"{p.record.campaign} {p.record.test_id}"
+            fw = r.summary["f"].to_json()
+            for fig in (page_ranking(r.diagnosis, f_without=fw, sentence=sentence(r.diagnosis, fw), test=test),
+                        page_extended_fit(r.diagnosis, test=test)):
                 pdf.savefig(fig)
                 plt.close(fig)
     return out

@@ -1,0 +1,85 @@
+"""Pages of ``diagnose``: the mechanisms ranked by dELPD, and the named mechanism's fit.
+
+Page A: dELPD over the baseline with +-2 SE bars for every mechanism of the catalogue (the decisive
+threshold drawn), the rule, the causes named, and f under the baseline and the extended model.
+Page B: per gauge, the residual of the baseline and of the extended model over the whole record
+(standardised by the noise), with the named mechanism's parameters.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..discrepancy.diagnose import DECISIVE_ELPD, Diagnosis
+from ..discrepancy.whole_record import CHANNEL_LABELS
+from .style import figure
+
+
+def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, test: str) -> Figure:
+    fig, axes = figure(f"{test}: what the baseline misses, mechanism by mechanism", nrows=1, ncols=2,
+                       gridspec_kw={"width_ratios": [3, 2]})
+    ax = axes[0]
+    ranked = list(dg.ranking)
+    y = np.arange(len(ranked))[::-1]
+    d = np.array([r.delpd for r in ranked])
+    se = np.array([r.se for r in ranked])
+    colours = ["tab:red" if r.decisive else "0.5" for r in ranked]
+    shown = np.sign(d) * np.log10(1.0 + np.abs(d))
+    lo = np.sign(d - 2 * se) * np.log10(1.0 + np.abs(d - 2 * se))
+    hi = np.sign(d + 2 * se) * np.log10(1.0 + np.abs(d + 2 * se))
+    ax.barh(y, shown, color=colours)
+    ax.errorbar(shown, y, xerr=[shown - lo, hi - shown], fmt="none", ecolor="k", lw=0.8)
+    ax.axvline(np.log10(1.0 + DECISIVE_ELPD), color="tab:blue", ls="--", lw=0.8, label="dELPD = 4")
+    ax.set_yticks(y, [r.fit.label for r in ranked], fontsize=8)
+    ax.set_xlabel("dELPD over the baseline, sign(d) log10(1 + |d|), bars +- 2 SE")
+    ax.legend(loc="lower right")
+    ax.set_title("expected log predictive density (block LOO) over the baseline")
+    ax2 = axes[1]
+    ax2.axis("off")
+    fx = dg.final.f_summary()
+    fb = dg.baseline.f_summary()
+    lines = [sentence, "",
+             f"f, stationary phase (eq. 17 + hoop): {f_without['q50']:.4f} [{f_without['q05']:.4f}, {f_without['q95']:.4f}]",
+             f"f, baseline over the whole record: {fb['q50']:.4f} [{fb['q05']:.4f}, {fb['q95']:.4f}]",
+             f"f, model '{dg.final.label}': {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}]",
+             f"hoop gauge gain (profiled, final model): {dg.final.hoop_gain:.3f}", ""]
+    for v in dg.causes:
+        lines.append(f"{v.mechanism.name}{' (' + v.channel + ')' if v.channel else ''}: {v.mechanism.meaning}")
+        for p in v.mechanism.parameters:
+            x = dg.final.fit.draws[p.name]
+            q = np.quantile(x, [0.05, 0.5, 0.95])
+            lines.append(f"   {p.name} = {q[1]:.4g} [{q[0]:.4g}, {q[2]:.4g}] {p.unit}: {p.meaning}")
+    lines += ["", "Rule: decisive when dELPD > 4 and (> 2 SE or > 40); the cause is the decisive mechanism with the",
+              "largest dELPD; others as close to it are not separable from this record; then the search goes on",
+              "with the cause in the model."]
+    ax2.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=8, wrap=True, transform=ax2.transAxes)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    return fig
+
+
+def page_extended_fit(dg: Diagnosis, *, test: str) -> Figure:
+    a, b = dg.baseline_comparison, dg.final_comparison
+    chans = [c for c in CHANNEL_LABELS if c in a.spans]
+    fig, axes = figure(f"{test}: residuals of the baseline and of '{dg.final.label}'", nrows=len(chans), ncols=1,
+                       sharex=False)
+    axes = np.atleast_1d(axes)
+    for ax, ch in zip(axes, chans):
+        i0, i3 = a.spans[ch]
+        _, iw0, iw1, _ = a.phase_bounds[ch]
+        t = a.time[i0:i3] * 1e6
+        ax.axvspan(a.time[iw0] * 1e6, a.time[max(iw1 - 1, iw0)] * 1e6, color="0.88", zorder=0)
+        ax.plot(t, a.standardised(ch)[i0:i3], color="0.5", lw=0.5, label="baseline", rasterized=True)
+        ax.plot(t, b.standardised(ch)[i0:i3], color="tab:red", lw=0.5, label=dg.final.label, rasterized=True)
+        ax.axhline(2, color="tab:blue", ls="--", lw=0.6)
+        ax.axhline(-2, color="tab:blue", ls="--", lw=0.6)
+        rms = dg.rms.get(ch, {})
+        txt = "; ".join(f"{ph} {bf:.2f} -> {af:.2f}" for ph, (bf, af) in rms.items())
+        ax.set_title(f"{CHANNEL_LABELS[ch]}: RMS of residual / noise sd, {txt}", fontsize=8)
+        ax.set_ylabel("residual / sd")
+        lim = max(4.0, float(np.nanpercentile(np.abs(a.standardised(ch)[i0:i3]), 99.5)) * 1.1)
+        ax.set_ylim(-lim, lim)
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("time on the record (us)")
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    return fig
