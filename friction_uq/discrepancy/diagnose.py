@@ -200,8 +200,10 @@ class Diagnoser:
         for c in lik.channels:
             i0, _, _, i3 = lik.bounds[c]
             nz = lik.noise[c]
-            dens.append(ar1_block_loo((lik.measured[c] - pred[c])[None, i0:i3], sd=nz.sd, rho=nz.rho,
-                                      block=self.block)[0])
+            w = lik.weight[c]
+            logw = np.add.reduceat(np.log(w), np.arange(0, i3 - i0, self.block))
+            dens.append(ar1_block_loo(lik.scaled_residual(c, pred[c])[None], sd=nz.sd, rho=nz.rho,
+                                      block=self.block)[0] + logw)
             blocks.append(offset + np.arange(i3 - i0) // self.block)
             offset += len(dens[-1])
         elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z,
@@ -212,11 +214,12 @@ class Diagnoser:
         return ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd, f_effective=f_eff,
                         predicted={c: v[None] for c, v in pred.items()}, lik=lik)
 
-    def predictive(self, mf: ModelFit) -> dict[str, np.ndarray]:
-        """Simulated gauges for the draws of a fitted model (channel -> (ndraw, n)), hoop gain profiled."""
+    def predictive(self, mf: ModelFit, n: int = 30) -> dict[str, np.ndarray]:
+        """Simulated gauges for the first ``n`` draws of a fitted model (channel -> (n, samples)), hoop gain
+        profiled."""
         names = list(mf.fit.draws)
         rows: dict[str, list[np.ndarray]] = {}
-        for s in range(len(mf.fit.draws["f"])):
+        for s in range(min(n, len(mf.fit.draws["f"]))):
             pred, _ = mf.lik.strains({n: float(mf.fit.draws[n][s]) for n in names})
             for c, v in pred.items():
                 rows.setdefault(c, []).append(v)
@@ -253,7 +256,7 @@ def rank(reference: ModelFit, fits: list[ModelFit]) -> tuple[Ranked, ...]:
 
 
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
-             hoop: bool, seed: int, n_draws: int = 60, progress: Callable[[str], None] | None = None,
+             hoop: bool, seed: int, n_draws: int = 1000, progress: Callable[[str], None] | None = None,
              base_scales: Mapping[str, tuple[float, float]] | None = None) -> Diagnosis:
     """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring).
 

@@ -3,9 +3,14 @@
 The whole-record likelihood compares every gauge over its span (:mod:`.whole_record`: from its
 wave's arrival to the first far-end echo) with the simulator's prediction, each residual scored by
 the exact AR(1) Gaussian log-likelihood of that gauge's pre-pulse noise (the reflected wave with
-twice the variance: its prediction carries the measured incident's noise). The hoop gauge's
-calibration factor enters linearly and is profiled out (its generalised least-squares value for
-each parameter vector).
+twice the variance: its prediction carries the measured incident's noise), widened by the model's
+tolerance: sample t has standard deviation s_t = sqrt(sd^2 + tol_t^2), tol_t the channel's
+tolerated model error (:func:`~.whole_record.tolerance_sd`: 1-2 % of the signal on a bar gauge,
+3 % on the hoop gauge, and a timing tolerance of 0.2 us times the local slope), and the residual
+scaled by sd / s_t is AR(1) with the gauge's coefficient. Without it the 0.1 %-level differences
+between any two simulators of the test (time step, mesh, a rounded constant) would read as physics
+on the high-signal channels. The hoop gauge's calibration factor enters linearly and is profiled
+out (its generalised least-squares value for each parameter vector).
 
 The posterior is approximated by a normal distribution in the unbounded coordinates of the
 parameters (:meth:`~friction_uq.models.Parameter.to_unbounded`) around its mode, found by
@@ -29,7 +34,7 @@ from scipy import optimize
 from ..analysis import Prepared
 from ..likelihood import ar1_loglike
 from ..models.simulator import SimulatorModel
-from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, whiten
+from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, tolerance_sd, whiten
 
 LogPrior = Callable[[Mapping[str, float]], float]
 
@@ -66,6 +71,17 @@ class WholeRecordLikelihood:
         self.bounds = channel_spans(prep, self.channels)
         self.noise = {c: channel_noise(prep, c) for c in self.channels}
         self.measured = {c: rec.strain(c) - prep.forces.channels[c].noise.offset for c in self.channels}
+        self.weight: dict[str, np.ndarray] = {}  # sd / s_t over each span (module docstring)
+        for c in self.channels:
+            sl, nz = self._span(c), self.noise[c]
+            tol = tolerance_sd(self.measured[c], c, sample_rate=rec.sample_rate)[sl]
+            self.weight[c] = nz.sd / np.hypot(nz.sd, tol)
+        self._log_weight = sum(float(np.sum(np.log(w))) for w in self.weight.values())
+
+    def scaled_residual(self, c: str, pred: np.ndarray) -> np.ndarray:
+        """(measured - predicted) sd / s_t over the channel's span: AR(1) with the gauge's sd and rho."""
+        sl = self._span(c)
+        return (self.measured[c][sl] - pred[sl]) * self.weight[c]
 
     def _span(self, c: str) -> slice:
         i0, _, _, i3 = self.bounds[c]
@@ -73,9 +89,9 @@ class WholeRecordLikelihood:
 
     def hoop_gain(self, predicted_unit: np.ndarray) -> float:
         """Generalised least-squares gain of the hoop gauge for a prediction at gain 1."""
-        s, nz = self._span("tube_hoop"), self.noise["tube_hoop"]
-        wp = whiten(predicted_unit[s], sd=nz.sd, rho=nz.rho)
-        wm = whiten(self.measured["tube_hoop"][s], sd=nz.sd, rho=nz.rho)
+        s, nz, w = self._span("tube_hoop"), self.noise["tube_hoop"], self.weight["tube_hoop"]
+        wp = whiten(predicted_unit[s] * w, sd=nz.sd, rho=nz.rho)
+        wm = whiten(self.measured["tube_hoop"][s] * w, sd=nz.sd, rho=nz.rho)
         den = float(wp @ wp)
         return float(wm @ wp) / den if den > 0 else 1.0
 
@@ -96,16 +112,16 @@ class WholeRecordLikelihood:
         pred, _ = self.strains(values)
         out = []
         for c in self.channels:
-            s, nz = self._span(c), self.noise[c]
-            out.append(whiten(self.measured[c][s] - pred[c][s], sd=nz.sd, rho=nz.rho))
+            nz = self.noise[c]
+            out.append(whiten(self.scaled_residual(c, pred[c]), sd=nz.sd, rho=nz.rho))
         return np.concatenate(out)
 
     def loglike(self, values: Mapping[str, float]) -> float:
         pred, _ = self.strains(values)
-        out = 0.0
+        out = self._log_weight
         for c in self.channels:
-            s, nz = self._span(c), self.noise[c]
-            out += float(ar1_loglike(self.measured[c][s] - pred[c][s], nz.sd, nz.rho))
+            nz = self.noise[c]
+            out += float(ar1_loglike(self.scaled_residual(c, pred[c]), nz.sd, nz.rho))
         return out
 
 

@@ -2,13 +2,15 @@
 
 Statistic. For each channel c and phase (rise, stationary, unloading) of the whole-record
 comparison (:mod:`.whole_record`), the residual is first shrunk by a model tolerance: the part of
-each residual sample within delta_c of the prediction's magnitude is forgiven,
+each residual sample within the tolerated model error tol_t is forgiven,
 
-    e'_t = e_t - clip(e_t, -delta_c |y_t|, +delta_c |y_t|),
+    e'_t = e_t - clip(e_t, -tol_t, +tol_t),
 
-with delta_c = 1 % on the bar gauges (the accuracy of a bar gauge's calibration and of the bar's
-E and c) and 3 % on the tube hoop gauge (the fit error of its influence function, physics.md
-section 6). On e' two standardised figures are formed:
+tol_t from :func:`~.whole_record.tolerance_sd`: 1 % of the signal on the output bar gauges (the
+accuracy of a bar gauge's calibration and of the bar's E and c), 2 % on the reflected wave (the
+incident less a small difference, which carries the plug's impact, the least certain part of any
+model of the test), 3 % on the tube hoop gauge (the fit error of its influence function,
+physics.md section 6), and 0.2 us times the local slope (the timing of a front). On e' two standardised figures are formed:
 
 * the level z = mean(e') / se, se^2 the variance of an AR(1) mean (long-run variance), of the
   offset error of the pre-pulse mean and of the phase mean of the prediction over the posterior
@@ -37,10 +39,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..signals import ar1_mean_sd
-from .whole_record import CHANNEL_LABELS, PHASES, WholeRecord, whiten
+from .whole_record import CHANNEL_LABELS, PHASES, WholeRecord, tolerance_sd, whiten
 
-#: Model tolerance per channel (relative to the prediction).
-TOLERANCE = {"input_bar": 0.01, "internal_output_bar": 0.01, "external_output_bar": 0.01, "tube_hoop": 0.03}
 #: Decision threshold on the statistic (standard-normal units).
 THRESHOLD = 5.0
 
@@ -111,9 +111,8 @@ class MisfitDecision:
                 "cells": [c.to_json() for c in self.cells]}
 
 
-def tolerated(resid: np.ndarray, predicted: np.ndarray, delta: float) -> np.ndarray:
-    """The residual less what lies within ``delta`` x |prediction| of zero (module docstring)."""
-    tol = delta * np.abs(predicted)
+def tolerated(resid: np.ndarray, tol: np.ndarray) -> np.ndarray:
+    """The residual less what lies within ``tol`` of zero (module docstring)."""
     return resid - np.clip(resid, -tol, tol)
 
 
@@ -129,19 +128,20 @@ def predictive_quadratic(e: np.ndarray, draws: np.ndarray, *, sd: float, rho: fl
     return q - float(b @ np.linalg.solve(np.eye(B.shape[1]) + B.T @ B, b))
 
 
-def decide(wr: WholeRecord, *, threshold: float = THRESHOLD, tolerance: dict[str, float] | None = None) -> MisfitDecision:
+def decide(wr: WholeRecord, *, threshold: float = THRESHOLD) -> MisfitDecision:
     """Misfit statistic and decision for a whole-record comparison (module docstring)."""
-    tol = TOLERANCE if tolerance is None else tolerance
     cells = []
+    fs = 1.0 / float(wr.time[1] - wr.time[0])
     for ch, (i0, iw0, iw1, i3) in wr.phase_bounds.items():
         pred = wr.predicted[ch].mean(axis=0)
         resid = wr.measured[ch] - pred
+        tol = tolerance_sd(wr.measured[ch], ch, sample_rate=fs)
         nz = wr.noise[ch]
         for phase, (a, b) in zip(PHASES, ((i0, iw0), (iw0, iw1), (iw1, i3))):
             n = b - a
             if n < 10:
                 continue
-            e = tolerated(resid[a:b], pred[a:b], tol.get(ch, 0.0))
+            e = tolerated(resid[a:b], tol[a:b])
             draws = wr.predicted[ch][:, a:b]
             spread = float(np.var(draws.mean(axis=1), ddof=1)) if len(draws) > 1 else 0.0
             se = math.sqrt(ar1_mean_sd(nz.sd, nz.rho_long_run, n) ** 2 + nz.offset_sd**2 + spread)

@@ -1,0 +1,155 @@
+"""Does ``diagnose`` name the hidden cause? A confusion matrix over simulated records.
+
+Records: the project's simulator with one hidden mechanism each at a documented detectable
+strength (below), f, nu, striker speed, rise time, noise levels and offsets drawn over their
+ranges (as ``bench_misfit.py``), both bundled set-ups; plus clean records. Each goes through
+``friction-uq run --diagnose``'s path (stationary posterior maximum, then
+:func:`friction_uq.discrepancy.diagnose.diagnose`).
+
+    python benchmarks/bench_diagnose.py [--per 8] [--clean 40] [--seed 3]
+
+Prints, per hidden mechanism: how often the first named cause is it (exact), how often it is
+named or listed as not separable from the named one (named-or-inseparable), false alarms on clean
+records, the coverage of f's 90 % interval under the chosen model (truth: the wall's coefficient
+at the window's mean sliding speed, pressure and slip), and the time per record.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import os
+import sys
+import tempfile
+import time
+from collections import Counter
+from types import MappingProxyType
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_misfit import clean_config, with_gain  # noqa: E402
+
+from friction_uq.analysis import prepare  # noqa: E402
+from friction_uq.discrepancy.diagnose import diagnose  # noqa: E402
+from friction_uq.errors import FrictionUQError  # noqa: E402
+from friction_uq.likelihood import Likelihood  # noqa: E402
+from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+from friction_uq.record import read_record  # noqa: E402
+from friction_uq.sampler import LogPosterior, start_ball, to_theta  # noqa: E402
+from friction_uq.simulate import simulate_to_file  # noqa: E402
+
+#: Hidden mechanism -> config edit at a detectable strength (and the truth's f at the window).
+HIDDEN = {
+    "plug_friction": lambda c, r: dataclasses.replace(c, plug_friction_force=float(r.uniform(200, 400)),
+                                                      plug_friction_coefficient=float(r.uniform(0.01, 0.02))),
+    "gauge_gain": lambda c, r: with_gain(c, "external_output_bar", float(r.choice([0.88, 1.12]))),
+    "clearance": lambda c, r: dataclasses.replace(c, gap=float(r.uniform(5e-6, 12e-6)), tube_compliance=True),
+    "velocity_friction": lambda c, r: dataclasses.replace(c, friction_law="velocity", friction_params=MappingProxyType(
+        {"f_s": float(r.uniform(0.07, 0.09)), "f_d": float(r.uniform(0.03, 0.04)), "v_c": float(r.uniform(5, 10))})),
+    "pressure_friction": lambda c, r: dataclasses.replace(c, friction_law="hyperbolic", friction_params=MappingProxyType(
+        {"f0": float(r.uniform(0.07, 0.1)), "p0": float(r.uniform(5e7, 1e8))})),
+    "slip_friction": lambda c, r: dataclasses.replace(c, friction_law="slip_weakening", friction_params=MappingProxyType(
+        {"f_s": float(r.uniform(0.09, 0.12)), "f_d": float(r.uniform(0.04, 0.06)), "d_c": float(r.uniform(5e-4, 2e-3))})),
+    "dispersion": lambda c, r: dataclasses.replace(c, dispersion=True),
+    "end_friction": lambda c, r: dataclasses.replace(c, end_friction=float(r.uniform(0.15, 0.25))),
+}
+
+
+def true_f(cfg, prep) -> float:
+    """The wall's coefficient at the window's mean sliding speed, pressure and slip (as f_effective)."""
+    p = cfg.friction_params
+    d = prep.data
+    V, slip = float(np.mean(d.V)), float(np.mean(d.slip))
+    law = cfg.friction_law
+    if law == "coulomb":
+        return p["f"]
+    if law == "velocity":
+        return p["f_d"] + (p["f_s"] - p["f_d"]) * math.exp(-V / p["v_c"])
+    if law == "slip_weakening":
+        return p["f_d"] + (p["f_s"] - p["f_d"]) * max(0.0, 1.0 - slip / p["d_c"])
+    if law == "hyperbolic":  # p_mean from tau_mean and the truth's f (fixed point)
+        tau = float(np.mean(d.F_eo)) / (2 * math.pi * d.radius * d.length)
+        f = p["f0"]
+        for _ in range(50):
+            f = p["f0"] / (1.0 + tau / f / p["p0"])
+        return f
+    raise ValueError(law)
+
+
+def analyse(path: str, priors, seed: int):
+    rec = read_record(path)
+    prep = prepare(rec)
+    lp = LogPosterior(Likelihood(prep.data, hoop=True), priors)
+    z_map, _ = start_ball(lp, priors, nwalkers=8, n_ensembles=1, rng=np.random.default_rng(seed))
+    th = to_theta(z_map[None])[0]
+
+    def log_prior(v):
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    return prep, diagnose(prep, log_prior, {"f": th[0], "nu": th[1]}, hoop=True, seed=seed, n_draws=200)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--per", type=int, default=8)
+    ap.add_argument("--clean", type=int, default=40)
+    ap.add_argument("--seed", type=int, default=3)
+    args = ap.parse_args()
+    priors = load_priors(default_prior_path("I1"))
+    rng = np.random.default_rng(args.seed)
+    tmp = tempfile.mkdtemp()
+    jobs = [("clean", None)] * args.clean + [(m, f) for m, f in HIDDEN.items() for _ in range(args.per)]
+    stats: dict[str, Counter] = {}
+    secs = []
+    for k, (hidden, make) in enumerate(jobs):
+        cfg = clean_config(rng, "A" if k % 2 == 0 else "B")
+        if make is not None:
+            cfg = make(cfg, rng)
+        path = os.path.join(tmp, f"r{k}.h5")
+        simulate_to_file(cfg, path, seed=int(rng.integers(2**31)))
+        c = stats.setdefault(hidden, Counter())
+        c["n"] += 1
+        t = time.perf_counter()
+        try:
+            prep, dg = analyse(path, priors, seed=k)
+        except FrictionUQError as exc:
+            c["refused"] += 1
+            print(f"{k:4d} {hidden:<18} refused: {exc}", file=sys.stderr, flush=True)
+            continue
+        secs.append(time.perf_counter() - t)
+        named = dg.cause.mechanism.name if dg.cause else None
+        c[f"named:{named}"] += 1
+        if hidden == "clean":
+            c["alarm"] += named is not None
+        else:
+            c["exact"] += named == hidden
+            c["named_or_inseparable"] += named == hidden or hidden in dg.not_separable
+            fx = dg.final.f_summary()
+            tf = true_f(cfg, prep)
+            c["covered"] += fx["q05"] <= tf <= fx["q95"]
+        print(f"{k:4d} {hidden:<18} named {named} causes {[v.label for v in dg.causes]} not_sep {list(dg.not_separable)} "
+              f"f {dg.final.f_summary()['q50']:.4f} [{dg.final.f_summary()['q05']:.4f}, {dg.final.f_summary()['q95']:.4f}] "
+              f"{secs[-1]:.1f} s", file=sys.stderr, flush=True)
+        os.remove(path)
+    names = ["clean"] + list(HIDDEN)
+    print(f"{'hidden':<18} {'n':>3} {'exact':>6} {'named/insep':>11} {'f covered':>9} {'alarm':>6} {'refused':>7}  first named cause")
+    for h in names:
+        c = stats.get(h, Counter())
+        n = max(c["n"] - c["refused"], 1)
+        tally = ", ".join(f"{k.split(':', 1)[1]} {v}" for k, v in sorted(c.items()) if k.startswith("named:"))
+        if h == "clean":
+            print(f"{h:<18} {c['n']:>3} {'-':>6} {'-':>11} {'-':>9} {c['alarm'] / n:>6.2f} {c['refused']:>7}  {tally}")
+        else:
+            print(f"{h:<18} {c['n']:>3} {c['exact'] / n:>6.2f} {c['named_or_inseparable'] / n:>11.2f} "
+                  f"{c['covered'] / n:>9.2f} {'-':>6} {c['refused']:>7}  {tally}")
+    eff = [h for h in HIDDEN]
+    tot = sum(stats[h]["n"] - stats[h]["refused"] for h in eff)
+    print(f"all effect records: exact {sum(stats[h]['exact'] for h in eff) / tot:.2f}, named or inseparable "
+          f"{sum(stats[h]['named_or_inseparable'] for h in eff) / tot:.2f}, f covered "
+          f"{sum(stats[h]['covered'] for h in eff) / tot:.2f}; time per record median {np.median(secs):.1f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,127 @@
+"""The mechanism catalogue and diagnose: hide an effect in a simulated record, require finding it.
+
+The default suite gates a small sample (one record per effect, one clean record); the study over
+many records with varied f, nu, striker speed and seed is ``benchmarks/bench_diagnose.py``.
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+
+import numpy as np
+import pytest
+
+from friction_uq.analysis import prepare
+from friction_uq.discrepancy import outcome
+from friction_uq.discrepancy.diagnose import beyond, candidates, diagnose
+from friction_uq.discrepancy.mechanisms import MECHANISMS, Mechanism, register
+from friction_uq.models.parameters import F, HOOP_GAIN, NU
+from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.record import read_record
+from friction_uq.simulate import SimulationConfig, simulate_to_file
+from friction_uq.simulate.config import ChannelSpec
+
+REQUIRED = ("velocity_friction", "pressure_friction", "slip_friction", "clearance", "plug_friction", "gauge_gain",
+            "dispersion", "end_friction")
+
+
+def test_the_catalogue_has_the_required_mechanisms_with_priors_and_meaning():
+    assert set(REQUIRED) <= set(MECHANISMS)
+    base = {F.name, NU.name, HOOP_GAIN.name, "sample_modulus"}
+    for m in MECHANISMS.values():
+        assert m.meaning and m.signature
+        for p in m.parameters:
+            assert p.name not in base
+            prior = m.priors[p.name]
+            lo, hi = prior.ppf(0.001), prior.ppf(0.999)
+            assert p.low <= lo < hi <= p.high, (m.name, p.name)  # the prior lives on the physical range
+            assert p.contains(m.start[p.name]), (m.name, p.name)
+    assert MECHANISMS["gauge_gain"].channels == ("input_bar", "internal_output_bar", "external_output_bar")
+
+
+def test_a_mechanism_is_registered_once():
+    with pytest.raises(ValueError, match="registered twice"):
+        register(MECHANISMS["clearance"])
+    with pytest.raises(ValueError, match="no prior or start"):
+        register(Mechanism(name="x", meaning="m", signature="s", parameters=(F,), priors={}, start={},
+                           apply=lambda v, s, g, ch: None))
+
+
+def test_one_friction_law_at_a_time():
+    after_velocity = {v.mechanism.name for v in candidates(exclude=("velocity_friction",))}
+    assert not after_velocity & {"velocity_friction", "pressure_friction", "slip_friction"}
+    assert {"clearance", "plug_friction", "dispersion"} <= after_velocity
+    assert len(candidates()) == len(MECHANISMS) + 2  # gauge_gain once per bar gauge
+
+
+def test_decisive_rule():
+    assert not beyond(3.9, 0.1, 40)  # below 4: never
+    assert beyond(10.0, 4.0, 40)  # > 2 SE
+    assert not beyond(10.0, 6.0, 40)
+    assert beyond(500.0, 400.0, 40)  # strong, concentrated evidence
+
+
+def _config(**kw) -> SimulationConfig:
+    ch = {
+        "input_bar": ChannelSpec(white=3e-6, ar1=2e-6, ar1_coef=0.5, offset=1e-5),
+        "internal_output_bar": ChannelSpec(white=2e-6, ar1=2e-6, ar1_coef=0.4, offset=-5e-6),
+        "external_output_bar": ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, offset=1e-6),
+        "tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3),
+    }
+    ch.update(kw.pop("channels", {}))
+    return SimulationConfig(channels=MappingProxyType(ch), **kw)
+
+
+def _diagnose(tmp_path, cfg, seed):
+    path = tmp_path / "r.h5"
+    simulate_to_file(cfg, path, seed=seed)
+    prep = prepare(read_record(path))
+    priors = load_priors(default_prior_path("I1"))
+
+    def log_prior(v):
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    from friction_uq.analysis import identify
+
+    lab = identify(prep, nu=0.4)
+    return prep, diagnose(prep, log_prior, {"f": lab.f, "nu": 0.4}, hoop=True, seed=seed)
+
+
+def test_clean_record_names_no_cause(tmp_path):
+    prep, dg = _diagnose(tmp_path, _config(striker_velocity=9.0, poisson_ratio=0.39,
+                                           friction_params=MappingProxyType({"f": 0.06})), seed=21)
+    assert dg.cause is None, [(r.fit.label, r.delpd, r.se) for r in dg.ranking]
+    fx = dg.final.f_summary()
+    assert fx["q05"] <= 0.06 <= fx["q95"]
+    doc = outcome.to_json(dg, {"mean": 0.06, "sd": 0.003, "q05": 0.055, "q50": 0.06, "q95": 0.065})
+    assert doc["cause"] is None and doc["not_separable"] == []
+    assert "No mechanism" in doc["sentence"]
+
+
+def test_plug_friction_is_named_and_f_recovered(tmp_path):
+    prep, dg = _diagnose(tmp_path, _config(striker_velocity=11.0, plug_friction_force=300.0,
+                                           plug_friction_coefficient=0.015,
+                                           friction_params=MappingProxyType({"f": 0.05})), seed=22)
+    assert dg.cause is not None and dg.cause.mechanism.name == "plug_friction"
+    fx = dg.final.f_summary()
+    assert fx["q05"] <= 0.05 <= fx["q95"], fx
+    doc = outcome.to_json(dg, {"mean": 0.06, "sd": 0.003, "q05": 0.055, "q50": 0.06, "q95": 0.065})
+    assert doc["cause"] == "plug_friction"
+    assert {"name", "delpd", "se", "parameters"} <= set(doc["ranking"][0])
+    assert "plug_friction" in doc["sentence"] and "with it" in doc["sentence"]
+
+
+def test_external_gauge_gain_is_named_with_its_channel(tmp_path):
+    prep, dg = _diagnose(tmp_path, _config(channels={"external_output_bar": ChannelSpec(
+        white=1e-6, ar1=1e-6, ar1_coef=0.6, gain=1.12)}), seed=23)
+    assert dg.cause is not None
+    assert (dg.cause.mechanism.name, dg.cause.channel) == ("gauge_gain", "external_output_bar")
+    g = dg.final.fit.draws["gain"]
+    assert np.quantile(g, 0.005) <= 1.12 <= np.quantile(g, 0.995)
+
+
+def test_clearance_is_named_and_the_gap_measured(tmp_path):
+    prep, dg = _diagnose(tmp_path, _config(gap=8e-6, tube_compliance=True), seed=24)
+    assert dg.cause is not None and dg.cause.mechanism.name == "clearance"
+    gap = dg.final.fit.draws["gap"]
+    assert np.quantile(gap, 0.005) <= 8e-6 <= np.quantile(gap, 0.995)
