@@ -78,7 +78,7 @@ def true_f(cfg, prep) -> float:
     raise ValueError(law)
 
 
-def analyse(path: str, priors, seed: int):
+def analyse(path: str, priors, seed: int, max_causes: int):
     rec = read_record(path)
     prep = prepare(rec)
     lp = LogPosterior(Likelihood(prep.data, hoop=True), priors)
@@ -88,7 +88,8 @@ def analyse(path: str, priors, seed: int):
     def log_prior(v):
         return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
 
-    return prep, diagnose(prep, log_prior, {"f": th[0], "nu": th[1]}, hoop=True, seed=seed, n_draws=200)
+    return prep, diagnose(prep, log_prior, {"f": th[0], "nu": th[1]}, hoop=True, seed=seed, n_draws=1000,
+                          max_causes=max_causes)
 
 
 def main() -> None:
@@ -96,6 +97,8 @@ def main() -> None:
     ap.add_argument("--per", type=int, default=8)
     ap.add_argument("--clean", type=int, default=40)
     ap.add_argument("--seed", type=int, default=3)
+    ap.add_argument("--max-causes", type=int, default=1,
+                    help="causes searched in turn (1: the first named cause, what the study scores)")
     args = ap.parse_args()
     priors = load_priors(default_prior_path("I1"))
     rng = np.random.default_rng(args.seed)
@@ -113,7 +116,7 @@ def main() -> None:
         c["n"] += 1
         t = time.perf_counter()
         try:
-            prep, dg = analyse(path, priors, seed=k)
+            prep, dg = analyse(path, priors, seed=k, max_causes=args.max_causes)
         except FrictionUQError as exc:
             c["refused"] += 1
             print(f"{k:4d} {hidden:<18} refused: {exc}", file=sys.stderr, flush=True)

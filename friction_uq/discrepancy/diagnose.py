@@ -257,7 +257,7 @@ def rank(reference: ModelFit, fits: list[ModelFit]) -> tuple[Ranked, ...]:
 
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
              hoop: bool, seed: int, n_draws: int = 1000, progress: Callable[[str], None] | None = None,
-             base_scales: Mapping[str, tuple[float, float]] | None = None) -> Diagnosis:
+             base_scales: Mapping[str, tuple[float, float]] | None = None, max_causes: int = MAX_CAUSES) -> Diagnosis:
     """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring).
 
     ``base_scales``: Gaussian stand-ins (centre, sd in the unbounded coordinate) of the f and nu
@@ -273,7 +273,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     rounds: list[tuple[Ranked, ...]] = []
     not_sep: tuple[str, ...] = ()
     separate_by = None
-    for k in range(MAX_CAUSES):
+    for k in range(max_causes):
         fits = []
         used = tuple(v.mechanism.name for v in causes)
         for cand in candidates(exclude=used):
