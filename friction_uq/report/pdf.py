@@ -10,9 +10,9 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from .._atomic import atomic_path
+from .._atomic import write_bytes
 from ..analysis import Identification, Prepared
-from ..diagnostics import Convergence, FNuBand, FUnderPrior, RatioPPC, VariableSummary
+from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
@@ -38,6 +38,7 @@ class ReportInputs:
     lab: Identification
     V: VariableSummary
     version: str
+    conflict: PriorDataConflict | None = None
 
 
 def _fmt(v: float) -> str:
@@ -69,10 +70,13 @@ def page_summary(r: ReportInputs) -> Figure:
         f"Posterior predictive check: the observed ratio lies in the 90 % band {100 * r.ppc.coverage:.0f} % of "
         "the window" + (" - the constant-ratio model misses something here (page 7)." if r.ppc.coverage < 0.7 else "."),
     ]
+    if r.conflict is not None:
+        lines.append(r.conflict.sentence())
     y = 0.97
     for line in lines:
-        ax.text(0.0, y, line, fontsize=11, va="top", wrap=True, transform=ax.transAxes)
-        y -= 0.065
+        color = "firebrick" if line.startswith("WARNING") else "black"
+        ax.text(0.0, y, line, fontsize=10.5, va="top", wrap=True, transform=ax.transAxes, color=color)
+        y -= 0.058
     rows = []
     for name, v in list(s.items()) + [("V", r.V)]:
         unit, scale = UNITS.get(name, ("", 1.0))
@@ -93,15 +97,17 @@ def page_summary(r: ReportInputs) -> Figure:
     return fig
 
 
-def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
-    """Write the PDF (summary page, pages 1-7, and page 8 when the hoop term was used) atomically."""
+def render_report(r: ReportInputs) -> bytes:
+    """The PDF (summary page, pages 1-7, and page 8 when the hoop term was used), in memory."""
+    import io
+
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
     p = r.prepared
-    out = Path(path)
     meta = {"Title": f"friction-uq {p.record.campaign} {p.record.test_id}", "Creator": f"friction-uq {r.version}"}
-    with atomic_path(out) as tmp, PdfPages(tmp, metadata=meta) as pdf:
+    buf = io.BytesIO()
+    with PdfPages(buf, metadata=meta) as pdf:
         builders = [
             lambda: page_summary(r),
             lambda: page_raw(p.record),
@@ -118,4 +124,9 @@ def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
             fig = build()
             pdf.savefig(fig)
             plt.close(fig)
-    return out
+    return buf.getvalue()
+
+
+def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
+    """Write the PDF of :func:`render_report` atomically."""
+    return write_bytes(path, render_report(r))
