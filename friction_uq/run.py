@@ -62,6 +62,7 @@ class RunResult:
     conflict: PriorDataConflict | None = None
     notes: tuple[str, ...] = ()
     stages: dict[str, float] = dataclasses.field(default_factory=dict)
+    sensitivity: dict[str, FUnderPrior] = dataclasses.field(default_factory=dict)
 
 
 def safe_stem(campaign: str, test_id: str) -> str:
@@ -293,7 +294,7 @@ def run_file(
     outputs = {k: p for k, p in names.items() if k != "pdf" or pdf_bytes is not None}
     if table:
         print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, conflict))
-    return RunResult(prep, samples, summary, conv, lab, outputs, seconds, conflict, tuple(said), stages)
+    return RunResult(prep, samples, summary, conv, lab, outputs, seconds, conflict, tuple(said), stages, sens)
 
 
 def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,

@@ -26,9 +26,10 @@ Design
   the chain is longer than ``tau_factor`` (50) tau and tau changed by less than ``tau_rtol``
   (1 %) since the previous check. At ``max_steps`` it stops anyway with a
   :class:`ConvergenceWarning` and ``converged=False`` in the result.
-* **Draws.** burn-in 3 max(tau), thinning max(1, tau_min / 2), and coarser if needed to keep at most ``max_draws`` (4000) draws. A chain's draws are its walkers'
-  thinned sequences one after the other (walker-major), so autocorrelation along ``draw`` is the
-  walkers' own and ArviZ's ESS is not inflated by interleaving walkers.
+* **Draws.** burn-in 3 max(tau), thinning max(1, tau_min / 2), coarser where needed to keep at
+  most ``max_draws`` (4000) draws. A chain's draws are its walkers' thinned sequences one after
+  the other (walker-major), so autocorrelation along ``draw`` is the walkers' own and ArviZ's ESS
+  is not inflated by interleaving walkers.
 * **Resuming.** With ``backend_path`` the chain is sampled in memory and saved, with the random
   state, at a convergence check when ``checkpoint_seconds`` (2 s) have passed since the last save,
   and when sampling ends (:mod:`.checkpoint`; saving every step cost about half the sampling
