@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -75,18 +76,21 @@ def page_summary(r: ReportInputs) -> Figure:
     y = 0.97
     for line in lines:
         color = "firebrick" if line.startswith("WARNING") else "black"
-        ax.text(0.0, y, line, fontsize=10.5, va="top", wrap=True, transform=ax.transAxes, color=color)
-        y -= 0.058
+        # wrapped here, not by matplotlib (whose wrap=True measures the text word by word)
+        text = "\n".join(textwrap.wrap(line, 150))
+        ax.text(0.0, y, text, fontsize=10, va="top", transform=ax.transAxes, color=color)
+        y -= 0.034 * (text.count("\n") + 1) + 0.016
     rows = []
     for name, v in list(s.items()) + [("V", r.V)]:
         unit, scale = UNITS.get(name, ("", 1.0))
         rows.append([name, unit, _fmt(v.mean * scale), _fmt(v.sd * scale), _fmt(v.q05 * scale), _fmt(v.q50 * scale),
                      _fmt(v.q95 * scale), f"{v.r_hat:.4f}" if np.isfinite(v.r_hat) else "-",
                      f"{v.ess_bulk:.0f}" if np.isfinite(v.ess_bulk) else "-"])
-    tab = ax.table(cellText=rows, colLabels=["quantity", "unit", "mean", "sd", "q05", "q50", "q95", "R-hat", "ESS"],
-                   loc="lower left", bbox=[0.0, 0.05, 0.75, 0.42])
-    tab.auto_set_font_size(False)
-    tab.set_fontsize(9)
+    head = ["quantity", "unit", "mean", "sd", "q05", "q50", "q95", "R-hat", "ESS"]
+    table = "\n".join(f"{c[0]:<10}{c[1]:<5}" + "".join(f"{x:>11}" for x in c[2:]) for c in [head] + rows)
+    # one monospace text block: a matplotlib table draws every cell as its own text and frame
+    ax.text(0.0, 0.05, table, fontsize=10, family="monospace", va="bottom", transform=ax.transAxes,
+            bbox={"facecolor": "white", "edgecolor": "0.6", "pad": 6})
     prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
             f"seed {r.samples.seed}, friction-uq {r.version}")
     ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
