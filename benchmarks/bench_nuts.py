@@ -91,7 +91,7 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--seed", type=int, default=1)
     a = ap.parse_args(argv)
     try:
-        import numpyro  # noqa: F401
+        import numpyro  # noqa: F401  (the optional extra)
     except ImportError:
         print("NUTS comparison needs the optional extra: pip install -e '.[bench]' (numpyro, jax)")
         return 1

@@ -35,6 +35,12 @@ from .prior_sensitivity import FUnderPrior, PriorDataConflict, nu_sensitivity, p
 from .sampler import PosteriorSamples
 from .window import StationaryData
 
+__all__ = [
+    "Convergence", "FNuBand", "FUnderPrior", "PriorDataConflict", "RatioPPC", "VariableSummary", "build_datatree",
+    "convergence", "derived_draws", "f_given_nu", "nu_sensitivity", "nu_variance_share", "pointwise_log_likelihood",
+    "prior_data_conflict", "ratio_ppc", "summarize",
+]
+
 #: Variables summarised, in report order (hoop_gain only when sampled).
 SUMMARY_VARIABLES = ("f", "nu", "kappa", "hoop_gain", "ratio", "p_mean", "tau_mean")
 #: Probabilities of the quantiles reported everywhere.

@@ -33,7 +33,6 @@ from .diagnostics import (
     Convergence,
     VariableSummary,
     build_datatree,
-    PriorDataConflict,
     convergence,
     f_given_nu,
     nu_sensitivity,
@@ -42,7 +41,8 @@ from .diagnostics import (
     ratio_ppc,
     summarize,
 )
-from .errors import FrictionUQError, OutputError, check_seed, os_error_text
+from .errors import OutputError, check_seed, os_error_text
+from .prior_sensitivity import FUnderPrior, PriorDataConflict
 from .priors import PRIORS_DIR, Priors, default_prior_path, load_priors
 from .record import read_record
 from .sampler import PosteriorSamples, sample_posterior, stderr_progress

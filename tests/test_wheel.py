@@ -88,16 +88,22 @@ def test_installed_wheel_runs_from_another_folder(wheel, tmp_path):
 
 
 def _other_pythons() -> list[str]:
-    found = []
-    for name in ("python3.13", "python3.12"):
-        exe = shutil.which(name)
-        if exe is None:
+    """Interpreters >= 3.12 other than this one's version: on PATH, or installed by pyenv."""
+    cands = [shutil.which(n) for n in ("python3.13", "python3.12")]
+    pyenv = shutil.which("pyenv")
+    if pyenv:
+        root = subprocess.run([pyenv, "root"], capture_output=True, text=True).stdout.strip()
+        bare = subprocess.run([pyenv, "versions", "--bare"], capture_output=True, text=True).stdout.split()
+        cands += [str(Path(root) / "versions" / v / "bin" / "python3") for v in bare if v.startswith(("3.12", "3.13"))]
+    found: dict[str, str] = {}
+    for exe in filter(None, cands):
+        r = subprocess.run([exe, "-c", "import sys; print(*sys.version_info[:2])"], capture_output=True, text=True)
+        if r.returncode != 0:
             continue
-        r = subprocess.run([exe, "-c", "import sys; print(sys.version_info[:2] >= (3, 12), sys.version_info[:2])"],
-                           capture_output=True, text=True)
-        if r.returncode == 0 and r.stdout.startswith("True") and f"{sys.version_info[:2]}" not in r.stdout:
-            found.append(exe)
-    return found
+        version = tuple(map(int, r.stdout.split()))
+        if version >= (3, 12) and version != sys.version_info[:2]:
+            found.setdefault(".".join(map(str, version)), exe)
+    return list(found.values())
 
 
 @pytest.mark.slow
