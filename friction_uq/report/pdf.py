@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,9 +11,9 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from .._atomic import atomic_path
+from .._atomic import write_bytes
 from ..analysis import Identification, Prepared
-from ..diagnostics import Convergence, FNuBand, FUnderPrior, RatioPPC, VariableSummary
+from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
@@ -38,6 +39,7 @@ class ReportInputs:
     lab: Identification
     V: VariableSummary
     version: str
+    conflict: PriorDataConflict | None = None
 
 
 def _fmt(v: float) -> str:
@@ -69,20 +71,26 @@ def page_summary(r: ReportInputs) -> Figure:
         f"Posterior predictive check: the observed ratio lies in the 90 % band {100 * r.ppc.coverage:.0f} % of "
         "the window" + (" - the constant-ratio model misses something here (page 7)." if r.ppc.coverage < 0.7 else "."),
     ]
+    if r.conflict is not None:
+        lines.append(r.conflict.sentence())
     y = 0.97
     for line in lines:
-        ax.text(0.0, y, line, fontsize=11, va="top", wrap=True, transform=ax.transAxes)
-        y -= 0.065
+        color = "firebrick" if line.startswith("WARNING") else "black"
+        # wrapped here, not by matplotlib (whose wrap=True measures the text word by word)
+        text = "\n".join(textwrap.wrap(line, 150))
+        ax.text(0.0, y, text, fontsize=10, va="top", transform=ax.transAxes, color=color)
+        y -= 0.034 * (text.count("\n") + 1) + 0.016
     rows = []
     for name, v in list(s.items()) + [("V", r.V)]:
         unit, scale = UNITS.get(name, ("", 1.0))
         rows.append([name, unit, _fmt(v.mean * scale), _fmt(v.sd * scale), _fmt(v.q05 * scale), _fmt(v.q50 * scale),
                      _fmt(v.q95 * scale), f"{v.r_hat:.4f}" if np.isfinite(v.r_hat) else "-",
                      f"{v.ess_bulk:.0f}" if np.isfinite(v.ess_bulk) else "-"])
-    tab = ax.table(cellText=rows, colLabels=["quantity", "unit", "mean", "sd", "q05", "q50", "q95", "R-hat", "ESS"],
-                   loc="lower left", bbox=[0.0, 0.05, 0.75, 0.42])
-    tab.auto_set_font_size(False)
-    tab.set_fontsize(9)
+    head = ["quantity", "unit", "mean", "sd", "q05", "q50", "q95", "R-hat", "ESS"]
+    table = "\n".join(f"{c[0]:<10}{c[1]:<5}" + "".join(f"{x:>11}" for x in c[2:]) for c in [head] + rows)
+    # one monospace text block: a matplotlib table draws every cell as its own text and frame
+    ax.text(0.0, 0.05, table, fontsize=10, family="monospace", va="bottom", transform=ax.transAxes,
+            bbox={"facecolor": "white", "edgecolor": "0.6", "pad": 6})
     prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
             f"seed {r.samples.seed}, friction-uq {r.version}")
     ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
@@ -93,15 +101,17 @@ def page_summary(r: ReportInputs) -> Figure:
     return fig
 
 
-def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
-    """Write the PDF (summary page, pages 1-7, and page 8 when the hoop term was used) atomically."""
+def render_report(r: ReportInputs) -> bytes:
+    """The PDF (summary page, pages 1-7, and page 8 when the hoop term was used), in memory."""
+    import io
+
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
     p = r.prepared
-    out = Path(path)
     meta = {"Title": f"friction-uq {p.record.campaign} {p.record.test_id}", "Creator": f"friction-uq {r.version}"}
-    with atomic_path(out) as tmp, PdfPages(tmp, metadata=meta) as pdf:
+    buf = io.BytesIO()
+    with PdfPages(buf, metadata=meta) as pdf:
         builders = [
             lambda: page_summary(r),
             lambda: page_raw(p.record),
@@ -118,4 +128,9 @@ def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
             fig = build()
             pdf.savefig(fig)
             plt.close(fig)
-    return out
+    return buf.getvalue()
+
+
+def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
+    """Write the PDF of :func:`render_report` atomically."""
+    return write_bytes(path, render_report(r))
