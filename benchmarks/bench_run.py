@@ -1,47 +1,100 @@
-"""Benchmark of the main job: ``friction-uq run`` on bundled records, end to end with the PDF.
+"""Benchmark of the main job: ``friction-uq run`` on a bundled record, end to end with the PDF.
 
-Target (issue 4): <= 30 s per record on a 2-core machine. Prints a table: wall time, sampler time,
-steps, ESS (bulk, min over variables), ESS per second of f, R-hat max.
+Target (issue 7): <= 5 s wall per record with the PDF on 2 cores, median of 5 runs of the
+command as a user starts it (a new process each time, imports included). Prints
 
-    python benchmarks/bench_run.py [RECORD ...]
+1. the command's wall and CPU time (user + sys of the process) for each of the ``--repeat`` runs
+   and their median;
+2. the breakdown of one in-process run: imports, signals (read, forces, window), sampling, the
+   DataTree (pointwise log-likelihood, ESS, R-hat), sensitivity (nu priors by PSIS reweighting,
+   prior-data conflict), outputs (netCDF, JSON, renames), PDF;
+3. ESS of f (bulk and tail; must be >= 2000), ESS per second of sampling, steps, R-hat max.
+
+On a shared machine wall times are noisy: quote CPU time beside them.
+
+    python benchmarks/bench_run.py [RECORD] [--repeat 5] [--no-pdf]
 """
 
 from __future__ import annotations
 
+import argparse
+import resource
+import statistics
+import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-import arviz_stats
-
 ROOT = Path(__file__).resolve().parents[1]
-DEFAULT = [ROOT / "data" / "A" / "A-03.h5", ROOT / "data" / "B" / "B-03.h5"]
+DEFAULT = ROOT / "data" / "A" / "A-03.h5"
+
+
+def _cpu_children() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def command_times(record: Path, repeat: int, pdf: bool) -> list[tuple[float, float]]:
+    """(wall, cpu) of ``friction-uq run RECORD`` in a new process, ``repeat`` times."""
+    rows = []
+    for k in range(repeat):
+        with tempfile.TemporaryDirectory() as out:
+            cmd = [sys.executable, "-m", "friction_uq.cli", "run", str(record), "--out", out, "--quiet", "--seed", "1"]
+            if not pdf:
+                cmd.append("--no-pdf")
+            c0, t0 = _cpu_children(), time.perf_counter()
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            wall, cpu = time.perf_counter() - t0, _cpu_children() - c0
+            if r.returncode != 0:
+                raise SystemExit(r.stderr)
+            rows.append((wall, cpu))
+            print(f"run {k + 1}: wall {wall:5.2f} s, cpu {cpu:5.2f} s", flush=True)
+    return rows
+
+
+def breakdown(record: Path, pdf: bool) -> None:
+    """Stage times of one in-process run, in a new process (so imports are measured cold)."""
+    code = f"""
+import time, tempfile
+t0 = time.perf_counter()
+from friction_uq.run import run_file
+{'import friction_uq.report.pdf' if pdf else ''}
+imports = time.perf_counter() - t0
+import arviz_stats, xarray as xr
+with tempfile.TemporaryDirectory() as out:
+    res = run_file({str(record)!r}, out_dir=out, seed=1, pdf={pdf}, progress=False, table=False, notes=False)
+    dt = xr.open_datatree(res.outputs["netcdf"], engine="h5netcdf")
+    bulk = float(arviz_stats.ess(dt, var_names=["f"], method="bulk")["f"].values)
+    tail = float(arviz_stats.ess(dt, var_names=["f"], method="tail")["f"].values)
+st = dict(imports=imports, **res.stages)
+print()
+print("stage        seconds")
+for k in ("imports", "signals", "sampling", "datatree", "sensitivity", "outputs", "pdf"):
+    print(f"{{k:<12}} {{st.get(k, 0.0):7.2f}}")
+print(f"{{'sum':<12}} {{sum(st.values()):7.2f}}")
+print()
+s = res.samples
+print(f"steps {{s.n_steps}} x {{s.nwalkers}} walkers x {{s.n_chains}} ensembles, tau max {{s.tau.max():.1f}}, "
+      f"draws {{s.n_chains * s.n_draws}}; ESS of f: bulk {{bulk:.0f}}, tail {{tail:.0f}} (needs >= 2000); "
+      f"{{bulk / s.seconds:.0f}} ESS/s of sampling; R-hat max {{res.convergence.r_hat_max:.4f}}")
+print("nu priors: " + ", ".join(f"{{k}} {{v.method}} (k {{v.pareto_k:.2f}})" for k, v in res.sensitivity.items()))
+"""
+    subprocess.run([sys.executable, "-c", code], check=True)
 
 
 def main(argv: list[str]) -> int:
-    from friction_uq.run import run_file
-    from friction_uq.sampler import PosteriorSamples  # noqa: F401  (import cost outside the timing)
-    import friction_uq.report.pdf  # noqa: F401
-
-    records = [Path(a) for a in argv] or DEFAULT
-    rows = []
-    for rec in records:
-        with tempfile.TemporaryDirectory() as out:
-            t0 = time.perf_counter()
-            res = run_file(rec, out_dir=out, seed=1, progress=False)
-            wall = time.perf_counter() - t0
-            import xarray as xr
-
-            dt = xr.open_datatree(res.outputs["netcdf"], engine="h5netcdf")
-            ess_f = float(arviz_stats.ess(dt, var_names=["f"], method="bulk")["f"].values)
-            rows.append((rec.name, wall, res.samples.seconds, res.samples.n_steps, res.convergence.ess_bulk_min,
-                         ess_f / res.samples.seconds, res.convergence.r_hat_max))
-    print()
-    print(f"{'record':<10} {'wall s':>7} {'sampler s':>9} {'steps':>6} {'ESS min':>8} {'ESS/s f':>8} {'R-hat':>7}")
-    for r in rows:
-        print(f"{r[0]:<10} {r[1]:>7.1f} {r[2]:>9.1f} {r[3]:>6d} {r[4]:>8.0f} {r[5]:>8.0f} {r[6]:>7.4f}")
-    print("target: wall <= 30 s per record (issue 4)")
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("record", nargs="?", type=Path, default=DEFAULT)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--no-pdf", action="store_true")
+    a = ap.parse_args(argv)
+    pdf = not a.no_pdf
+    print(f"friction-uq run {a.record.name}{'' if pdf else ' --no-pdf'}: {a.repeat} runs, each a new process")
+    rows = command_times(a.record, a.repeat, pdf)
+    print(f"median: wall {statistics.median(r[0] for r in rows):.2f} s, cpu {statistics.median(r[1] for r in rows):.2f} s "
+          f"(target: wall <= 5 s with the PDF on 2 cores)")
+    breakdown(a.record, pdf)
     return 0
 
 

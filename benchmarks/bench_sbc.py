@@ -36,7 +36,7 @@ def main(argv: list[str] | None = None) -> int:
     cases = [False] if a.no_hoop else [True] if a.hoop_only else [False, True]
     lo, hi = binomial_band(a.n, 0.9, 0.95)
     source = "records" if a.records else "closed-form"
-    print(f"SBC ({source}): {a.n} replicas per likelihood, truth from priors/I1.toml, seed {a.seed}; "
+    print(f"SBC ({source}): {a.n} replicas per likelihood, truth from the packaged I1.toml, seed {a.seed}; "
           f"binomial 95 % band around 0.90: [{lo:.3f}, {hi:.3f}]")
     ok = True
     for hoop in cases:

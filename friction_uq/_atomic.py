@@ -1,31 +1,196 @@
 """Atomic file output: write to a temporary name in the same folder, then rename.
 
 A file written this way appears whole or not at all, with the permissions an ordinary file gets
-(``mkstemp`` alone would leave it 0600).
+(``mkstemp`` alone would leave it 0600). Temporary names are ``.<name>.<random>.tmp<suffix>``
+(:func:`temporary_glob` finds those an interrupted process left behind). An operating-system error
+(no space, read-only file system, permission, a directory in the way) becomes one
+:class:`~friction_uq.errors.OutputError` sentence naming the file; the temporary file is removed.
 """
 
 from __future__ import annotations
 
+import errno
 import os
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from .errors import OutputError, os_error_text
+
+
+def temporary_glob(name: str) -> str:
+    """Glob pattern of the temporary files :func:`atomic_path` makes for a file called ``name``."""
+    return f".{name}.*.tmp{Path(name).suffix}"
+
+
+def output_error(path: str | os.PathLike[str], exc: OSError) -> OutputError:
+    """One sentence for an operating-system error while writing ``path``."""
+    hint = {
+        errno.ENOSPC: "; free some space or choose another --out",
+        errno.EDQUOT: "; free some space or choose another --out",
+        errno.EROFS: "; choose a writable --out",
+        errno.EACCES: "; choose a folder you may write to",
+        errno.EPERM: "; choose a folder you may write to",
+        errno.EISDIR: "; a directory has that name",
+    }.get(exc.errno or 0, "")
+    return OutputError(f"{path}: cannot write ({os_error_text(exc)}){hint}")
+
 
 @contextmanager
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[str]:
-    """Yield a temporary path beside ``path``; on success it replaces ``path``, on error it is removed."""
+    """Yield a temporary path beside ``path``; on success it replaces ``path``, on error it is removed.
+
+    Raises
+    ------
+    OutputError
+        On any ``OSError`` while creating, writing or renaming (the message names ``path``).
+    """
     out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp" + out.suffix, dir=out.parent)
-    os.close(fd)
+    tmp = None
     try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        if out.is_dir():
+            raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(out))
+        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp" + out.suffix, dir=out.parent)
+        os.close(fd)
         yield tmp
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, out)
+    except OSError as exc:
+        raise output_error(out, exc) from None
     finally:
-        if os.path.exists(tmp):
+        if tmp is not None and os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically (see :func:`atomic_path`)."""
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
+    return Path(path)
+
+
+def write_together(files: dict[Path, bytes | None], *, last: Path) -> None:
+    """Write several files as one set: all to temporary names first, then renamed, ``last`` last.
+
+    ``files`` maps each path to its content, or to None for a file of an earlier set that this set
+    does not have (it is removed, so no file of another run stays beside the new ones). ``last``
+    (the file naming the others' checksums) is removed first and renamed into place last: while
+    it is missing the set is incomplete, and once it is there every other file is the new one.
+
+    Raises
+    ------
+    OutputError
+        On any operating-system error; temporary files are removed and no old file is replaced.
+    """
+    tmps: dict[Path, str] = {}
+    try:
+        for path, data in files.items():
+            if data is None:
+                continue
+            path.parent.mkdir(parents=True, exist_ok=True)
+            if path.is_dir():
+                raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix, dir=path.parent)
+            tmps[path] = tmp
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
+    except OSError as exc:
+        for tmp in tmps.values():
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        raise output_error(getattr(exc, "filename", None) or next(iter(files)), exc) from None
+    current = None
+    try:
+        current = last
+        if last.exists():
+            last.unlink()
+        for path, data in files.items():
+            current = path
+            if data is None:
+                if path.exists():
+                    path.unlink()
+            elif path != last:
+                os.replace(tmps.pop(path), path)
+        current = last
+        if last in tmps:
+            os.replace(tmps.pop(last), last)
+    except OSError as exc:
+        raise output_error(current, exc) from None
+    finally:
+        for tmp in tmps.values():
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+
+
+@contextmanager
+def output_lock(folder: Path, stem: str) -> Iterator[Path]:
+    """Hold ``folder/.<stem>.lock`` (``fcntl.flock``) while a run writes ``<stem>.*`` into ``folder``.
+
+    A second run of the same record into the same folder is refused at once with one sentence (it
+    would overwrite the first one's outputs and checkpoint). The lock file is removed on release;
+    a lock whose file was removed meanwhile is taken again on the new file.
+
+    Raises
+    ------
+    OutputError
+        If another process holds the lock, or the lock file cannot be created.
+    """
+    import fcntl
+
+    path = folder / f".{stem}.lock"
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise output_error(path, exc) from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise OutputError(
+                f"{folder}: another friction-uq run is writing {stem} into this folder (lock {path.name}); "
+                "wait for it to end or choose another --out") from None
+        except OSError as exc:
+            os.close(fd)
+            raise output_error(path, exc) from None
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(path))
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(fd)  # the holder removed the file between our open and flock: lock the new one
+    try:
+        yield path
+    finally:
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+        os.close(fd)
+
+
+def remove_orphans(folder: Path, names: list[str]) -> list[Path]:
+    """Remove the temporary files an interrupted process left for ``names`` in ``folder``.
+
+    Call it only while holding :func:`output_lock` for these names (then nobody else writes them).
+    Returns the files removed.
+    """
+    gone = []
+    for name in names:
+        for p in folder.glob(temporary_glob(name)):
+            try:
+                p.unlink()
+                gone.append(p)
+            except OSError:
+                pass
+    return gone

@@ -1,7 +1,9 @@
 """The ``friction-uq`` command. Thin: parse, call one library function, print or write.
 
-Every error the package raises on purpose (:class:`~friction_uq.errors.FrictionUQError`) is
-printed as one sentence on stderr with exit status 2, without a traceback.
+Every error the package raises on purpose (:class:`~friction_uq.errors.FrictionUQError`), every
+operating-system error (no space, read-only, permission, a directory in the way) and every usage
+error is printed as one sentence on stderr with exit status 2, without a traceback. Seeds, output
+names and formats, and the type of every input file are checked before any work.
 """
 
 from __future__ import annotations
@@ -13,9 +15,85 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from .errors import FrictionUQError
+from .errors import ConfigError, FrictionUQError, OutputError, os_error_text
 
 EXIT_BAD_INPUT = 2
+#: Figure formats of ``design -o`` and ``compare -o`` (matplotlib writes them without extra packages).
+FIGURE_SUFFIXES = (".pdf", ".png", ".svg", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp")
+#: Record file names ``simulate -o`` writes.
+RECORD_SUFFIXES = (".h5", ".hdf5")
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with usage errors as one line (``friction-uq: error: ...``), exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(EXIT_BAD_INPUT, f"friction-uq: error: {message} (see {self.prog} --help)\n")
+
+
+def _seed(text: str) -> int:
+    try:
+        v = int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"seed {text!r} is not an integer") from None
+    if not 0 <= v < 2**64:
+        raise argparse.ArgumentTypeError(f"seed must be an integer in [0, 2**64), got {text}")
+    return v
+
+
+def _output_file(path: Path, suffixes: Sequence[str], what: str) -> None:
+    """Refuse an output name that is a directory, has a parent that is a file, or an unknown suffix."""
+    if path.is_dir():
+        raise OutputError(f"{path}: is a directory; give a {what} file name ending in {' or '.join(suffixes)}")
+    if path.suffix.lower() not in suffixes:
+        raise OutputError(f"{path}: unknown {what} format {path.suffix or '(no suffix)'!r}; "
+                          f"give a name ending in {', '.join(suffixes)}")
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise OutputError(f"{path}: {parent} is a file, not a folder")
+            break
+
+
+def _check_text_file(path: Path, what: str, error: type[FrictionUQError]) -> str:
+    """The UTF-8 text of an input file, or one sentence saying why it is not one."""
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise error(f"{path}: cannot read the {what} ({os_error_text(exc)})") from None
+    if raw.startswith(HDF5_SIGNATURE):
+        raise error(f"{path}: is an HDF5 file (a test record?), not a {what}")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: the {what} is not UTF-8 text (byte {exc.start}); save it as UTF-8") from None
+    if "\x00" in text:
+        raise error(f"{path}: the {what} contains NUL characters (a binary file?)")
+    return text
+
+
+def _check_config(path: Path) -> None:
+    """Refuse a configuration that is not UTF-8 TOML, or is nested too deeply to parse."""
+    import tomllib
+
+    text = _check_text_file(path, "simulation configuration (TOML)", ConfigError)
+    try:
+        tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ConfigError(f"{path}: nested too deeply to be a simulation configuration") from None
+
+
+def _check_results(paths: Sequence[Path]) -> None:
+    """Refuse a ``compare`` input that is not a JSON result (an HDF5 record, a binary, bad JSON)."""
+    for path in paths:
+        text = _check_text_file(path, "result file (JSON written by run)", FrictionUQError)
+        try:
+            json.loads(text)
+        except (json.JSONDecodeError, RecursionError) as exc:
+            raise FrictionUQError(f"{path}: not a friction-uq result file (not JSON: {exc})") from None
 
 
 def _window(text: str) -> tuple[float, float]:
@@ -39,7 +117,7 @@ def _nu(text: str) -> float:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="friction-uq",
         description="Friction coefficient with honest uncertainty from confined friction tests on "
         "split Hopkinson bars (Durand et al. 2016).",
@@ -70,7 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Simulate a confined friction test from a TOML configuration.")
     s.add_argument("config", type=Path, help="simulation configuration (TOML)")
     s.add_argument("-o", "--output", type=Path, required=True, help="record to write (test.h5)")
-    s.add_argument("--seed", type=int, help="noise seed (default: the config's)")
+    s.add_argument("--seed", type=_seed, help="noise seed, 0 <= seed < 2**64 (default: the config's)")
 
     s = sub.add_parser("compare", help="compare tests across campaigns from run results (JSON)",
                        description="Table and figure of kappa and f against sliding velocity and wall "
@@ -82,9 +160,9 @@ def build_parser() -> argparse.ArgumentParser:
                        description="The main job: sample the posterior of f and nu for one record and "
                        "write <campaign>_<test_id>.nc, .json and .pdf.")
     s.add_argument("file", type=Path, help="test record (test.h5)")
-    s.add_argument("--priors", type=Path, help="prior file (TOML; default: priors/<material>.toml)")
+    s.add_argument("--priors", type=Path, help="prior file (TOML; default: the package's <material>.toml)")
     s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
-    s.add_argument("--seed", type=int, default=20161, help="random seed (default 20161)")
+    s.add_argument("--seed", type=_seed, default=20161, help="random seed, 0 <= seed < 2**64 (default 20161)")
     s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds on the record's time base (default: automatic); write --window=T0:T1 when T0 is negative")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
@@ -115,6 +193,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except FrictionUQError as exc:
         print(f"friction-uq: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except OSError as exc:  # a system error no writer turned into a sentence: still one line
+        where = exc.filename or ""
+        print(f"friction-uq: error: {where}{': ' if where else ''}{os_error_text(exc)}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except (RecursionError, UnicodeDecodeError) as exc:
+        print(f"friction-uq: error: an input file cannot be read ({type(exc).__name__}: {exc})", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("friction-uq: interrupted", file=sys.stderr)
         return 130
@@ -142,6 +227,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             print(identification_table(rec, ident))
         return 0
     if args.command == "design":
+        _output_file(args.output, FIGURE_SUFFIXES, "figure")
         from .record import read_record
         from .report.design_figure import design_figure
 
@@ -150,6 +236,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
         return 0
     if args.command == "simulate":
+        _output_file(args.output, RECORD_SUFFIXES, "record")
+        _check_config(args.config)
         from .simulate import load_config, simulate_to_file
 
         cfg = load_config(args.config)
@@ -157,6 +245,9 @@ def _dispatch(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
         return 0
     if args.command == "compare":
+        if args.output:
+            _output_file(args.output, FIGURE_SUFFIXES, "figure")
+        _check_results(args.results)
         from .campaign import compare, comparison_table
 
         comp = compare(args.results)

@@ -6,8 +6,9 @@
   :mod:`friction_uq.sampler`).
 * :func:`convergence`: R-hat max and ESS min (arviz_stats), ESS per second.
 * :func:`summarize`: mean, sd, q05, q50, q95 (+ R-hat, ESS) per variable as floats.
-* :func:`f_given_nu`, :func:`nu_variance_share`, :func:`nu_sensitivity`: how the uncertainty of
-  nu propagates into f.
+* :func:`f_given_nu`, :func:`nu_variance_share`: how the uncertainty of nu propagates into f;
+  :func:`nu_sensitivity` and :func:`prior_data_conflict` live in
+  :mod:`friction_uq.prior_sensitivity` (re-exported here).
 * :func:`ratio_ppc`: posterior predictive of F_eo/F_io over the window.
 
 Derived variables per draw (SI units): ratio r = expm1(f beta(nu)) (eq. 5, 13); kappa = f nu/(1-nu);
@@ -18,7 +19,7 @@ tau_mean = r <x> / (2 pi R L) (eq. 18, with <x> the window mean of the latent tr
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import arviz_base
@@ -30,8 +31,15 @@ from scipy.ndimage import uniform_filter1d
 from .likelihood import Likelihood
 from .physics import cell
 from .priors import Priors
-from .sampler import PosteriorSamples, sample_posterior
+from .prior_sensitivity import FUnderPrior, PriorDataConflict, nu_sensitivity, prior_data_conflict
+from .sampler import PosteriorSamples
 from .window import StationaryData
+
+__all__ = [
+    "Convergence", "FNuBand", "FUnderPrior", "PriorDataConflict", "RatioPPC", "VariableSummary", "build_datatree",
+    "convergence", "derived_draws", "f_given_nu", "nu_sensitivity", "nu_variance_share", "pointwise_log_likelihood",
+    "prior_data_conflict", "ratio_ppc", "summarize",
+]
 
 #: Variables summarised, in report order (hoop_gain only when sampled).
 SUMMARY_VARIABLES = ("f", "nu", "kappa", "hoop_gain", "ratio", "p_mean", "tau_mean")
@@ -138,7 +146,7 @@ def build_datatree(
     dt.attrs.update(
         {
             "test_id": data.test_id,
-            "seed": samples.seed,
+            "seed": samples.seed if samples.seed < 2**63 else str(samples.seed),  # netCDF attributes: int64
             "prior_path": samples.prior_path,
             "prior_description": samples.prior_description,
             "hoop_term": int(samples.hoop),
@@ -296,54 +304,6 @@ def nu_variance_share(samples: PosteriorSamples, *, n_bins: int = 20) -> float:
         slope = float(xc @ (y - y.mean())) / sxx if sxx > 0 else 0.0
         fitted[idx] = y.mean() + slope * xc
     return float(np.var(fitted) / np.var(f))
-
-
-@dataclass(frozen=True)
-class FUnderPrior:
-    """f's posterior under one nu prior."""
-
-    label: str
-    prior_description: str
-    mean: float
-    sd: float
-    q05: float
-    q50: float
-    q95: float
-    draws: np.ndarray  # f draws (at most 4000, evenly thinned), for histograms
-
-    def to_json(self) -> dict[str, float | str]:
-        return {k: getattr(self, k) for k in ("label", "prior_description", "mean", "sd", "q05", "q50", "q95")}
-
-
-def _f_under(label: str, samples: PosteriorSamples) -> FUnderPrior:
-    f = samples.flat("f")
-    q = np.quantile(f, QUANTILES)
-    keep = np.unique(np.linspace(0, len(f) - 1, min(len(f), 4000)).astype(int))
-    return FUnderPrior(label, samples.prior_description, float(f.mean()), float(f.std(ddof=1)),
-                       float(q[0]), float(q[1]), float(q[2]), f[keep])
-
-
-def nu_sensitivity(
-    data: StationaryData,
-    priors: Mapping[str, Priors],
-    *,
-    seed: int,
-    hoop: bool | None = None,
-    done: Mapping[str, PosteriorSamples] | None = None,
-    **sampler_kwargs: object,
-) -> dict[str, FUnderPrior]:
-    """f's posterior under each prior of ``priors`` (label -> Priors), by re-running the sampler.
-
-    Re-running (rather than reweighting the default run, or using the f = kappa (1-nu)/nu
-    separability) is exact with or without the hoop term and whatever the overlap of the priors;
-    it costs one sampler run per alternative. Runs already done (e.g. the default one) are passed
-    in ``done`` under their label and reused.
-    """
-    out = {}
-    for label, pri in priors.items():
-        s = done[label] if done and label in done else sample_posterior(data, pri, seed=seed, hoop=hoop, **sampler_kwargs)
-        out[label] = _f_under(label, s)
-    return out
 
 
 # ----------------------------------------------------------------------------------------------

@@ -40,3 +40,26 @@ class ConfigError(FrictionUQError):
 
 class SamplingError(FrictionUQError):
     """The sampler could not produce a usable posterior."""
+
+
+class OutputError(FrictionUQError):
+    """An output cannot be written (no space, read-only, permission, a directory in the way, a lock)."""
+
+
+class SeedError(FrictionUQError):
+    """A random seed outside [0, 2**64)."""
+
+
+def os_error_text(exc: OSError) -> str:
+    """The operating system's reason for ``exc`` in a few words (``strerror``, else the message)."""
+    return exc.strerror or str(exc) or type(exc).__name__
+
+
+def check_seed(seed: object, *, what: str = "--seed") -> int:
+    """``seed`` as an int if it is an integer in [0, 2**64) (numpy's SeedSequence range), else SeedError."""
+    if isinstance(seed, bool) or not isinstance(seed, int) and not hasattr(seed, "__index__"):
+        raise SeedError(f"{what}: must be an integer in [0, 2**64), got {seed!r}")
+    value = int(seed.__index__())
+    if not 0 <= value < 2**64:
+        raise SeedError(f"{what}: must be an integer in [0, 2**64), got {value}")
+    return value

@@ -1,6 +1,7 @@
 """Prior distributions of the friction analysis, read from a TOML file per sample material.
 
-A prior file (``priors/<material>.toml``) holds one table per parameter::
+A prior file (``<material>.toml``; the package ships ``friction_uq/prior_files/``) holds one table
+per parameter::
 
     material = "I1"
     description = "one line for reports"
@@ -79,8 +80,10 @@ DISTRIBUTIONS: Mapping[str, tuple[str, ...]] = {
 #: Smallest probability mass the untruncated normal may put inside [lower, upper].
 MIN_MASS = 1e-9
 
-#: Folder of the prior files shipped with the project.
-PRIORS_DIR = Path(__file__).resolve().parents[1] / "priors"
+#: Folder of the prior files shipped inside the package (package data, found from any folder).
+PRIORS_DIR = Path(__file__).resolve().parent / "prior_files"
+#: Largest prior file read (bytes): a prior file is a few dozen lines.
+MAX_PRIOR_BYTES = 1_000_000
 
 _LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
 
@@ -347,18 +350,30 @@ def load_priors(path: str | Path) -> Priors:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_PRIOR_BYTES + 1)
     except OSError as exc:
-        raise _fail(path, "file", f"cannot be read ({exc.strerror or exc})") from exc
+        raise _fail(path, "file", f"cannot be read ({exc.strerror or exc})") from None
+    if len(raw) > MAX_PRIOR_BYTES:
+        raise _fail(path, "file", f"is larger than {MAX_PRIOR_BYTES} bytes, not a prior file")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise _fail(path, "file", f"is not UTF-8 text (byte {exc.start}: {raw[exc.start:exc.start + 1]!r}); "
+                    "save it as UTF-8 TOML") from None
+    if "\x00" in text:
+        raise _fail(path, "file", "contains NUL characters: a binary file, not TOML")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise _fail(path, "file", f"not valid TOML: {exc}") from exc
+        raise _fail(path, "file", f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise _fail(path, "file", "is nested too deeply to be a prior file") from None
     return parse_priors(doc, path=path)
 
 
 def default_prior_path(material: str, *, directory: str | Path | None = None) -> Path:
-    """``<directory>/<material>.toml`` (``directory`` defaults to the project's ``priors/``).
+    """``<directory>/<material>.toml`` (``directory`` defaults to :data:`PRIORS_DIR`, in the package).
 
     Raises
     ------

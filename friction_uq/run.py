@@ -1,14 +1,19 @@
 """``friction-uq run``: from one record to the posterior, its propagation and the report.
 
 Outputs (in ``out_dir``): ``<campaign>_<test_id>.nc`` (ArviZ DataTree), ``.json`` (summary) and
-``.pdf`` (report). Each file is written to a temporary name and renamed: it appears whole or not
-at all. The sampler's HDF5 backend (``.<stem>.chains.h5``) lets an interrupted run resume; it is
-removed once the outputs are written.
+``.pdf`` (report). The three are made in memory, written to temporary names, then renamed
+together, the JSON (which names the ``.nc``'s and the ``.pdf``'s sha256) last: they always come
+from the same run. A run holds ``.<stem>.lock`` in the folder while it works (a second run of the
+same record into the same folder is refused), removes temporary files an interrupted run left,
+and keeps a checkpoint (``.<stem>.checkpoint.npz``, every few seconds) from which an interrupted
+run resumes; a checkpoint of another seed, prior, window or setting is replaced with a notice.
+The checkpoint is removed once the outputs are written.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 import math
 import os
@@ -22,9 +27,9 @@ import numpy as np
 from scipy import stats
 
 from . import __version__
-from ._atomic import atomic_path
+from ._atomic import output_lock, remove_orphans, write_together
 from .analysis import Identification, Prepared, identify, prepare
-from .discrepancy.check import WholeRecordCheck, check_whole_record
+from .discrepancy.check import WholeRecordCheck
 from .diagnostics import (
     Convergence,
     VariableSummary,
@@ -33,10 +38,12 @@ from .diagnostics import (
     f_given_nu,
     nu_sensitivity,
     nu_variance_share,
+    prior_data_conflict,
     ratio_ppc,
     summarize,
 )
-from .errors import FrictionUQError
+from .errors import OutputError, check_seed, os_error_text
+from .prior_sensitivity import FUnderPrior, PriorDataConflict
 from .priors import PRIORS_DIR, Priors, default_prior_path, load_priors
 from .record import read_record
 from .sampler import PosteriorSamples, sample_posterior, stderr_progress
@@ -53,7 +60,12 @@ class RunResult:
     lab: Identification
     outputs: dict[str, Path]
     seconds: float
+    conflict: PriorDataConflict | None = None
+    notes: tuple[str, ...] = ()
+    stages: dict[str, float] = dataclasses.field(default_factory=dict)
+    sensitivity: dict[str, FUnderPrior] = dataclasses.field(default_factory=dict)
     whole_record: WholeRecordCheck | None = None
+    diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
 
 
 def safe_stem(campaign: str, test_id: str) -> str:
@@ -80,26 +92,29 @@ def sliding_velocity_summary(p: Prepared) -> VariableSummary:
 
 
 def alternative_nu_priors(default_path: Path, priors: Priors) -> dict[str, Priors]:
-    """The priors used and the nu alternatives shipped in ``priors/`` (``<material>-nu-*.toml``).
+    """The priors used and the nu alternatives ``<material>-nu-*.toml``.
 
-    Each alternative keeps the used f (and hoop gain) prior and swaps nu only, so the posteriors
-    of f differ by the nu prior alone. A material without alternatives gets none (the report then
-    shows f under the one prior used).
+    Alternatives are looked up beside the prior file used, then among the files shipped in the
+    package (:data:`~friction_uq.priors.PRIORS_DIR`; a label found beside the file wins). Each
+    keeps the used f (and hoop gain) prior and swaps nu only, so the posteriors of f differ by the
+    nu prior alone. A material without alternatives gets none (the report then shows f under the
+    one prior used).
     """
     out: dict[str, Priors] = {"default": priors}
-    material = priors.material or default_path.stem
-    for alt in sorted(PRIORS_DIR.glob(f"{material}-nu-*.toml")):
-        if alt.resolve() == Path(default_path).resolve():
-            continue
-        other = load_priors(alt)
-        label = alt.stem.removeprefix(f"{material}-")
-        out[label] = dataclasses.replace(priors.replace(other["nu"]), path=str(alt), description=other.description)
+    material = priors.material or Path(default_path).stem
+    used = Path(default_path).resolve()
+    for folder in dict.fromkeys([Path(default_path).resolve().parent, PRIORS_DIR]):
+        for alt in sorted(folder.glob(f"{material}-nu-*.toml")):
+            label = alt.stem.removeprefix(f"{material}-")
+            if alt.resolve() == used or label in out:
+                continue
+            other = load_priors(alt)
+            out[label] = dataclasses.replace(priors.replace(other["nu"]), path=str(alt), description=other.description)
     return out
 
 
-def _atomic_write_bytes(path: Path, write) -> None:
-    with atomic_path(path) as tmp:
-        write(tmp)
+def _sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
 
 
 def hoop_unusable(p: Prepared) -> str | None:
@@ -137,11 +152,36 @@ def run_file(
     hoop: bool = True,
     pdf: bool = True,
     progress: bool = True,
+    table: bool = True,
+    notes: bool = True,
     whole_record: bool = True,
     diagnose: bool = False,
 ) -> RunResult:
-    """The main job (see the module docstring); prints a summary table at the end."""
+    """The main job (see the module docstring).
+
+    ``progress`` prints progress lines, ``notes`` one-line notices (hoop gauge left out, checkpoint
+    replaced, prior-data conflict) and ``table`` the summary table; with all three False nothing is
+    printed (the notices are in ``RunResult.notes``). ``whole_record`` simulates the whole test with
+    the posterior against every gauge (:mod:`friction_uq.discrepancy`); ``diagnose`` also fits every
+    mechanism of the catalogue and names the cause of a misfit. Every input (seed, record, priors, output
+    folder) is checked before sampling.
+
+    Raises
+    ------
+    FrictionUQError
+        Bad input of any kind, or an output that cannot be written (:class:`OutputError`).
+    """
     t_start = time.perf_counter()
+    seed = check_seed(seed)
+    stages: dict[str, float] = {}
+    said: list[str] = []
+    say = (lambda msg: print(f"friction-uq: {msg}", file=sys.stderr, flush=True)) if progress else (lambda msg: None)
+
+    def note(msg: str) -> None:
+        said.append(msg)
+        if notes:
+            print(f"friction-uq: note: {msg}", file=sys.stderr, flush=True)
+
     record = read_record(path)
     prep = prepare(record, window=window, dispersion=dispersion)
     p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
@@ -151,163 +191,153 @@ def run_file(
     use_hoop = bool(hoop and prep.data.hoop is not None and left_out is None)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
-        raise FrictionUQError(f"{out}: --out must be a directory, and this is a file")
+        raise OutputError(f"{out}: --out must be a directory, and this is a file")
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise FrictionUQError(f"{out}: cannot create the output directory ({exc.strerror or exc})") from None
+        raise OutputError(f"{out}: cannot create the output directory ({os_error_text(exc)})") from None
     stem = safe_stem(record.campaign, record.test_id)
-    backend = out / f".{stem}.chains.h5"
-    say = (lambda msg: print(msg, file=sys.stderr)) if progress else (lambda msg: None)
-    say(f"friction-uq: {record.campaign} {record.test_id}: window {prep.window.t0 * 1e6:.1f}-"
-        f"{prep.window.t1 * 1e6:.1f} us, hoop term {'on' if use_hoop else 'off'}, priors {p_path}")
-    if left_out:
-        print(f"friction-uq: note: the hoop gauge is left out of the likelihood: {left_out}", file=sys.stderr)
+    names = {"netcdf": out / f"{stem}.nc", "pdf": out / f"{stem}.pdf", "json": out / f"{stem}.json"}
+    for p in names.values():
+        if p.is_dir():
+            raise OutputError(f"{p}: cannot write the output, a directory has that name")
+    stages["signals"] = time.perf_counter() - t_start
 
-    samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
-                               progress=stderr_progress if progress else None)
-    dt = build_datatree(samples, prep.data, priors, seed=seed)
-    conv = convergence(dt, samples)
-    summary = summarize(dt)
-    say(f"friction-uq: sensitivity to the nu prior ({len(alternatives) - 1} more runs)")
-    sens = nu_sensitivity(prep.data, alternatives, seed=seed, hoop=use_hoop, done={"default": samples})
-    band = f_given_nu(samples, np.linspace(0.15, 0.49, 69))
-    share = nu_variance_share(samples)
-    ppc = ratio_ppc(samples, prep.data, seed=seed)
-    # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
-    lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
-    V = sliding_velocity_summary(prep)
-    wrc = None
-    if whole_record:
-        say("friction-uq: the whole test simulated with the posterior, against every gauge")
-        wrc = whole_record_check(prep, priors, summary, hoop=use_hoop, seed=seed)
-        add_whole_record(dt, wrc)
-    diag = None
-    if diagnose:
-        from .discrepancy import outcome
+    with output_lock(out, stem):
+        backend = out / f".{stem}.checkpoint.npz"
+        remove_orphans(out, [p.name for p in names.values()] + [backend.name])
+        old_backend = out / f".{stem}.chains.h5"  # an earlier version's emcee backend
+        if old_backend.exists():
+            old_backend.unlink()
+        say(f"{record.campaign} {record.test_id}: window {prep.window.t0 * 1e6:.1f}-"
+            f"{prep.window.t1 * 1e6:.1f} us, hoop term {'on' if use_hoop else 'off'}, priors {p_path}")
+        if left_out:
+            note(f"the hoop gauge is left out of the likelihood: {left_out}")
 
-        say("friction-uq: diagnose: fitting each mechanism of the catalogue to the whole record")
-        diag = run_diagnose(prep, priors, summary, hoop=use_hoop, seed=seed, say=say)
-        outcome.add_to_datatree(dt, diag)
+        t = time.perf_counter()
+        samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
+                                   progress=stderr_progress if progress else None, notify=note)
+        stages["sampling"] = time.perf_counter() - t
+        t = time.perf_counter()
+        dt = build_datatree(samples, prep.data, priors, seed=seed)
+        conv = convergence(dt, samples)
+        summary = summarize(dt)
+        stages["datatree"] = time.perf_counter() - t
+        t = time.perf_counter()
+        sens = nu_sensitivity(prep.data, alternatives, seed=seed, hoop=use_hoop, done={"default": samples})
+        n_rerun = sum(s.method == "sampled" for k, s in sens.items() if k != "default")
+        say(f"sensitivity to the nu prior: {len(alternatives) - 1} alternatives, {len(alternatives) - 1 - n_rerun} "
+            f"by importance reweighting, {n_rerun} sampled afresh")
+        conflict = prior_data_conflict(dt, samples, priors)
+        if conflict.flagged:
+            note(conflict.sentence())
+        stages["sensitivity"] = time.perf_counter() - t
+        t = time.perf_counter()
+        band = f_given_nu(samples, np.linspace(0.15, 0.49, 69))
+        share = nu_variance_share(samples)
+        ppc = ratio_ppc(samples, prep.data, seed=seed)
+        # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
+        lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
+        V = sliding_velocity_summary(prep)
+        stages["analysis"] = time.perf_counter() - t
+        t = time.perf_counter()
+        wrc = diag = None
+        if whole_record or diagnose:
+            from .discrepancy import pipeline
 
-    dt.attrs.update({
-        "friction_uq_version": __version__, "record": str(record.path), "record_sha256": record.sha256,
-        "test_id": record.test_id, "campaign": record.campaign, "window_s": [prep.window.t0, prep.window.t1],
-        "dispersion_correction": int(dispersion), "hoop_term": int(use_hoop), "seed": seed,
-        "prior_file": str(p_path),
-    })
-    outputs: dict[str, Path] = {}
-    nc = out / f"{stem}.nc"
-    _atomic_write_bytes(nc, lambda tmp: dt.to_netcdf(tmp, engine="h5netcdf"))
-    outputs["netcdf"] = nc
+            start = {"f": summary["f"].q50, "nu": summary["nu"].q50}
+            say("the whole test simulated with the posterior, against every gauge")
+            wrc = pipeline.whole_record_check(prep, priors, start, hoop=use_hoop, seed=seed)
+            pipeline.add_whole_record(dt, wrc)
+            if diagnose:
+                from .discrepancy import outcome
 
-    if pdf:
-        from .report.pdf import ReportInputs, write_report
+                say("diagnose: fitting each mechanism of the catalogue to the whole record")
+                diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say)
+                outcome.add_to_datatree(dt, diag)
+        stages["whole_record"] = time.perf_counter() - t
+        t = time.perf_counter()
 
-        inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
-                              whole_record=wrc, diagnosis=diag)
-        outputs["pdf"] = write_report(inputs, out / f"{stem}.pdf")
+        dt.attrs.update({
+            "friction_uq_version": __version__, "record": str(record.path), "record_sha256": record.sha256,
+            "test_id": record.test_id, "campaign": record.campaign, "window_s": [prep.window.t0, prep.window.t1],
+            "dispersion_correction": int(dispersion), "hoop_term": int(use_hoop),
+            "seed": seed if seed < 2**63 else str(seed),  # netCDF attributes hold int64
+            "prior_file": str(p_path), "prior_data_conflict": int(bool(conflict.flagged)),
+        })
+        nc_bytes = bytes(dt.to_netcdf(None, engine="h5netcdf"))
+        stages["outputs"] = time.perf_counter() - t
+        t = time.perf_counter()
+        pdf_bytes = None
+        if pdf:
+            from .report.pdf import ReportInputs, render_report
 
-    seconds = time.perf_counter() - t_start
-    doc: dict[str, object] = {}
-    allv = dict(summary) | {"V": V}
-    for name in JSON_VARIABLES:
-        v = allv[name]
-        doc[name] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50, "q95": v.q95}
-    if "hoop_gain" in summary:
-        v = summary["hoop_gain"]
-        doc["hoop_gain"] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50, "q95": v.q95}
-    doc |= {
-        "window": [prep.window.t0, prep.window.t1],
-        "rhat_max": conv.r_hat_max,
-        "ess_min": min(conv.ess_bulk_min, conv.ess_tail_min),
-        "seed": seed,
-        "seconds": seconds,
-        "converged": conv.ok,
-        "test_id": record.test_id,
-        "campaign": record.campaign,
-        "record_sha256": record.sha256,
-        "prior_file": str(p_path),
-        "hoop_term": use_hoop,
-        "hoop_left_out": left_out,
-        "dispersion_correction": dispersion,
-        "nu_variance_share_of_f": share,
-        "f_under_nu_priors": {k: s.to_json() for k, s in sens.items()},
-        "ppc_ratio_coverage_90": ppc.coverage,
-        "lab_point_estimate_nominal_nu": {"nu": lab.nu, "f": lab.f, "ratio": lab.ratio},
-        "ess_per_second": conv.ess_per_second,
-        "friction_uq_version": __version__,
-    }
-    if wrc is not None:
-        doc["misfit"] = wrc.to_json()
-    if diag is not None:
-        doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json())
-        fx = diag.final.f_summary() if diag.causes else summary["f"].to_json()
-        doc["f_headline"] = {"model": diag.final.label if diag.causes else "baseline (stationary phase, eq. 17 + hoop)"}
-        doc["f_headline"].update({k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")})
-    js = out / f"{stem}.json"
-    _atomic_write_bytes(js, lambda tmp: Path(tmp).write_text(json.dumps(doc, indent=2) + "\n"))
-    outputs["json"] = js
-    if backend.exists():
-        backend.unlink()
-    print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, wrc,
-                        page=(9 if use_hoop else 8) if pdf else None,
-                        diagnosis=doc["discrepancy"]["sentence"] if diag is not None else None))
-    return RunResult(prep, samples, summary, conv, lab, outputs, seconds, wrc)
+            inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
+                                  conflict, whole_record=wrc, diagnosis=diag)
+            pdf_bytes = render_report(inputs)
+        stages["pdf"] = time.perf_counter() - t
 
-
-def whole_record_check(prep: Prepared, priors: Priors, summary: dict[str, VariableSummary], *, hoop: bool,
-                       seed: int) -> WholeRecordCheck:
-    """The whole-record check (:mod:`friction_uq.discrepancy.check`) with this run's f and nu priors,
-    started from the stationary posterior's medians."""
-
-    def log_prior(v) -> float:
-        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
-
-    return check_whole_record(prep, log_prior, {"f": summary["f"].q50, "nu": summary["nu"].q50},
-                              hoop=hoop or prep.record.has_hoop, seed=seed)
-
-
-def run_diagnose(prep: Prepared, priors: Priors, summary: dict[str, VariableSummary], *, hoop: bool, seed: int,
-                 say=lambda msg: None):
-    """Fit every mechanism of the catalogue (:mod:`friction_uq.discrepancy.diagnose`), started from the
-    stationary posterior's medians, with this run's f and nu priors."""
-    from .discrepancy.diagnose import diagnose
-
-    def log_prior(v) -> float:
-        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
-
-    from .models.parameters import F, NU
-
-    scales = {}
-    for par in (F, NU):
-        lo, mid, hi = (float(par.to_unbounded(priors[par.name].ppf(q))) for q in (0.16, 0.5, 0.84))
-        scales[par.name] = (mid, max(0.5 * (hi - lo), 1e-3))
-    return diagnose(prep, log_prior, {"f": summary["f"].q50, "nu": summary["nu"].q50}, hoop=hoop or prep.record.has_hoop,
-                    seed=seed, progress=lambda m: say(f"friction-uq: diagnose: {m}"), base_scales=scales)
-
-
-def add_whole_record(dt, wrc: WholeRecordCheck) -> None:
-    """Simulated gauges of the posterior draws over the whole record (``posterior_predictive``) and
-    the measured ones (``whole_record_observed``), on the record's time base."""
-    import xarray as xr
-
-    comp = wrc.comparison
-    pp = {ch: (("chain", "draw", "time_record"), v[None]) for ch, v in comp.predicted.items()}
-    obs = {ch: (("time_record",), v) for ch, v in comp.measured.items()}
-    coords = {"time_record": comp.time}
-    dt["posterior_predictive"] = xr.DataTree(xr.Dataset(pp, coords=coords | {"chain": [0], "draw": np.arange(
-        len(next(iter(comp.predicted.values()))))}, attrs={
-        "description": "gauge strains (compression positive) simulated for draws of the whole-record fit of the "
-                       "simulator driven by the measured incident wave", "misfit_statistic": wrc.decision.statistic,
-        "misfit_threshold": wrc.decision.threshold, "misfit_detected": int(wrc.decision.detected)}))
-    dt["whole_record_observed"] = xr.DataTree(xr.Dataset(obs, coords=coords, attrs={
-        "description": "measured gauge strains, offset removed, compression positive"}))
+        seconds = time.perf_counter() - t_start
+        doc: dict[str, object] = {}
+        allv = dict(summary) | {"V": V}
+        for name in JSON_VARIABLES:
+            v = allv[name]
+            doc[name] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50, "q95": v.q95}
+        if "hoop_gain" in summary:
+            v = summary["hoop_gain"]
+            doc["hoop_gain"] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50, "q95": v.q95}
+        doc |= {
+            "window": [prep.window.t0, prep.window.t1],
+            "rhat_max": conv.r_hat_max,
+            "ess_min": min(conv.ess_bulk_min, conv.ess_tail_min),
+            "seed": seed,
+            "seconds": seconds,
+            "converged": conv.ok,
+            "test_id": record.test_id,
+            "campaign": record.campaign,
+            "record_sha256": record.sha256,
+            "prior_file": str(p_path),
+            "hoop_term": use_hoop,
+            "hoop_left_out": left_out,
+            "dispersion_correction": dispersion,
+            "nu_variance_share_of_f": share,
+            "f_under_nu_priors": {k: s.to_json() for k, s in sens.items()},
+            "prior_data_conflict": conflict.to_json(),
+            "ppc_ratio_coverage_90": ppc.coverage,
+            "lab_point_estimate_nominal_nu": {"nu": lab.nu, "f": lab.f, "ratio": lab.ratio},
+            "ess_per_second": conv.ess_per_second,
+            "notes": said,
+            "outputs": {"netcdf": {"file": names["netcdf"].name, "sha256": _sha256(nc_bytes)},
+                        "pdf": None if pdf_bytes is None else {"file": names["pdf"].name, "sha256": _sha256(pdf_bytes)}},
+            "friction_uq_version": __version__,
+        }
+        if wrc is not None:
+            doc["misfit"] = wrc.to_json()
+        if diag is not None:
+            doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json())
+            fx = diag.final.f_summary() if diag.causes else summary["f"].to_json()
+            doc["f_headline"] = {"model": diag.final.label if diag.causes else "baseline (stationary phase, eq. 17 + hoop)"}
+            doc["f_headline"].update({k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")})
+        js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
+        write_together({names["netcdf"]: nc_bytes, names["pdf"]: pdf_bytes, names["json"]: js_bytes},
+                       last=names["json"])
+        backend.unlink(missing_ok=True)
+        stages["outputs"] += time.perf_counter() - t - stages["pdf"]
+    outputs = {k: p for k, p in names.items() if k != "pdf" or pdf_bytes is not None}
+    if table:
+        lines = []
+        if wrc is not None:
+            lines.append(wrc.decision.sentence(page=(9 if use_hoop else 8) if pdf_bytes is not None else None))
+        if diag is not None:
+            lines.append(doc["discrepancy"]["sentence"])
+        print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, conflict, lines))
+    return RunResult(prep, samples, summary, conv, lab, outputs, seconds, conflict, tuple(said), stages, sens,
+                     wrc, diag)
 
 
 def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,
-                  outputs: dict[str, Path], seconds: float, wrc: WholeRecordCheck | None = None, *,
-                  page: int | None = None, diagnosis: str | None = None) -> str:
+                  outputs: dict[str, Path], seconds: float, conflict: PriorDataConflict | None = None,
+                  findings: list[str] | None = None) -> str:
     """The table the terminal ends with."""
     units = {"p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
     lines = [f"{campaign} {test_id}: posterior (90 % credible intervals)",
@@ -322,10 +352,9 @@ def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary],
     lines.append(f"convergence {'OK' if conv.ok else 'NOT REACHED'}: R-hat max {conv.r_hat_max:.4f}, "
                  f"ESS min {min(conv.ess_bulk_min, conv.ess_tail_min):.0f}, {conv.ess_per_second:.0f} ESS/s; "
                  f"{seconds:.1f} s in all")
-    if wrc is not None:
-        lines.append(wrc.decision.sentence(page=page))
-    if diagnosis is not None:
-        lines.append(diagnosis)
+    if conflict is not None:
+        lines.append(conflict.sentence())
+    lines += findings or []
     for k, pth in outputs.items():
         lines.append(f"wrote {pth}")
     return "\n".join(lines)

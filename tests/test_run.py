@@ -124,3 +124,66 @@ def test_out_that_is_a_file_is_refused(paper_run, tmp_path, capsys):
     assert main(["run", str(rec), "--out", str(afile), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "must be a directory" in err and "Traceback" not in err
+
+
+def test_json_names_the_checksums_and_the_nu_priors(paper_run):
+    import hashlib
+
+    _, out, _ = paper_run
+    doc = json.loads((out / "paper_P-01.json").read_text())
+    for key, suffix in (("netcdf", ".nc"), ("pdf", ".pdf")):
+        f = out / f"paper_P-01{suffix}"
+        assert doc["outputs"][key] == {"file": f.name, "sha256": hashlib.sha256(f.read_bytes()).hexdigest()}
+    sens = doc["f_under_nu_priors"]
+    assert sorted(sens) == ["default", "nu-tight", "nu-wide"]
+    for label in ("nu-tight", "nu-wide"):
+        assert sens[label]["method"] in ("reweighted", "sampled")
+        # reweighted only where the Pareto k says it is reliable (S = 4000 draws: k <= 0.7)
+        assert (sens[label]["method"] == "reweighted") == (sens[label]["pareto_k"] <= 0.7)
+    assert doc["prior_data_conflict"]["conflict"] is False
+
+
+def test_a_prior_that_overwhelms_the_data_is_said_everywhere(paper_run, tmp_path, capsys, monkeypatch):
+    """f ~ half-normal(1e-9): the posterior of f is the prior's; terminal, JSON and summary page say so."""
+    import matplotlib.pyplot as plt
+
+    import friction_uq.report.pdf as report
+    from friction_uq.priors import default_prior_path
+
+    _, _, rec = paper_run
+    original = default_prior_path("I1").read_text()
+    text = original.replace("scale = 0.3", "scale = 1e-9")
+    assert text != original
+    pri = tmp_path / "I1-squeezed.toml"
+    pri.write_text(text)
+    seen = {}
+    render = report.render_report
+
+    def keep(inputs):
+        seen["inputs"] = inputs
+        return render(inputs)
+
+    monkeypatch.setattr(report, "render_report", keep)
+    out = tmp_path / "out"
+    assert main(["run", str(rec), "--priors", str(pri), "--out", str(out), "--quiet", "--seed", "2"]) == 0
+    captured = capsys.readouterr()
+    assert "note: WARNING: the priors, not the data, drive the result - f: prior dominates the data" in captured.err
+    assert "WARNING: the priors, not the data, drive the result" in captured.out  # the summary table
+    js = json.loads((out / "paper_P-01.json").read_text())
+    assert js["prior_data_conflict"]["conflict"] is True and js["prior_data_conflict"]["flagged"] == ["f"]
+    assert js["f"]["q95"] < 1e-8
+    fig = report.page_summary(seen["inputs"])
+    lines = [t.get_text() for t in fig.axes[0].texts]
+    plt.close(fig)
+    assert any(line.startswith("WARNING: the priors, not the data, drive the result - f:") for line in lines)
+
+
+def test_run_file_can_run_silently(paper_run, tmp_path, capsys):
+    from friction_uq.run import run_file
+
+    _, _, rec = paper_run
+    res = run_file(rec, out_dir=tmp_path / "o", seed=9, pdf=False, progress=False, table=False, notes=False)
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err == ""
+    assert set(res.outputs) == {"netcdf", "json"} and res.convergence.ok
+    assert {"signals", "sampling", "datatree", "sensitivity", "outputs", "pdf"} <= set(res.stages)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import emcee
 import numpy as np
@@ -191,14 +192,14 @@ class Interrupt(Exception):
 
 
 def test_interrupted_run_resumes_to_the_uninterrupted_result(paper_data, tmp_path):
-    kw = dict(seed=11, hoop=False, n_ensembles=2)
-    full = sample_posterior(paper_data, DEFAULT, backend_path=tmp_path / "full.h5", **kw)
+    kw = dict(seed=11, hoop=False, n_ensembles=2, checkpoint_seconds=0.0)
+    full = sample_posterior(paper_data, DEFAULT, backend_path=tmp_path / "full.npz", **kw)
 
     def stop_at_300(p: Progress) -> None:
         if p.steps >= 300:
             raise Interrupt
 
-    path = tmp_path / "run.h5"
+    path = tmp_path / "run.npz"
     with pytest.raises(Interrupt):
         sample_posterior(paper_data, DEFAULT, backend_path=path, progress=stop_at_300, **kw)
     steps = []
@@ -207,17 +208,47 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(paper_data, tmp_pat
     assert resumed.n_steps == full.n_steps and resumed.converged
     np.testing.assert_array_equal(resumed.array(), full.array())
     # resuming a finished run steps no further and gives the same draws
-    again = sample_posterior(paper_data, DEFAULT, backend_path=tmp_path / "full.h5", **kw)
+    again = sample_posterior(paper_data, DEFAULT, backend_path=tmp_path / "full.npz", **kw)
     assert again.n_steps == full.n_steps
     np.testing.assert_array_equal(again.array(), full.array())
-    # and the in-memory run gives the same numbers as the HDF5-backed one
+    # and the run without checkpoints gives the same numbers as the checkpointed one
     mem = sample_posterior(paper_data, DEFAULT, **kw)
     np.testing.assert_array_equal(mem.array(), full.array())
 
 
-def test_backend_of_another_run_is_refused(paper_data, tmp_path):
-    path = tmp_path / "b.h5"
+def test_checkpoint_of_another_run_is_replaced_with_a_notice(paper_data, tmp_path):
+    path = tmp_path / "b.npz"
+    kw = dict(hoop=False, backend_path=path, max_steps=100, n_ensembles=1)
     with pytest.warns(ConvergenceWarning, match="max_steps=100"):
-        sample_posterior(paper_data, DEFAULT, seed=1, hoop=False, backend_path=path, max_steps=100, n_ensembles=1)
-    with pytest.raises(SamplingError, match=r"b\.h5: this sampler backend was written for other data, priors, seed or settings"):
-        sample_posterior(paper_data, DEFAULT, seed=2, hoop=False, backend_path=path, max_steps=100, n_ensembles=1)
+        first = sample_posterior(paper_data, DEFAULT, seed=1, **kw)
+    assert path.exists()
+    notes: list[str] = []
+    with pytest.warns(ConvergenceWarning, match="max_steps=100"):
+        other = sample_posterior(paper_data, DEFAULT, seed=2, notify=notes.append, **kw)
+    assert len(notes) == 1
+    assert re.fullmatch(r"the checkpoint .*b\.npz was written for other data, priors, seed, window or settings; "
+                        r"it is removed and sampling starts afresh", notes[0])
+    with pytest.warns(ConvergenceWarning):
+        fresh = sample_posterior(paper_data, DEFAULT, seed=2, hoop=False, max_steps=100, n_ensembles=1)
+    np.testing.assert_array_equal(other.array(), fresh.array())  # started afresh, not from seed 1's chain
+    assert not np.array_equal(other.array(), first.array())
+
+
+@pytest.mark.parametrize("content", [b"", b"PK\x03\x04 truncated zip", b"\x89HDF\r\n\x1a\n old emcee backend"])
+def test_corrupt_checkpoint_is_removed_and_sampling_starts_afresh(paper_data, tmp_path, content):
+    path = tmp_path / "c.npz"
+    path.write_bytes(content)
+    notes: list[str] = []
+    with pytest.warns(ConvergenceWarning):
+        got = sample_posterior(paper_data, DEFAULT, seed=3, hoop=False, backend_path=path, max_steps=100,
+                               n_ensembles=1, notify=notes.append)
+    assert len(notes) == 1 and re.match(r"the checkpoint .*c\.npz cannot be read \(", notes[0])
+    with pytest.warns(ConvergenceWarning):
+        fresh = sample_posterior(paper_data, DEFAULT, seed=3, hoop=False, max_steps=100, n_ensembles=1)
+    np.testing.assert_array_equal(got.array(), fresh.array())
+
+
+@pytest.mark.parametrize("seed", [-1, 2**64, 1.5, True])
+def test_bad_seed_is_refused_before_sampling(paper_data, seed):
+    with pytest.raises(SamplingError, match=r"seed must be an integer in \[0, 2\*\*64\)"):
+        sample_posterior(paper_data, DEFAULT, seed=seed, hoop=False)

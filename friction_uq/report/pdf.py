@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,10 +11,10 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from .._atomic import atomic_path
+from .._atomic import write_bytes
 from ..analysis import Identification, Prepared
 from ..discrepancy.check import WholeRecordCheck
-from ..diagnostics import Convergence, FNuBand, FUnderPrior, RatioPPC, VariableSummary
+from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
@@ -39,6 +40,7 @@ class ReportInputs:
     lab: Identification
     V: VariableSummary
     version: str
+    conflict: PriorDataConflict | None = None
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
 
@@ -72,6 +74,8 @@ def page_summary(r: ReportInputs) -> Figure:
         f"Posterior predictive check: the observed ratio lies in the 90 % band {100 * r.ppc.coverage:.0f} % of "
         "the window" + (" - the constant-ratio model misses something here (page 7)." if r.ppc.coverage < 0.7 else "."),
     ]
+    if r.conflict is not None:
+        lines.append(r.conflict.sentence())
     if r.whole_record is not None:
         lines.append("Whole record: " + r.whole_record.decision.sentence(page=whole_record_page(r)))
     if r.diagnosis is not None:
@@ -80,18 +84,22 @@ def page_summary(r: ReportInputs) -> Figure:
         lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, s["f"].to_json()))
     y = 0.97
     for line in lines:
-        ax.text(0.0, y, line, fontsize=11, va="top", wrap=True, transform=ax.transAxes)
-        y -= 0.065
+        color = "firebrick" if line.startswith("WARNING") else "black"
+        # wrapped here, not by matplotlib (whose wrap=True measures the text word by word)
+        text = "\n".join(textwrap.wrap(line, 150))
+        ax.text(0.0, y, text, fontsize=10, va="top", transform=ax.transAxes, color=color)
+        y -= 0.034 * (text.count("\n") + 1) + 0.016
     rows = []
     for name, v in list(s.items()) + [("V", r.V)]:
         unit, scale = UNITS.get(name, ("", 1.0))
         rows.append([name, unit, _fmt(v.mean * scale), _fmt(v.sd * scale), _fmt(v.q05 * scale), _fmt(v.q50 * scale),
                      _fmt(v.q95 * scale), f"{v.r_hat:.4f}" if np.isfinite(v.r_hat) else "-",
                      f"{v.ess_bulk:.0f}" if np.isfinite(v.ess_bulk) else "-"])
-    tab = ax.table(cellText=rows, colLabels=["quantity", "unit", "mean", "sd", "q05", "q50", "q95", "R-hat", "ESS"],
-                   loc="lower left", bbox=[0.0, 0.05, 0.75, 0.42])
-    tab.auto_set_font_size(False)
-    tab.set_fontsize(9)
+    head = ["quantity", "unit", "mean", "sd", "q05", "q50", "q95", "R-hat", "ESS"]
+    table = "\n".join(f"{c[0]:<10}{c[1]:<5}" + "".join(f"{x:>11}" for x in c[2:]) for c in [head] + rows)
+    # one monospace text block: a matplotlib table draws every cell as its own text and frame
+    ax.text(0.0, 0.05, table, fontsize=10, family="monospace", va="bottom", transform=ax.transAxes,
+            bbox={"facecolor": "white", "edgecolor": "0.6", "pad": 6})
     prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
             f"seed {r.samples.seed}, friction-uq {r.version}")
     ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
@@ -105,20 +113,17 @@ def page_summary(r: ReportInputs) -> Figure:
     return fig
 
 
-def whole_record_page(r: ReportInputs) -> int:
-    """Number of the first whole-record page (after page 7, or 8 with the hoop page)."""
-    return 9 if r.samples.hoop else 8
+def render_report(r: ReportInputs) -> bytes:
+    """The PDF (summary page, pages 1-7, and page 8 when the hoop term was used), in memory."""
+    import io
 
-
-def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
-    """Write the PDF (summary page, pages 1-7, and page 8 when the hoop term was used) atomically."""
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
     p = r.prepared
-    out = Path(path)
     meta = {"Title": f"friction-uq {p.record.campaign} {p.record.test_id}", "Creator": f"friction-uq {r.version}"}
-    with atomic_path(out) as tmp, PdfPages(tmp, metadata=meta) as pdf:
+    buf = io.BytesIO()
+    with PdfPages(buf, metadata=meta) as pdf:
         builders = [
             lambda: page_summary(r),
             lambda: page_raw(p.record),
@@ -135,20 +140,36 @@ def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
             fig = build()
             pdf.savefig(fig)
             plt.close(fig)
-        if r.whole_record is not None:
-            from .whole_record_pages import pages_whole_record
+        for fig in discrepancy_pages(r):
+            pdf.savefig(fig)
+            plt.close(fig)
+    return buf.getvalue()
 
-            for fig in pages_whole_record(r.whole_record, test=f"{p.record.campaign} {p.record.test_id}"):
-                pdf.savefig(fig)
-                plt.close(fig)
-        if r.diagnosis is not None:
-            from ..discrepancy.outcome import sentence
-            from .diagnose_pages import page_extended_fit, page_ranking
 
-            test = f"{p.record.campaign} {p.record.test_id}"
-            fw = r.summary["f"].to_json()
-            for fig in (page_ranking(r.diagnosis, f_without=fw, sentence=sentence(r.diagnosis, fw), test=test),
-                        page_extended_fit(r.diagnosis, test=test)):
-                pdf.savefig(fig)
-                plt.close(fig)
-    return out
+def whole_record_page(r: ReportInputs) -> int:
+    """Number of the first whole-record page (after page 7, or 8 with the hoop page)."""
+    return 9 if r.samples.hoop else 8
+
+
+def discrepancy_pages(r: ReportInputs) -> list[Figure]:
+    """The whole-record pages and, with a diagnosis, the ranking and the extended fit."""
+    p = r.prepared
+    test = f"{p.record.campaign} {p.record.test_id}"
+    figs: list[Figure] = []
+    if r.whole_record is not None:
+        from .whole_record_pages import pages_whole_record
+
+        figs += pages_whole_record(r.whole_record, test=test)
+    if r.diagnosis is not None:
+        from ..discrepancy.outcome import sentence
+        from .diagnose_pages import page_extended_fit, page_ranking
+
+        fw = r.summary["f"].to_json()
+        figs += [page_ranking(r.diagnosis, f_without=fw, sentence=sentence(r.diagnosis, fw), test=test),
+                 page_extended_fit(r.diagnosis, test=test)]
+    return figs
+
+
+def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
+    """Write the PDF of :func:`render_report` atomically."""
+    return write_bytes(path, render_report(r))

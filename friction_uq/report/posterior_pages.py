@@ -5,6 +5,8 @@ Pages only draw what :mod:`friction_uq.diagnostics` computed.
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
@@ -113,7 +115,7 @@ def page_convergence(samples: PosteriorSamples, conv: Convergence, *, number: in
         f"tau max {conv.tau_max:.1f} steps (chain > 50 tau: {'yes' if conv.converged else 'no'})   "
         f"acceptance {conv.acceptance:.2f}   {conv.seconds:.1f} s, {conv.ess_per_second:.0f} ESS/s"
     )
-    fig.text(0.01, 0.01, text, fontsize=8, wrap=True)
+    fig.text(0.01, 0.01, "\n".join(textwrap.wrap(text, 190)), fontsize=8)
     fig.subplots_adjust(bottom=0.12)
     return fig
 

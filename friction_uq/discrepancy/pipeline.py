@@ -1,0 +1,61 @@
+"""The discrepancy stage as ``run`` calls it: with the run's priors and its stationary posterior."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+import numpy as np
+
+from ..analysis import Prepared
+from ..models.parameters import F, NU
+from ..priors import Priors
+from .check import WholeRecordCheck, check_whole_record
+from .diagnose import Diagnosis, diagnose
+
+
+def f_nu_log_prior(priors: Priors) -> Callable[[Mapping[str, float]], float]:
+    """log prior of f and nu from the run's prior file."""
+
+    def log_prior(v: Mapping[str, float]) -> float:
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    return log_prior
+
+
+def whole_record_check(prep: Prepared, priors: Priors, start: Mapping[str, float], *, hoop: bool,
+                       seed: int) -> WholeRecordCheck:
+    """:func:`.check.check_whole_record` with the run's f and nu priors, started from ``start`` (the
+    stationary posterior's medians)."""
+    return check_whole_record(prep, f_nu_log_prior(priors), start, hoop=hoop or prep.record.has_hoop, seed=seed)
+
+
+def run_diagnose(prep: Prepared, priors: Priors, start: Mapping[str, float], *, hoop: bool, seed: int,
+                 say: Callable[[str], None] = lambda msg: None) -> Diagnosis:
+    """:func:`.diagnose.diagnose` with the run's f and nu priors (and their Gaussian stand-ins for the
+    mode search), started from the stationary posterior's medians."""
+    scales = {}
+    for par in (F, NU):
+        lo, mid, hi = (float(par.to_unbounded(priors[par.name].ppf(q))) for q in (0.16, 0.5, 0.84))
+        scales[par.name] = (mid, max(0.5 * (hi - lo), 1e-3))
+    return diagnose(prep, f_nu_log_prior(priors), start, hoop=hoop or prep.record.has_hoop, seed=seed,
+                    progress=lambda m: say(f"diagnose: {m}"), base_scales=scales)
+
+
+def add_whole_record(dt, wrc: WholeRecordCheck) -> None:
+    """Simulated gauges of the posterior draws over the whole record (``posterior_predictive``) and
+    the measured ones (``whole_record_observed``), on the record's time base."""
+    import xarray as xr
+
+    comp = wrc.comparison
+    n_draw = len(next(iter(comp.predicted.values())))
+    pp = {ch: (("chain", "draw", "time_record"), v[None]) for ch, v in comp.predicted.items()}
+    obs = {ch: (("time_record",), v) for ch, v in comp.measured.items()}
+    coords = {"time_record": comp.time}
+    dt["posterior_predictive"] = xr.DataTree(xr.Dataset(
+        pp, coords=coords | {"chain": [0], "draw": np.arange(n_draw)},
+        attrs={"description": "gauge strains (compression positive) simulated for draws of the whole-record fit "
+                              "of the simulator driven by the measured incident wave",
+               "misfit_statistic": wrc.decision.statistic, "misfit_threshold": wrc.decision.threshold,
+               "misfit_detected": int(wrc.decision.detected)}))
+    dt["whole_record_observed"] = xr.DataTree(xr.Dataset(obs, coords=coords, attrs={
+        "description": "measured gauge strains, offset removed, compression positive"}))

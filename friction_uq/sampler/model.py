@@ -1,0 +1,141 @@
+"""The density emcee samples: parametrisation z = (log f, logit nu, log g), log posterior, start ball."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from scipy import optimize
+
+from ..errors import SamplingError
+from ..likelihood import Likelihood
+from ..physics import cell
+from ..priors import Priors
+
+
+# ----------------------------------------------------------------------------------------------
+# Parametrisation
+# ----------------------------------------------------------------------------------------------
+
+
+def to_theta(z: np.ndarray) -> np.ndarray:
+    """(log f, log(nu/(1-nu)), log g) -> (f, nu, g), row-wise (any number of columns >= 2)."""
+    z = np.asarray(z, float)
+    theta = np.exp(z)
+    theta[..., 1] = 1.0 / (1.0 + np.exp(-z[..., 1]))
+    return theta
+
+
+def to_z(theta: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`to_theta`."""
+    theta = np.asarray(theta, float)
+    with np.errstate(divide="ignore"):
+        z = np.log(theta)
+        z[..., 1] = np.log(theta[..., 1] / (1.0 - theta[..., 1]))
+    return z
+
+
+def _log_jacobian(theta: np.ndarray) -> np.ndarray:
+    """log |d theta / d z| = log f + log(nu (1 - nu)) [+ log g]."""
+    out = np.log(theta[..., 0]) + np.log(theta[..., 1] * (1.0 - theta[..., 1]))
+    if theta.shape[-1] > 2:
+        out = out + np.sum(np.log(theta[..., 2:]), axis=-1)
+    return out
+
+
+class LogPosterior:
+    """Vectorised log posterior density in z (emcee's ``log_prob_fn`` with ``vectorize=True``)."""
+
+    def __init__(self, likelihood: Likelihood, priors: Priors) -> None:
+        self.likelihood = likelihood
+        self.priors = priors
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        """z: shape (nwalkers, ndim) -> shape (nwalkers,); -inf outside the prior support."""
+        z = np.atleast_2d(np.asarray(z, float))
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            theta = to_theta(z)
+            lp = self.priors.logpdf(theta) + _log_jacobian(theta)
+        ok = np.isfinite(lp)
+        out = np.full(len(z), -np.inf)
+        if ok.any():
+            ll = self.likelihood(theta[ok])
+            out[ok] = np.where(np.isfinite(ll), lp[ok] + ll, -np.inf)
+        return out
+
+
+# ----------------------------------------------------------------------------------------------
+# Start
+# ----------------------------------------------------------------------------------------------
+
+
+def _initial_guess(likelihood: Likelihood, priors: Priors) -> np.ndarray:
+    """Parameter vector from the least-squares force ratio and the prior medians (f, nu, g)."""
+    d = likelihood.data
+    nu = float(priors["nu"].ppf(0.5))
+    r0 = likelihood.force.r0
+    sd_r = math.hypot(d.sd_eo, r0 * d.sd_io) / (abs(float(np.mean(d.F_io))) * math.sqrt(d.n))
+    r = max(r0, 3.0 * sd_r, 1e-6)
+    f = float(math.log1p(r) / cell.beta(nu, radius=d.radius, length=d.length))
+    theta = [f, nu] + ([float(priors["hoop_gain"].ppf(0.5))] if len(priors.names) > 2 else [])
+    return np.array(theta)
+
+
+def _hessian(fun: Callable[[np.ndarray], np.ndarray], z: np.ndarray, h: float = 1e-4) -> np.ndarray:
+    """Central-difference Hessian of a vectorised function at z (all stencil points in one call)."""
+    k = len(z)
+    eye = np.eye(k) * h
+    pts = [z]
+    for i in range(k):
+        for j in range(i, k):
+            pts += [z + eye[i] + eye[j], z + eye[i] - eye[j], z - eye[i] + eye[j], z - eye[i] - eye[j]]
+    vals = fun(np.array(pts))
+    H = np.full((k, k), np.nan)
+    if not np.all(np.isfinite(vals)):  # optimum on a prior bound: no Hessian
+        return H
+    m = 1
+    for i in range(k):
+        for j in range(i, k):
+            pp, pm, mp, mm = vals[m:m + 4]
+            H[i, j] = H[j, i] = (pp - pm - mp + mm) / (4.0 * h * h)
+            m += 4
+    return H
+
+
+def start_ball(
+    log_post: LogPosterior, priors: Priors, *, nwalkers: int, n_ensembles: int, rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Maximum a posteriori in z and starting positions, shape (n_ensembles, nwalkers, ndim).
+
+    The ball's sd is a tenth of the Laplace approximation's (inverse Hessian at the optimum);
+    walkers falling outside the prior support are redrawn.
+    """
+    z0 = to_z(_initial_guess(log_post.likelihood, priors))
+    if not np.isfinite(log_post(z0)[0]):
+        raise SamplingError(
+            f"the starting point {dict(zip(priors.names, to_theta(z0)))} has zero prior or likelihood; "
+            "check the priors against the data"
+        )
+    res = optimize.minimize(lambda z: -float(log_post(z)[0]), z0, method="Nelder-Mead",
+                            options={"xatol": 1e-7, "fatol": 1e-7, "maxiter": 4000})
+    z_map = res.x if np.isfinite(res.fun) and res.fun <= -float(log_post(z0)[0]) else z0
+    H = _hessian(log_post, z_map)
+    try:
+        cov = np.linalg.inv(-H)
+        chol = np.linalg.cholesky(0.5 * (cov + cov.T))
+    except np.linalg.LinAlgError:
+        chol = np.eye(len(z_map)) * 1e-3
+    if not np.all(np.isfinite(chol)):
+        chol = np.eye(len(z_map)) * 1e-3
+    out = np.empty((n_ensembles, nwalkers, len(z_map)))
+    for k in range(n_ensembles):
+        todo = np.ones(nwalkers, bool)
+        for _ in range(100):
+            out[k, todo] = z_map + 0.1 * rng.standard_normal((int(todo.sum()), len(z_map))) @ chol.T
+            todo = ~np.isfinite(log_post(out[k]))
+            if not todo.any():
+                break
+        else:
+            raise SamplingError("could not place the walkers inside the prior support around the MAP")
+    return z_map, out

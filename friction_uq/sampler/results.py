@@ -1,0 +1,115 @@
+"""What the sampler returns and reports: settings, progress lines, posterior draws."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+class ConvergenceWarning(UserWarning):
+    """The sampler stopped at ``max_steps`` before the convergence criterion was met."""
+
+
+@dataclass(frozen=True)
+class Progress:
+    """What a progress callback receives at each check (every ``check_every`` steps)."""
+
+    steps: int
+    max_steps: int
+    tau_max: float
+    tau_change: float
+    steps_over_tau: float
+    acceptance: float
+    seconds: float
+
+    def line(self) -> str:
+        """A short line for a terminal."""
+        return (
+            f"sampling: step {self.steps}/{self.max_steps}, tau {self.tau_max:.1f} "
+            f"(steps/tau {self.steps_over_tau:.0f}, needs 50; change {100 * self.tau_change:.1f} %, needs < 1 %), "
+            f"acceptance {self.acceptance:.2f}, {self.seconds:.1f} s"
+        )
+
+
+def stderr_progress(info: Progress) -> None:
+    """Progress callback printing :meth:`Progress.line` to stderr."""
+    print(info.line(), file=sys.stderr, flush=True)
+
+
+@dataclass(frozen=True)
+class SamplerSettings:
+    """Sampler settings (see the module docstring)."""
+
+    nwalkers: int = 32
+    n_ensembles: int = 4
+    max_steps: int = 20000
+    check_every: int = 100
+    checkpoint_seconds: float = 2.0
+    tau_factor: float = 50.0
+    tau_rtol: float = 0.01
+    burn_factor: float = 3.0
+    thin_factor: float = 0.5
+    max_draws: int = 4000
+
+
+@dataclass(frozen=True)
+class PosteriorSamples:
+    """Posterior draws and run statistics.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Sampled parameters, e.g. ("f", "nu", "hoop_gain").
+    draws : dict of str to array, shape (chain, draw)
+        Draws of each parameter (chain = independent ensemble).
+    log_likelihood, log_prior : array, shape (chain, draw)
+        Per draw (log_prior in (f, nu, g), without the sampler's Jacobian).
+    acceptance : array, shape (chain,)
+        Mean acceptance fraction of each ensemble.
+    tau : array, shape (chain, ndim)
+        Integrated autocorrelation time (steps) per ensemble and parameter, in the sampler's z
+        (the stopping rule uses the estimate pooled over ensembles).
+    n_steps, burn, thin : int
+        Steps per walker, discarded burn-in, thinning.
+    converged : bool
+        Whether the stopping criterion was met before ``max_steps``.
+    seconds : float
+        Wall time of the whole call (s).
+    """
+
+    names: tuple[str, ...]
+    draws: dict[str, np.ndarray]
+    log_likelihood: np.ndarray
+    log_prior: np.ndarray
+    acceptance: np.ndarray
+    tau: np.ndarray
+    n_steps: int
+    burn: int
+    thin: int
+    converged: bool
+    seconds: float
+    seed: int
+    hoop: bool
+    nwalkers: int
+    map_estimate: dict[str, float]
+    prior_path: str = ""
+    prior_description: str = ""
+    settings: SamplerSettings = field(default_factory=SamplerSettings)
+
+    @property
+    def n_chains(self) -> int:
+        return self.log_likelihood.shape[0]
+
+    @property
+    def n_draws(self) -> int:
+        return self.log_likelihood.shape[1]
+
+    def array(self) -> np.ndarray:
+        """All draws, shape (chain, draw, ndim), columns in ``names`` order."""
+        return np.stack([self.draws[n] for n in self.names], axis=-1)
+
+    def flat(self, name: str) -> np.ndarray:
+        """Draws of ``name`` pooled over chains, shape (chain * draw,)."""
+        return self.draws[name].reshape(-1)
