@@ -54,7 +54,8 @@ def test_the_papers_case_contains_0049(paper_run):
 def test_netcdf_is_an_arviz_datatree(paper_run):
     _, out, _ = paper_run
     dt = xr.open_datatree(out / "paper_P-01.nc", engine="h5netcdf")
-    for group in ("posterior", "log_likelihood", "observed_data", "sample_stats", "prior"):
+    for group in ("posterior", "log_likelihood", "observed_data", "sample_stats", "prior", "posterior_predictive",
+                  "whole_record_observed"):
         assert group in dt.children, group
     post = dt["posterior"]
     assert post["f"].dims[:2] == ("chain", "draw")
@@ -67,7 +68,9 @@ def test_pdf_is_a_multipage_report(paper_run):
     data = (out / "paper_P-01.pdf").read_bytes()
     assert data[:4] == b"%PDF"
     pages = data.count(b"/Type /Page") - data.count(b"/Type /Pages")
-    assert pages == 9  # summary + pages 1-7 + page 8 (hoop gauge vs model: the hoop term was used)
+    # summary + pages 1-7 + page 8 (hoop gauge vs model: the hoop term was used) + 9-10 (the whole test
+    # simulated against the four gauges, two per page)
+    assert pages == 11
 
 
 def test_a_prior_file_with_a_typo_is_refused_and_nothing_is_written(paper_run, tmp_path, capsys):

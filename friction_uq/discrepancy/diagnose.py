@@ -156,7 +156,7 @@ class Diagnoser:
         self.n_draws = n_draws
         E0 = rec.apparatus.sample.young_modulus
         self.E0 = E0
-        self.modulus = Parameter("sample_modulus", "Pa", 0.0, math.inf, "Young's modulus of the sample")
+        self.modulus = Parameter("sample_modulus", "Pa", E0 / 4.0, 4.0 * E0, "Young's modulus of the sample")
         self.modulus_prior = stats.lognorm(s=SAMPLE_MODULUS_SD_LOG, scale=E0)
         self.block = max(1, int(round(BLOCK * rec.sample_rate)))
         d = prep.data

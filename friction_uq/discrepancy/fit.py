@@ -116,8 +116,15 @@ class WholeRecordLikelihood:
             out.append(whiten(self.scaled_residual(c, pred[c]), sd=nz.sd, rho=nz.rho))
         return np.concatenate(out)
 
+    @property
+    def n_samples(self) -> int:
+        return sum(self.bounds[c][3] - self.bounds[c][0] for c in self.channels)
+
     def loglike(self, values: Mapping[str, float]) -> float:
-        pred, _ = self.strains(values)
+        try:
+            pred, _ = self.strains(values)
+        except ValueError:
+            return -np.inf
         out = self._log_weight
         for c in self.channels:
             nz = self.noise[c]
@@ -150,10 +157,16 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     centre = np.array([scale[n][0] for n in names])
     width = np.array([scale[n][1] for n in names])
 
+    n_data: list[int] = []
+
     def residuals(z: np.ndarray) -> np.ndarray:
         nonlocal calls
         calls += 1
-        r = lik.whitened(values_of(z))
+        try:
+            r = lik.whitened(values_of(z))
+            n_data[:] = [len(r)]
+        except ValueError:  # parameters the simulator cannot run (a column too stiff to integrate)
+            r = np.full(n_data[0] if n_data else lik.n_samples, 1e3)
         return np.concatenate([r, (z - centre) / width])
 
     res = optimize.least_squares(residuals, z0, method="lm", x_scale="jac", diff_step=1e-6, max_nfev=60 * (len(z0) + 1))

@@ -7,7 +7,8 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from ..analysis import Prepared
-from ..models.parameters import F, NU
+from ..models.parameters import F
+from ..models.simulator import NU
 from ..priors import Priors
 from .check import WholeRecordCheck, check_whole_record
 from .diagnose import Diagnosis, diagnose

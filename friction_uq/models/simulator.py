@@ -26,7 +26,11 @@ from ..record import Apparatus
 from ..simulate.config import DEFAULT_PLUG, ChannelSpec, SimulationConfig
 from ..simulate.loading import Loading
 from ..simulate.model import run_model
-from .parameters import F, HOOP_GAIN, NU, Parameter, ParameterSet
+from .parameters import F, HOOP_GAIN, Parameter, ParameterSet
+
+#: nu as the simulator takes it: below 0.49, where the confined modulus (and with it the column's
+#: wave speed and the number of time steps) stays finite.
+NU = Parameter("nu", "-", 0.0, 0.49, "Poisson ratio of the sample")
 
 #: Gauge channels the simulator predicts.
 GAUGES = ("input_bar", "internal_output_bar", "external_output_bar", "tube_hoop")

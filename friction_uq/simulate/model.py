@@ -37,6 +37,10 @@ from .hoop import hoop_strain
 from .loading import Loading
 
 
+#: Most time steps of the cell per record sample (a stiffer column would need more memory than a record is worth).
+MAX_SUBSTEPS = 200
+
+
 @dataclass(frozen=True)
 class ModelOutput:
     """Noise-free result on the record's grid (n samples). SI units, compression positive.
@@ -111,6 +115,9 @@ def run_model(config: SimulationConfig, *, loading: Loading | None = None) -> Mo
     c_max = cell.max_wave_speed(young_modulus=sample.young_modulus, density=sample.density, nu=nu, den=den)
     dt_crit = cell.critical_time_step(element_length=h, wave_speed=c_max, damping=config.damping)
     n_sub = max(1, math.ceil(dt_out / (config.cfl * dt_crit)))
+    if n_sub > MAX_SUBSTEPS:
+        raise ValueError(f"the sample's wave speed {c_max:.0f} m/s needs {n_sub} time steps per sample (at most "
+                         f"{MAX_SUBSTEPS}): check its modulus, density and Poisson ratio")
     dt = dt_out / n_sub
     n = n_out * n_sub
     m_plug = plug.density * math.pi * a * a * plug.length
