@@ -16,6 +16,7 @@ import numpy as np
 
 from ..analysis import Prepared
 from ..models import SimulatorModel, measured_loading
+from .diagnose import NU_STARTS
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .misfit import MisfitDecision, decide
 from .whole_record import WholeRecord, compare_whole_record
@@ -52,7 +53,8 @@ def check_whole_record(prep: Prepared, log_prior: Callable[[Mapping[str, float]]
     model = SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), hoop=hoop and rec.has_hoop)
     lik = WholeRecordLikelihood(prep, model)
     rng = np.random.default_rng(np.random.SeedSequence([seed, 8]))
-    fit = fit_whole_record(lik, log_prior, {"f": start["f"], "nu": start["nu"]}, n_draws=n_draws, rng=rng)
+    fit = fit_whole_record(lik, log_prior, {"f": start["f"], "nu": start["nu"]}, n_draws=n_draws, rng=rng,
+                           extra_starts=tuple({"nu": nu} for nu in NU_STARTS))
     gain = lik.strains(fit.mode)[1]
     draws = dict(fit.draws)
     draws["hoop_gain"] = np.full(len(draws["f"]), gain)

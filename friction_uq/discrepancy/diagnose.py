@@ -49,6 +49,8 @@ BLOCK = 10e-6
 #: Decisive evidence: dELPD above DECISIVE_ELPD and above DECISIVE_SE standard errors or STRONG_ELPD.
 DECISIVE_ELPD, DECISIVE_SE, STRONG_ELPD = 4.0, 2.0, 40.0
 MAX_CAUSES = 3
+#: Further starting values of nu for the baseline's mode search.
+NU_STARTS = (0.33, 0.45)
 SAMPLE_MODULUS_SD_LOG = 0.1
 
 #: What would separate two mechanisms that one record cannot.
@@ -190,11 +192,14 @@ class Diagnoser:
                 st[p.name] = start.get(p.name, v.mechanism.start[p.name])
         self._n_fit += 1
         rng = np.random.default_rng(np.random.SeedSequence([self.seed, 9, self._n_fit]))
-        scales = {"sample_modulus": (math.log(self.E0), SAMPLE_MODULUS_SD_LOG), **self.base_scales}
+        lo, mid, hi = (float(self.modulus.to_unbounded(self.modulus_prior.ppf(q))) for q in (0.16, 0.5, 0.84))
+        scales = {"sample_modulus": (mid, 0.5 * (hi - lo)), **self.base_scales}
         for v in variants:
             scales.update(v.mechanism.prior_z())
+        # the baseline from several nu (the closed form's, and either side of the prior): see fit.py
+        extra = () if variants else tuple({"nu": nu, "sample_modulus": self.E0} for nu in NU_STARTS)
         fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False,
-                               prior_scale=scales)
+                               prior_scale=scales, extra_starts=extra)
         pred, gain = lik.strains(fit.mode)
         dens, blocks, offset = [], [], 0
         for c in lik.channels:
@@ -202,12 +207,14 @@ class Diagnoser:
             nz = lik.noise[c]
             w = lik.weight[c]
             logw = np.add.reduceat(np.log(w), np.arange(0, i3 - i0, self.block))
-            dens.append(ar1_block_loo(lik.scaled_residual(c, pred[c])[None], sd=nz.sd, rho=nz.rho,
+            dens.append(ar1_block_loo(lik.scaled_residual(c, pred[c])[None], sd=nz.sd, rho=nz.rho_long_run,
                                       block=self.block)[0] + logw)
             blocks.append(offset + np.arange(i3 - i0) // self.block)
             offset += len(dens[-1])
-        elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z,
-                                  np.concatenate(blocks))
+        # the offsets' pseudo-residuals (one per channel, last) belong to no block: give them the first
+        n_pseudo = len(fit.whitened) - sum(len(b) for b in blocks)
+        block_of = np.concatenate(blocks + [np.zeros(n_pseudo, int)])
+        elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z, block_of)
         names = list(fit.draws)
         S = len(fit.draws["f"])
         f_eff = np.array([self._f_effective(variants, {n: float(fit.draws[n][s]) for n in names}) for s in range(S)])

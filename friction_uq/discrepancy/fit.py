@@ -2,7 +2,9 @@
 
 The whole-record likelihood compares every gauge over its span (:mod:`.whole_record`: from its
 wave's arrival to the first far-end echo) with the simulator's prediction, each residual scored by
-the exact AR(1) Gaussian log-likelihood of that gauge's pre-pulse noise (the reflected wave with
+the exact AR(1) Gaussian log-likelihood of that gauge's pre-pulse noise, with the effective
+coefficient that reproduces the noise's long-run variance (white plus AR(1) noise whitened with its
+lag-1 coefficient would overstate what the record says about a level: a gain, f), (the reflected wave with
 twice the variance: its prediction carries the measured incident's noise), widened by the model's
 tolerance: sample t has standard deviation s_t = sqrt(sd^2 + tol_t^2), tol_t the channel's
 tolerated model error (:func:`~.whole_record.tolerance_sd`: 1-2 % of the signal on a bar gauge,
@@ -32,7 +34,6 @@ import numpy as np
 from scipy import optimize
 
 from ..analysis import Prepared
-from ..likelihood import ar1_loglike
 from ..models.simulator import SimulatorModel
 from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, tolerance_sd, whiten
 
@@ -77,11 +78,34 @@ class WholeRecordLikelihood:
             tol = tolerance_sd(self.measured[c], c, sample_rate=rec.sample_rate)[sl]
             self.weight[c] = nz.sd / np.hypot(nz.sd, tol)
         self._log_weight = sum(float(np.sum(np.log(w))) for w in self.weight.values())
+        # offset errors: the whitened direction of a constant offset, and the Gaussian constants
+        self._wv = {c: whiten(self.weight[c], sd=self.noise[c].sd, rho=self.noise[c].rho_long_run)
+                    for c in self.channels}
+        self._const = 0.0
+        for c in self.channels:
+            nz, n = self.noise[c], len(self.weight[c])
+            self._const += (-0.5 * n * math.log(2.0 * math.pi * nz.sd**2) - 0.5 * (n - 1) * math.log(1.0 - nz.rho_long_run**2)
+                            - 0.5 * math.log1p(nz.offset_sd**2 * float(self._wv[c] @ self._wv[c])))
 
-    def scaled_residual(self, c: str, pred: np.ndarray) -> np.ndarray:
-        """(measured - predicted) sd / s_t over the channel's span: AR(1) with the gauge's sd and rho."""
+    def _raw_scaled(self, c: str, pred: np.ndarray) -> np.ndarray:
         sl = self._span(c)
         return (self.measured[c][sl] - pred[sl]) * self.weight[c]
+
+    def _offset(self, c: str, w: np.ndarray) -> float:
+        """Most probable offset error of the channel (prior N(0, offset sd^2)) given whitened residuals w."""
+        nz = self.noise[c]
+        if nz.offset_sd <= 0.0:
+            return 0.0
+        wv = self._wv[c]
+        return float(wv @ w) / (float(wv @ wv) + 1.0 / nz.offset_sd**2)
+
+    def scaled_residual(self, c: str, pred: np.ndarray) -> np.ndarray:
+        """(measured - predicted - offset error) sd / s_t over the channel's span: AR(1) with the gauge's sd
+        and effective coefficient. The offset error (the pre-pulse mean is uncertain) is profiled."""
+        nz = self.noise[c]
+        u = self._raw_scaled(c, pred)
+        d = self._offset(c, whiten(u, sd=nz.sd, rho=nz.rho_long_run))
+        return u - d * self.weight[c]
 
     def _span(self, c: str) -> slice:
         i0, _, _, i3 = self.bounds[c]
@@ -90,8 +114,8 @@ class WholeRecordLikelihood:
     def hoop_gain(self, predicted_unit: np.ndarray) -> float:
         """Generalised least-squares gain of the hoop gauge for a prediction at gain 1."""
         s, nz, w = self._span("tube_hoop"), self.noise["tube_hoop"], self.weight["tube_hoop"]
-        wp = whiten(predicted_unit[s] * w, sd=nz.sd, rho=nz.rho)
-        wm = whiten(self.measured["tube_hoop"][s] * w, sd=nz.sd, rho=nz.rho)
+        wp = whiten(predicted_unit[s] * w, sd=nz.sd, rho=nz.rho_long_run)
+        wm = whiten(self.measured["tube_hoop"][s] * w, sd=nz.sd, rho=nz.rho_long_run)
         den = float(wp @ wp)
         return float(wm @ wp) / den if den > 0 else 1.0
 
@@ -108,13 +132,10 @@ class WholeRecordLikelihood:
         return pred, g
 
     def whitened(self, values: Mapping[str, float]) -> np.ndarray:
-        """AR(1)-whitened residuals of every channel, concatenated (log-likelihood = const - |w|^2 / 2)."""
+        """AR(1)-whitened residuals of every channel with its profiled offset error, concatenated, then one
+        pseudo-residual per channel (offset / its sd): log-likelihood = const - |w|^2 / 2."""
         pred, _ = self.strains(values)
-        out = []
-        for c in self.channels:
-            nz = self.noise[c]
-            out.append(whiten(self.scaled_residual(c, pred[c]), sd=nz.sd, rho=nz.rho))
-        return np.concatenate(out)
+        return self.whitened_from(pred)
 
     @property
     def n_samples(self) -> int:
@@ -125,24 +146,34 @@ class WholeRecordLikelihood:
             pred, _ = self.strains(values)
         except ValueError:
             return -np.inf
-        out = self._log_weight
+        w = self.whitened_from(pred)
+        return self._log_weight + self._const - 0.5 * float(w @ w)
+
+    def whitened_from(self, pred: Mapping[str, np.ndarray]) -> np.ndarray:
+        out, pseudo = [], []
         for c in self.channels:
             nz = self.noise[c]
-            out += float(ar1_loglike(self.scaled_residual(c, pred[c]), nz.sd, nz.rho))
-        return out
+            w = whiten(self._raw_scaled(c, pred[c]), sd=nz.sd, rho=nz.rho_long_run)
+            d = self._offset(c, w)
+            out.append(w - d * self._wv[c])
+            pseudo.append(d / nz.offset_sd if nz.offset_sd > 0 else 0.0)
+        return np.concatenate(out + [np.array(pseudo)])
 
 
 def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Mapping[str, float], *,
                      n_draws: int = 30, rng: np.random.Generator,
                      prior_scale: Mapping[str, tuple[float, float]] | None = None,
-                     importance: bool = True) -> WholeRecordFit:
+                     importance: bool = True, extra_starts: tuple[Mapping[str, float], ...] = ()) -> WholeRecordFit:
     """Posterior mode, Laplace approximation and importance-weighted draws (module docstring).
 
     ``start`` gives a value for every free parameter (``hoop_gain``, profiled, is not one).
     ``prior_scale`` (name -> (centre, sd) in the parameter's unbounded coordinate) gives the
     Gaussian stand-ins of the priors used while searching the mode (Levenberg-Marquardt on the
     whitened residuals); the exact ``log_prior`` weights the draws. Without ``importance`` the
-    draws are the normal approximation's, unweighted (no simulator run per draw).
+    draws are the normal approximation's, unweighted (no simulator run per draw). ``extra_starts``
+    (partial value sets overriding ``start``) are further starting points of the mode search; the
+    best mode is kept (the rise of the record pins the sample's confined modulus, which a low nu with
+    a stiff sample matches as well as the right nu: two modes).
     """
     params = [lik.model.parameters[n] for n in start if n != "hoop_gain"]
     names = tuple(p.name for p in params)
@@ -169,7 +200,13 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
             r = np.full(n_data[0] if n_data else lik.n_samples, 1e3)
         return np.concatenate([r, (z - centre) / width])
 
-    res = optimize.least_squares(residuals, z0, method="lm", x_scale="jac", diff_step=1e-6, max_nfev=60 * (len(z0) + 1))
+    res = None
+    for alt in ({}, *extra_starts):
+        za = np.array([float(p.to_unbounded(alt.get(p.name, start[p.name]))) for p in params])
+        r = optimize.least_squares(residuals, za, method="trf", x_scale=width, diff_step=1e-6,
+                                   max_nfev=60 * (len(z0) + 1))
+        if res is None or r.cost < res.cost:
+            res = r
     zm = res.x
     J = res.jac
     H = J.T @ J  # Gauss-Newton precision in z (data and the Gaussian stand-ins of the priors)
