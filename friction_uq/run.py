@@ -135,8 +135,9 @@ def run_file(
     hoop: bool = True,
     pdf: bool = True,
     progress: bool = True,
+    table: bool = True,
 ) -> RunResult:
-    """The main job (see the module docstring); prints a summary table at the end."""
+    """The main job (see the module docstring); prints a summary table at the end unless ``table=False``."""
     t_start = time.perf_counter()
     record = read_record(path)
     prep = prepare(record, window=window, dispersion=dispersion)
@@ -226,7 +227,8 @@ def run_file(
     outputs["json"] = js
     if backend.exists():
         backend.unlink()
-    print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds))
+    if table:
+        print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds))
     return RunResult(prep, samples, summary, conv, lab, outputs, seconds)
 
 
