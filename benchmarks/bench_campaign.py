@@ -1,6 +1,6 @@
 """Campaign scale: the bundled records on 1 and 2 local workers, and many simulated records.
 
-    python benchmarks/bench_campaign.py bundled [--workers 1 2] [--pdf]
+    python benchmarks/bench_campaign.py bundled [--workers 1 2] [--pdf] [--keep DIR]
     python benchmarks/bench_campaign.py simulated [--n 100] [--workers 2]
 
 ``bundled`` runs the 10 records of data/A and data/B in a fresh folder for each worker count
@@ -53,7 +53,8 @@ def bundled(args: argparse.Namespace) -> None:
     lines, base = [], None
     for w in args.workers:
         with tempfile.TemporaryDirectory() as tmp:
-            wall, results, doc = campaign(records, Path(tmp), workers=w, pdf=args.pdf)
+            out = Path(args.keep) / f"workers{w}" if args.keep else Path(tmp)
+            wall, results, doc = campaign(records, out, workers=w, pdf=args.pdf)
         lines.append(row("bundled", w, wall, results, base))
         base = base or wall
         print("\n".join(doc["statements"]))
@@ -90,6 +91,7 @@ def main() -> None:
     p.add_argument("--n", type=int, default=100, help="simulated records (default 100)")
     p.add_argument("--seed", type=int, default=2026)
     p.add_argument("--pdf", action="store_true", help="bundled: write the PDF reports too")
+    p.add_argument("--keep", help="bundled: keep the campaign outputs in KEEP/workers<N> (fresh folders)")
     args = p.parse_args()
     args.workers = args.workers or ([1, 2] if args.case == "bundled" else [2])
     (bundled if args.case == "bundled" else simulated)(args)

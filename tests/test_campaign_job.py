@@ -57,6 +57,9 @@ def test_up_to_date_needs_same_record_settings_prior_version_and_outputs(tmp_pat
                    {"settings": old.settings | {"seed": 6}}, {"settings": old.settings | {"dispersion": True}}):
         assert not _up_to_date(old, dataclasses.replace(old, **change), tmp_path), change
     assert not _up_to_date(dataclasses.replace(old, status="failed"), old, tmp_path)
+    with_pdf = dataclasses.replace(old, settings=old.settings | {"pdf": True})
+    assert _up_to_date(with_pdf, old, tmp_path)  # a run with the report serves one without
+    assert not _up_to_date(old, with_pdf, tmp_path)
     (tmp_path / "A_A-01.json").unlink()
     assert not _up_to_date(old, old, tmp_path)
 
@@ -120,7 +123,7 @@ def test_a_campaign_runs_on_a_separate_scheduler_and_a_bad_record_does_not_stop_
 
 
 def test_a_rerun_skips_what_is_up_to_date(scheduler_campaign, capsys):
-    code, d, out, address, _ = scheduler_campaign
+    _, d, out, address, _ = scheduler_campaign
     capsys.readouterr()
     assert main(["campaign", str(d), "--out", str(out), "--scheduler", address, "--no-pdf"]) == 1
     doc = json.loads((out / "campaign.json").read_text())

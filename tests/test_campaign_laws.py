@@ -97,7 +97,7 @@ def test_a_constant_friction_campaign_names_constant_and_flags_nothing():
 def test_choose_takes_the_simplest_nested_contender_or_says_the_data_do_not_separate():
     models = {m.name: m for m in (Model("velocity"), Model("pressure"), Model("pressure+velocity"),
                                   Model("velocity", "B"), Model("pressure", "B"))}
-    row = lambda m, d, se: {"model": m, "d_elpd": d, "d_se": se}  # noqa: E731
+    row = lambda m, d, se: {"model": m, "d_elpd": d, "d_se": se}
     nested = [row("pressure+velocity", 0.0, 0.0), row("velocity", 1.0, 1.5), row("pressure", 9.0, 2.0)]
     assert choose(nested, models).name == "velocity"
     apart = [row("velocity + offset B", 0.0, 0.0), row("pressure + offset B", 1.4, 1.9), row("velocity", 9.0, 1.0)]

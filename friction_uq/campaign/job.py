@@ -142,7 +142,11 @@ def write_result(result: RecordResult, path: str | os.PathLike[str]) -> Path:
 
 
 def _up_to_date(old: RecordResult, new: RecordResult, out_dir: Path) -> bool:
-    same = (old.ok and old.record_sha256 == new.record_sha256 and old.settings == new.settings
+    # a run with the PDF report also serves a campaign without one (not the other way round)
+    analysis = {k: v for k, v in old.settings.items() if k != "pdf"} == {k: v for k, v in new.settings.items()
+                                                                        if k != "pdf"}
+    pdf_ok = old.settings.get("pdf", False) or not new.settings.get("pdf", False)
+    same = (old.ok and old.record_sha256 == new.record_sha256 and analysis and pdf_ok
             and old.prior_sha256 == new.prior_sha256 and old.friction_uq_version == new.friction_uq_version)
     return same and all((out_dir / name).exists() for name in old.outputs.values())
 

@@ -135,7 +135,7 @@ def summary_text(doc: dict[str, Any]) -> str:
     """Plain-text campaign summary: one line per record, then the statements."""
     lines = [f"{'record':<28} {'set-up':<7} {'test':<8} {'status':<8} {'s':>6}  message"]
     for r in doc["records"]:
-        lines.append(f"{Path(r['path']).name:<28} {str(r['campaign'] or '-'):<7} {str(r['test_id'] or '-'):<8} "
+        lines.append(f"{Path(r['path']).name:<28} {r['campaign'] or '-'!s:<7} {r['test_id'] or '-'!s:<8} "
                      f"{r['status']:<8} {r['seconds']:>6.1f}  {r['message'] or ''}")
     c = doc["counts"]
     lines.append(f"{c['done']} analysed, {c['skipped']} up to date, {c['failed']} failed")

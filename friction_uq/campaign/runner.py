@@ -70,7 +70,7 @@ def read_header(path: Path) -> RecordHeader:
             mat = h5["apparatus/sample"].attrs.get("material") if "apparatus/sample" in h5 else None
     except (OSError, KeyError):
         return RecordHeader(str(path), sha, None, None, None)
-    as_str = lambda v: v.decode() if isinstance(v, bytes) else (str(v) if v is not None else None)  # noqa: E731
+    as_str = lambda v: v.decode() if isinstance(v, bytes) else (str(v) if v is not None else None)
     return RecordHeader(str(path), sha, as_str(camp), as_str(tid), as_str(mat))
 
 

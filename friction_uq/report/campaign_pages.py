@@ -115,7 +115,7 @@ def write_campaign_report(ca: CampaignAnalysis, doc: dict[str, Any], path: str |
     from matplotlib.backends.backend_pdf import PdfPages
 
     out = Path(path)
-    records = [f"{Path(r['path']).name:<22} {str(r['campaign']):<6} {str(r['test_id']):<8} {r['status']:<8} "
+    records = [f"{Path(r['path']).name:<22} {r['campaign']!s:<6} {r['test_id']!s:<8} {r['status']:<8} "
                f"{r['message'] or ''}" for r in doc["records"]]
     with plt.rc_context(RC):
         pages = [_text_page("Campaign summary", doc["statements"] + [""] + records)]
