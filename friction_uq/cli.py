@@ -193,7 +193,7 @@ def _add_campaign_parser(sub) -> None:
     s.add_argument("--priors", type=Path, help="prior file for every record (default: priors/<material>.toml)")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
-    s.add_argument("--no-pdf", action="store_true", help="no per-record and campaign PDF reports")
+    s.add_argument("--no-pdf", action="store_true", help="no per-record PDF reports (campaign.pdf is always written)")
     s.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
 
 

@@ -117,7 +117,8 @@ def test_a_campaign_runs_on_a_separate_scheduler_and_a_bad_record_does_not_stop_
         r = read_result(out / "records" / f"{name}.result.json")
         assert r.status == "done" and r.causes is None and 0.03 < r.summary["f"]["q50"] < 0.07
         assert (out / "records" / r.outputs["netcdf"]).exists()
-    assert (out / "campaign.nc").exists() and not (out / "campaign.pdf").exists()
+    assert (out / "campaign.nc").exists() and (out / "campaign.pdf").read_bytes()[:4] == b"%PDF"
+    assert not list((out / "records").glob("*.pdf"))  # --no-pdf: no per-record reports
     log = worker_log.read_text()
     assert "posterior (90 % credible intervals)" not in log and "wrote " not in log  # the job prints nothing
 

@@ -53,8 +53,8 @@ def run_campaign(
 ) -> CampaignOutcome:
     """Analyse every record (skipping those up to date), then pool, fit the laws, flag, write the outputs.
 
-    Per-record outputs go to ``out_dir/records/``; ``campaign.json``, ``campaign.nc`` and (with
-    ``pdf``) ``campaign.pdf`` to ``out_dir``.
+    Per-record outputs go to ``out_dir/records/`` (their PDF reports only with ``pdf``);
+    ``campaign.json``, ``campaign.nc`` and ``campaign.pdf`` to ``out_dir``.
     """
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
@@ -76,10 +76,9 @@ def run_campaign(
     outputs = {"json": write_json(doc, out / "campaign.json")}
     if ca is not None:
         outputs["netcdf"] = write_netcdf(ca, out / "campaign.nc")
-        if pdf:
-            from ..report.campaign_pages import write_campaign_report
+        from ..report.campaign_pages import write_campaign_report
 
-            outputs["pdf"] = write_campaign_report(ca, doc, out / "campaign.pdf")
+        outputs["pdf"] = write_campaign_report(ca, doc, out / "campaign.pdf")
     return CampaignOutcome(results, ca, doc, outputs)
 
 

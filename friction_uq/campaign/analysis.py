@@ -18,7 +18,7 @@ from ..errors import FrictionUQError
 from ..priors import load_priors
 from .flags import outlier_tests, setup_flags, tally_causes
 from .job import RecordResult
-from .laws import LAWS, NESTS, Elpd, Fit, LawData, Model, decisive, loo, rank
+from .laws import LAWS, NESTS, Elpd, Fit, LawData, Model, decisive, law_mean, loo, rank
 from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin
 
 MIN_TESTS_FOR_LAWS = 5
@@ -53,6 +53,16 @@ class CampaignAnalysis:
     nu: tuple[float, float] = (float("nan"), float("nan"))
     flagged: list[dict[str, object]] = field(default_factory=list)
     sentences: list[str] = field(default_factory=list)
+
+    def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:
+        """Draws of f along (V, p) for one set-up under a fitted model, at the campaign's nu: (draws, len(V))."""
+        fit = self.fits[model]
+        x = fit.draws[:: max(1, len(fit.draws) // n)]
+        th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
+        y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref)
+        if fit.model.offset_setup == setup:
+            y = y * (1.0 + th["delta"])
+        return y * fit.kbar * (1.0 - self.nu[0]) / self.nu[0]
 
 
 def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:

@@ -52,20 +52,6 @@ def _forest(ca: CampaignAnalysis):
     return fig
 
 
-def _law_curve(ca: CampaignAnalysis, name: str, V: np.ndarray, p: np.ndarray, setup: str) -> np.ndarray:
-    """Draws of f along (V, p) for one set-up under model ``name`` (kappa law x (1-nu)/nu): (draws, len(V))."""
-    from ..campaign.laws import law_mean  # the campaign stage's law shapes, imported lazily
-
-    fit = ca.fits[name]
-    x = fit.draws[:: max(1, len(fit.draws) // 400)]
-    th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
-    y = law_mean(fit.model.law, th, V, (p - fit.p_ref) / fit.p_ref)
-    if fit.model.offset_setup == setup:
-        y = y * (1.0 + th["delta"])
-    nu = ca.nu[0]
-    return y * fit.kbar * (1 - nu) / nu
-
-
 def _law_page(ca: CampaignAnalysis):
     d = ca.law_data
     name = ca.chosen or str(ca.ranking[0]["model"])
@@ -80,7 +66,7 @@ def _law_page(ca: CampaignAnalysis):
         coef = np.polyfit(d.V[on], d.p[on], 1) if on.sum() > 1 else np.array([0.0, d.p[on][0]])
         vv = np.linspace(d.V[on].min() * 0.9, d.V[on].max() * 1.1, 60)
         pp = np.polyval(coef, vv)
-        band = np.quantile(_law_curve(ca, name, vv, pp, s), [0.05, 0.5, 0.95], axis=0)
+        band = np.quantile(ca.f_curve(name, vv, pp, s), [0.05, 0.5, 0.95], axis=0)
         for ax, x, xx, xs in ((axes[0], d.V[on], vv, 1.0), (axes[1], d.p[on], pp, 1e-6)):
             ax.errorbar(x * xs, f, yerr=1.645 * fsd, fmt="o", color=f"C{k}", capsize=3, label=f"set-up {s}")
             ax.fill_between(xx * xs, band[0], band[2], color=f"C{k}", alpha=0.2)
