@@ -156,6 +156,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("results", type=Path, nargs="+", help="<campaign>_<test_id>.json files written by run")
     s.add_argument("-o", "--output", type=Path, help="figure file (PDF or PNG)")
 
+    _add_campaign_parser(sub)
+
     s = sub.add_parser("run", help="joint posterior of f and nu, uncertainty propagation, PDF report",
                        description="The main job: sample the posterior of f and nu for one record and "
                        "write <campaign>_<test_id>.nc, .json and .pdf.")
@@ -257,6 +259,8 @@ def _dispatch(args: argparse.Namespace) -> int:
 
             print(f"wrote {campaign_figure(comp, args.output)}")
         return 0
+    if args.command == "campaign":
+        return _campaign(args)
     if args.command in ("run", "diagnose"):
         from .run import run_file
 
@@ -268,6 +272,50 @@ def _dispatch(args: argparse.Namespace) -> int:
         )
         return 0
     raise AssertionError(args.command)  # argparse restricts the choices
+
+
+def _workers(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"workers {text!r} is not a whole number") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"workers must be at least 1, got {v}")
+    return v
+
+
+def _add_campaign_parser(sub) -> None:
+    s = sub.add_parser("campaign", help="many records in parallel (Dask), pooled, the friction law across set-ups",
+                       description="Analyse records on Dask (a local cluster or a scheduler), skip those up to "
+                       "date, pool f and kappa from the stored draws, compare friction laws by leave-one-test-out "
+                       "ELPD and flag set-ups off the shared law. Writes DIR/campaign.json, .nc, .pdf and "
+                       "DIR/records/. Exit 0 when every record was analysed, 1 when some were refused (the "
+                       "summary says why), 2 on bad input.")
+    s.add_argument("records", type=Path, nargs="*", help="record files (test.h5) or folders of them")
+    s.add_argument("--out", type=Path, required=True, help="campaign output directory")
+    s.add_argument("--workers", type=_workers, default=2, help="local worker processes (default 2)")
+    s.add_argument("--scheduler", help="address of a running Dask scheduler (e.g. tcp://10.0.0.5:8786) "
+                   "instead of a local cluster")
+    s.add_argument("--seed", type=int, default=20161, help="campaign seed (default 20161)")
+    s.add_argument("--priors", type=Path, help="prior file for every record (default: priors/<material>.toml)")
+    s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
+    s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
+    s.add_argument("--no-pdf", action="store_true", help="no per-record PDF reports (campaign.pdf is always written)")
+    s.add_argument("--diagnose", action="store_true",
+                   help="diagnose each record (run --diagnose) and tally the causes named per set-up")
+    s.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
+
+
+def _campaign(args: argparse.Namespace) -> int:
+    from .campaign import run_campaign, summary_text
+
+    outcome = run_campaign(args.records, args.out, workers=args.workers, scheduler=args.scheduler, seed=args.seed,
+                           priors_path=args.priors, dispersion=args.dispersion, hoop=not args.no_hoop,
+                           pdf=not args.no_pdf, progress=not args.quiet, diagnose=args.diagnose)
+    print(summary_text(outcome.doc))
+    for path in outcome.outputs.values():
+        print(f"wrote {path}")
+    return 1 if outcome.doc["counts"]["failed"] else 0
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -5,11 +5,15 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-
-from ..campaign import Comparison
 from .style import RC, figure, save_figure
+
+
+if TYPE_CHECKING:  # the figure draws a comparison; it does not import the campaign stage
+    from ..campaign.compare import Comparison
 
 
 def campaign_figure(c: Comparison, path: str | os.PathLike[str]) -> Path:

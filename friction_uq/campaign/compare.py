@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import FrictionUQError
+from ..errors import FrictionUQError
 
 REQUIRED = ("f", "kappa", "nu", "V", "p_mean", "test_id", "campaign")
 

@@ -1,0 +1,91 @@
+"""Campaigns: many records analysed in parallel on Dask, pooled, and the friction law across set-ups.
+
+Modules, one concern each:
+
+* :mod:`.job` - the per-record job and its versioned result (read back with ``read_result``);
+* :mod:`.runner` - records and seeds, the Dask cluster or scheduler, the progress bar;
+* :mod:`.pooling` - hierarchical pooling of f and kappa from the stored draws;
+* :mod:`.laws` - friction laws fitted jointly, leave-one-test-out ELPD;
+* :mod:`.flags` - set-ups and tests off the shared law, per-record causes tallied;
+* :mod:`.analysis` - from the results to the campaign's conclusions;
+* :mod:`.outputs` - ``campaign.json``, ``campaign.nc``, the text summary;
+* :mod:`.compare` - the older ``compare`` of JSON medians (weighted trend lines).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import FrictionUQError
+from .analysis import CampaignAnalysis, analyse
+from .compare import Comparison, TestResult, TrendFit, compare, comparison_table, fit_trend, load_result
+from .job import RecordResult, RecordTask, read_result, run_record
+from .outputs import campaign_doc, summary_text, write_json, write_netcdf
+from .runner import check_headers, find_records, make_tasks, read_header, record_seed, run_tasks
+
+RECORDS_SUBDIR = "records"
+
+
+@dataclass(frozen=True)
+class CampaignOutcome:
+    results: list[RecordResult]
+    analysis: CampaignAnalysis | None
+    doc: dict[str, Any]
+    outputs: dict[str, Path]
+
+
+def run_campaign(
+    inputs: Sequence[str | os.PathLike[str]],
+    out_dir: str | os.PathLike[str],
+    *,
+    workers: int = 2,
+    scheduler: str | None = None,
+    seed: int = 20161,
+    priors_path: str | os.PathLike[str] | None = None,
+    dispersion: bool = False,
+    hoop: bool = True,
+    pdf: bool = True,
+    diagnose: bool = False,
+    progress: bool = True,
+) -> CampaignOutcome:
+    """Analyse every record (skipping those up to date), then pool, fit the laws, flag, write the outputs.
+
+    Per-record outputs go to ``out_dir/records/`` (their PDF reports only with ``pdf``);
+    ``campaign.json``, ``campaign.nc`` and ``campaign.pdf`` to ``out_dir``.
+    """
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise FrictionUQError(f"{out}: --out must be a directory, and this is a file")
+    headers = [read_header(p) for p in find_records(inputs)]
+    check_headers(headers)
+    records_dir = out / RECORDS_SUBDIR
+    try:
+        records_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FrictionUQError(f"{records_dir}: cannot create the output directory ({exc.strerror or exc})") from None
+    tasks = make_tasks(headers, out_dir=records_dir, seed=seed, priors_path=str(priors_path) if priors_path else None,
+                       dispersion=dispersion, hoop=hoop, pdf=pdf, diagnose=diagnose)
+    results = run_tasks(tasks, workers=workers, scheduler=scheduler, progress=progress)
+    ca = analyse(results, records_dir, seed=seed) if any(r.ok for r in results) else None
+    settings = {"dispersion": dispersion, "hoop": hoop, "pdf": pdf, "diagnose": diagnose,
+                "priors": str(priors_path) if priors_path else None}
+    doc = campaign_doc(results, ca, seed=seed, settings=settings)
+    outputs = {"json": write_json(doc, out / "campaign.json")}
+    if ca is not None:
+        outputs["netcdf"] = write_netcdf(ca, out / "campaign.nc")
+        from ..report.campaign_pages import write_campaign_report
+
+        outputs["pdf"] = write_campaign_report(ca, doc, out / "campaign.pdf")
+    return CampaignOutcome(results, ca, doc, outputs)
+
+
+__all__ = [
+    "CampaignAnalysis", "CampaignOutcome", "Comparison", "RecordResult", "RecordTask", "TestResult", "TrendFit",
+    "analyse", "check_headers", "compare", "comparison_table", "find_records", "fit_trend", "load_result",
+    "make_tasks", "read_header", "read_result", "record_seed", "run_campaign", "run_record", "run_tasks",
+    "summary_text",
+]

@@ -1,0 +1,202 @@
+"""From the per-record results of a campaign to its pooled values, friction law and flags.
+
+Reads each analysed record's stored draws (the ``.nc`` beside its result), pools f and kappa
+(:mod:`.pooling`), fits the candidate friction laws with and without a set-up offset
+(:mod:`.laws`), chooses the best-supported law by leave-one-test-out ELPD, converts its
+parameters from kappa to f with the campaign's nu, and flags set-ups and tests (:mod:`.flags`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FrictionUQError
+from ..priors import load_priors
+from .flags import outlier_tests, setup_flags, tally_causes
+from .job import RecordResult
+from .laws import LAWS, NESTS, Elpd, Fit, LawData, Model, decisive, law_mean, loo, rank
+from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin
+
+MIN_TESTS_FOR_LAWS = 5
+
+
+@dataclass
+class RecordPosterior:
+    """One analysed test's draws (thinned) read back from its ``.nc``."""
+
+    label: str
+    setup: str
+    f: np.ndarray
+    kappa: np.ndarray
+    nu: np.ndarray
+    p_mean: np.ndarray
+    V: dict[str, float]
+    prior_file: str
+
+
+@dataclass
+class CampaignAnalysis:
+    tests: list[RecordPosterior]
+    pooled: dict[str, Pooled]
+    tallies: dict[str, dict[str, object]]
+    law_data: LawData | None = None
+    ranking: list[dict[str, object]] = field(default_factory=list)
+    best: str | None = None
+    chosen: str | None = None
+    law_posterior: dict[str, dict[str, float]] = field(default_factory=dict)
+    law_draws: dict[str, np.ndarray] = field(default_factory=dict)
+    fits: dict[str, Fit] = field(default_factory=dict)
+    nu: tuple[float, float] = (float("nan"), float("nan"))
+    flagged: list[dict[str, object]] = field(default_factory=list)
+    sentences: list[str] = field(default_factory=list)
+
+    def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:
+        """Draws of f along (V, p) for one set-up under a fitted model, at the campaign's nu: (draws, len(V))."""
+        fit = self.fits[model]
+        x = fit.draws[:: max(1, len(fit.draws) // n)]
+        th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
+        y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref)
+        if fit.model.offset_setup == setup:
+            y = y * (1.0 + th["delta"])
+        return y * fit.kbar * (1.0 - self.nu[0]) / self.nu[0]
+
+
+def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
+    """Thinned posterior draws of f, kappa, nu and p_mean from the record's ``.nc``."""
+    import xarray as xr
+
+    nc = records_dir / r.outputs.get("netcdf", "")
+    try:
+        dt = xr.open_datatree(nc, engine="h5netcdf")
+        post = dt["posterior"]
+        draws = {k: thin(post[k].values) for k in ("f", "kappa", "nu", "p_mean")}
+        dt.close()
+    except (OSError, KeyError, ValueError) as exc:
+        raise FrictionUQError(f"{nc}: cannot read the posterior draws of {r.label} ({exc})") from None
+    return RecordPosterior(r.label, str(r.campaign), draws["f"], draws["kappa"], draws["nu"], draws["p_mean"],
+                         r.summary["V"], str(r.prior_file))
+
+
+def campaign_nu(tests: Sequence[RecordPosterior], prior_mean: float, prior_sd: float) -> tuple[float, float]:
+    """nu shared by the tests: normal approximations of their posteriors combined, the prior counted once."""
+    prec = sum(1.0 / np.var(t.nu) for t in tests) - (len(tests) - 1) / prior_sd**2
+    num = sum(np.mean(t.nu) / np.var(t.nu) for t in tests) - (len(tests) - 1) * prior_mean / prior_sd**2
+    if prec <= 1.0 / prior_sd**2:  # the tests add nothing beyond the prior (no hoop term): keep the prior
+        return prior_mean, prior_sd
+    return float(num / prec), float(1.0 / np.sqrt(prec))
+
+
+def _law_data(tests: Sequence[RecordPosterior]) -> LawData:
+    return LawData([t.label for t in tests], [t.setup for t in tests],
+                   np.array([np.mean(t.kappa) for t in tests]), np.array([np.std(t.kappa) for t in tests]),
+                   np.array([t.V["mean"] for t in tests]), np.array([t.V["sd"] for t in tests]),
+                   np.array([np.mean(t.p_mean) for t in tests]), np.array([np.std(t.p_mean) for t in tests]))
+
+
+def _nested(a: Model, b: Model) -> bool:
+    """Model a is a special case of model b."""
+    return b.law in NESTS[a.law] and (a.offset_setup is None or a.offset_setup == b.offset_setup)
+
+
+def choose(ranking: Sequence[dict[str, object]], models: dict[str, Model]) -> Model | None:
+    """The simplest model not decisively worse than the top one that all such models contain, else None."""
+    contenders = [models[str(r["model"])] for r in ranking if not decisive(float(r["d_elpd"]), float(r["d_se"]))]
+    for m in sorted(contenders, key=lambda m: len(m.params)):
+        if all(_nested(m, other) for other in contenders):
+            return m
+    return None
+
+
+def _summ(x: np.ndarray) -> dict[str, float]:
+    q = np.quantile(x, [0.05, 0.5, 0.95])
+    return {"mean": float(np.mean(x)), "sd": float(np.std(x)), "q05": float(q[0]), "q50": float(q[1]),
+            "q95": float(q[2])}
+
+
+def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np.ndarray]:
+    """The law's parameters in f units: kappa-law draws times (1-nu)/nu with the campaign's nu."""
+    rng = np.random.default_rng(seed)
+    x = fit.draws
+    nu_d = np.clip(rng.normal(nu[0], nu[1], len(x)), 1e-3, 0.499)
+    g = fit.kbar * (1.0 - nu_d) / nu_d
+    col = {p: x[:, k] for k, p in enumerate(fit.model.params)}
+    out: dict[str, np.ndarray] = {}
+    if "a" in col:
+        out["f_ref" if "c" in col else "f"] = col["a"] * g
+    if "s" in col:
+        out["f_s"], out["f_d"], out["v_c"] = col["s"] * g, col["d"] * g, np.exp(col["log_vc"])
+    if "c" in col:
+        out["c_per_p_ref"] = col["c"]
+        out["df_dp_per_MPa"] = col["c"] / fit.p_ref * 1e6 * (col.get("a", col.get("d")) * g)
+    if "delta" in col:
+        out[f"offset_{fit.model.offset_setup}"] = col["delta"]
+    out["scatter_rel"] = col["r"]
+    return out
+
+
+def analyse(results: Sequence[RecordResult], records_dir: str | Path, *, seed: int = 20161) -> CampaignAnalysis:
+    """Pool, fit the laws, choose, flag (see the module docstring)."""
+    ok = [r for r in results if r.ok]
+    tests = [read_test_posterior(r, Path(records_dir)) for r in ok]
+    return analyse_tests(tests, tally_causes(ok), seed=seed)
+
+
+def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str, object]], *,
+                  seed: int = 20161) -> CampaignAnalysis:
+    """The campaign's conclusions from the tests' draws and the tally of their causes."""
+    tests = list(tests)
+    pooled: dict[str, Pooled] = {}
+    if tests:
+        priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
+        pooled["f"] = pool([StoredDraws(t.label, t.setup, t.f, priors[t.prior_file]["f"].logpdf(t.f)) for t in tests], "f")
+        pooled["kappa"] = pool([StoredDraws(t.label, t.setup, t.kappa, implied_kappa_log_prior(t.kappa, priors[t.prior_file]))
+                                for t in tests], "kappa")
+    ca = CampaignAnalysis(tests, pooled, tallies)
+    if len(tests) < MIN_TESTS_FOR_LAWS:
+        ca.sentences.append(f"friction law: {len(tests)} analysed test(s); comparing laws needs at least "
+                            f"{MIN_TESTS_FOR_LAWS}")
+        return ca
+    data = _law_data(tests)
+    ca.law_data = data
+    kbar, p_ref = float(np.mean(data.kappa)), float(np.mean(data.p))
+    setups = sorted(set(data.setups))
+    offsets = [setups[-1]] if len(setups) == 2 else (setups if len(setups) > 2 else [])
+    models = {m.name: m for m in [Model(law) for law in LAWS] + [Model(law, s) for s in offsets for law in LAWS]}
+    elpds: dict[str, Elpd] = {}
+    for k, (name, m) in enumerate(models.items()):
+        fit = Fit(m, data, kbar=kbar, p_ref=p_ref, seed=seed + 1000 * k)
+        ca.fits[name] = fit
+        elpds[name] = loo(fit, seed=seed + 1000 * k)
+    ca.ranking = rank(list(elpds.values()))
+    chosen = choose(ca.ranking, models)
+    if chosen is None:
+        top_laws = {models[str(r["model"])].law for r in ca.ranking
+                    if not decisive(float(r["d_elpd"]), float(r["d_se"]))}
+        ca.sentences.append("friction law: the data do not separate " + ", ".join(sorted(top_laws))
+                            + " (none is decisively better: dELPD > 4 and > 2 SE)")
+        law_for_flags = models[str(ca.ranking[0]["model"])].law
+    else:
+        ca.chosen, ca.best = chosen.name, chosen.law
+        law_for_flags = chosen.law
+    prior0 = load_priors(tests[0].prior_file)["nu"]
+    pm, psd = float(prior0.ppf(0.5)), float(np.std(prior0.rvs(np.random.default_rng(seed), 20000)))
+    with_offset = {s: (elpds[Model(law_for_flags, s).name],
+                       _summ(ca.fits[Model(law_for_flags, s).name].draws[:, -2])) for s in offsets}
+    ca.flagged = setup_flags(elpds[law_for_flags], with_offset, setups, tallies)
+    flagged_setups = {str(f["setup"]) for f in ca.flagged}
+    if len(setups) == 2 and flagged_setups:
+        flagged_setups = set(setups)
+    trusted = [t for t in tests if t.setup not in flagged_setups] or tests
+    if len(setups) == 2 and ca.flagged and "named_by_causes" in ca.flagged[0]:
+        trusted = [t for t in tests if t.setup != ca.flagged[0]["named_by_causes"]]
+    ca.nu = campaign_nu(trusted, pm, psd)
+    name = ca.chosen or str(ca.ranking[0]["model"])
+    ca.law_draws = f_law_draws(ca.fits[name], ca.nu, seed=seed)
+    ca.law_posterior = {k: _summ(v) for k, v in ca.law_draws.items()}
+    chosen_elpd = elpds[name]
+    ca.flagged += outlier_tests(chosen_elpd, data.labels)
+    return ca

@@ -1,0 +1,94 @@
+"""Set-ups and tests that do not follow the shared law, and the per-record causes tallied beside them.
+
+A set-up is flagged when the best law with a multiplicative offset on that set-up beats the law
+without it decisively (leave-one-test-out dELPD > 4 and > 2 SE). With exactly two set-ups an
+offset on one is the same model as an offset on the other: the campaign then says that the two
+disagree, by how much, and lets the per-record causes (when a diagnosis named them) say which.
+
+A test is flagged when its own leave-one-out predictive density under the chosen model is an
+outlier: a pointwise ELPD more than 4 below the median of the others (a test the law and the
+between-test scatter do not explain).
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Sequence
+
+import numpy as np
+
+from .job import RecordResult
+from .laws import Elpd, decisive, difference
+
+TEST_OUTLIER_ELPD = 4.0
+
+
+def tally_causes(results: Sequence[RecordResult]) -> dict[str, dict[str, object]]:
+    """Per set-up: tests analysed, tests diagnosed, and how many tests named each cause.
+
+    ``causes`` is None on a result no diagnosis was made for; such tests count in ``tests`` but
+    not in ``diagnosed``. A cause named twice in one test counts once.
+    """
+    out: dict[str, dict[str, object]] = {}
+    for r in results:
+        if not r.ok:
+            continue
+        entry = out.setdefault(str(r.campaign), {"tests": 0, "diagnosed": 0, "causes": Counter()})
+        entry["tests"] += 1
+        if r.causes is not None:
+            entry["diagnosed"] += 1
+            entry["causes"].update(set(r.causes))
+    return {k: {"tests": v["tests"], "diagnosed": v["diagnosed"], "causes": dict(sorted(v["causes"].items()))}
+            for k, v in sorted(out.items())}
+
+
+def causes_sentence(setup: str, tally: dict[str, object]) -> str:
+    """E.g. 'set-up B: 5 tests, 5 diagnosed; plug friction named in 5, gauge gain in 1'."""
+    causes = tally.get("causes") or {}
+    head = f"set-up {setup}: {tally['tests']} tests, {tally['diagnosed']} diagnosed"
+    if not tally["diagnosed"]:
+        return head + " (no per-record diagnosis in these results)"
+    if not causes:
+        return head + "; no cause named"
+    return head + "; " + ", ".join(f"{c} named in {n}" for c, n in sorted(causes.items(), key=lambda kv: -kv[1]))
+
+
+def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]], setups: Sequence[str],
+                tallies: dict[str, dict[str, object]]) -> list[dict[str, object]]:
+    """One entry per set-up whose offset model beats the shared law decisively."""
+    flags = []
+    pair = len(setups) == 2
+    for s, (e, delta) in with_offset.items():
+        d, se = difference(e, base)
+        if not decisive(d, se):
+            continue
+        other = [x for x in setups if x != s]
+        entry: dict[str, object] = {
+            "setup": s, "offset": delta, "d_elpd": d, "d_se": se,
+            "tests": int(tallies.get(s, {}).get("tests", 0)),
+        }
+        if pair:
+            entry["relative_to"] = other[0]
+            entry["note"] = (f"with two set-ups an offset on {s} is an offset on {other[0]}: they disagree by "
+                             f"{delta['q50'] * 100:+.0f} % on kappa; which one is off needs a third set-up or "
+                             "the per-record causes")
+            named = {x: sum((tallies.get(x, {}).get("causes") or {}).values()) for x in setups}
+            if named[s] > 0 and named[other[0]] == 0:
+                entry["named_by_causes"] = s
+            elif named[other[0]] > 0 and named[s] == 0:
+                entry["named_by_causes"] = other[0]
+        entry["causes"] = {x: causes_sentence(x, tallies[x]) for x in ([s] + (other if pair else [])) if x in tallies}
+        flags.append(entry)
+    return flags
+
+
+def outlier_tests(chosen: Elpd, labels: Sequence[str]) -> list[dict[str, object]]:
+    """Tests whose leave-one-out density is far below the others' under the chosen model."""
+    pw = chosen.pointwise
+    out = []
+    for i, lab in enumerate(labels):
+        rest = np.delete(pw, i)
+        gap = float(np.median(rest) - pw[i])
+        if gap > TEST_OUTLIER_ELPD:
+            out.append({"test": lab, "elpd_loo": float(pw[i]), "below_median_by": gap})
+    return out

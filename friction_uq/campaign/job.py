@@ -1,0 +1,212 @@
+"""The per-record job of a campaign and its result, with a versioned JSON schema.
+
+:func:`run_record` is what a Dask worker runs for one record: it calls
+:func:`friction_uq.run.run_file` (no progress, no table), reads back the JSON it wrote and returns
+a :class:`RecordResult`. It prints nothing: whatever the analysis would say on the terminal
+(notes such as a hoop gauge left out) is captured into ``notes``. A record the analysis refuses
+gives a result with ``status = "failed"`` and the one-sentence refusal as ``message``; the job
+never raises for a bad record, so the campaign goes on.
+
+The result is written beside the run outputs as ``<stem>.result.json`` and read back with
+:func:`read_result` (the one function that knows the schema). A record whose stored result is
+up to date (same record sha256, same settings, same prior file checksum, same package version,
+outputs present) is not analysed again: the job returns the stored result with ``status =
+"skipped"``.
+
+Schema version 1 (``schema = "friction-uq/campaign-record"``): ``path``, ``status``
+(``done`` | ``skipped`` | ``failed``), ``message``, ``campaign`` (the set-up), ``test_id``,
+``material``, ``record_sha256``, ``prior_file``, ``prior_sha256``, ``friction_uq_version``,
+``settings`` (seed, dispersion, hoop, pdf), ``outputs`` (file names in the same folder),
+``summary`` (f, kappa, nu, V, p_mean: mean, sd, q05, q50, q95), ``converged``, ``notes``,
+``seconds`` (wall), ``cpu_seconds`` (the worker process's user + system time for this record),
+``peak_rss_mb`` (the worker process's peak resident memory so far) and ``causes``: the causes a per-record diagnosis names (a list of strings, or null
+when no diagnosis was made); the campaign tallies them per set-up.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import hashlib
+import io
+import json
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .. import __version__
+from .._atomic import atomic_path
+from ..errors import FrictionUQError
+
+SCHEMA = "friction-uq/campaign-record"
+SCHEMA_VERSION = 1
+SUMMARY_VARIABLES = ("f", "kappa", "nu", "V", "p_mean")
+STATUSES = ("done", "skipped", "failed")
+
+
+@dataclass(frozen=True)
+class RecordTask:
+    """One record to analyse: the file, its seed and the campaign's settings."""
+
+    path: str
+    seed: int
+    out_dir: str
+    priors_path: str | None = None
+    dispersion: bool = False
+    hoop: bool = True
+    pdf: bool = True
+    diagnose: bool = False
+
+    @property
+    def settings(self) -> dict[str, Any]:
+        out = {"seed": int(self.seed), "dispersion": bool(self.dispersion), "hoop": bool(self.hoop),
+               "pdf": bool(self.pdf)}
+        if self.diagnose:  # only when set: results written without it stay up to date
+            out["diagnose"] = True
+        return out
+
+
+@dataclass(frozen=True)
+class RecordResult:
+    """What the job returns for one record (see the module docstring for the schema)."""
+
+    path: str
+    status: str
+    message: str | None = None
+    campaign: str | None = None
+    test_id: str | None = None
+    material: str | None = None
+    record_sha256: str | None = None
+    prior_file: str | None = None
+    prior_sha256: str | None = None
+    friction_uq_version: str = __version__
+    settings: dict[str, Any] = field(default_factory=dict)
+    outputs: dict[str, str] = field(default_factory=dict)
+    summary: dict[str, dict[str, float]] = field(default_factory=dict)
+    converged: bool | None = None
+    notes: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+    cpu_seconds: float = 0.0
+    peak_rss_mb: float = 0.0
+    causes: list[str] | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.status in ("done", "skipped")
+
+    @property
+    def label(self) -> str:
+        return f"{self.campaign} {self.test_id}" if self.test_id else Path(self.path).name
+
+    def to_json(self) -> dict[str, Any]:
+        return {"schema": SCHEMA, "schema_version": SCHEMA_VERSION} | dataclasses.asdict(self)
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def read_result(path: str | os.PathLike[str]) -> RecordResult:
+    """Read a ``<stem>.result.json`` back; refuse a file of another schema or version with one sentence."""
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise FrictionUQError(f"{p}: not a campaign record result ({exc})") from None
+    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
+        raise FrictionUQError(f"{p}: not a campaign record result (key 'schema' is not {SCHEMA!r})")
+    if doc.get("schema_version") != SCHEMA_VERSION:
+        raise FrictionUQError(f"{p}: key 'schema_version' is {doc.get('schema_version')!r}, this friction-uq reads "
+                              f"version {SCHEMA_VERSION}")
+    names = {f.name for f in dataclasses.fields(RecordResult)}
+    unknown = sorted(set(doc) - names - {"schema", "schema_version"})
+    if unknown:
+        raise FrictionUQError(f"{p}: unknown key(s) {', '.join(unknown)} in a schema version {SCHEMA_VERSION} result")
+    if doc.get("status") not in STATUSES:
+        raise FrictionUQError(f"{p}: key 'status' is {doc.get('status')!r}, allowed values: {', '.join(STATUSES)}")
+    if "path" not in doc:
+        raise FrictionUQError(f"{p}: key 'path' missing")
+    return RecordResult(**{k: v for k, v in doc.items() if k in names})
+
+
+def result_path(out_dir: str | os.PathLike[str], stem: str) -> Path:
+    return Path(out_dir) / f"{stem}.result.json"
+
+
+def write_result(result: RecordResult, path: str | os.PathLike[str]) -> Path:
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(json.dumps(result.to_json(), indent=2) + "\n")
+    return Path(path)
+
+
+def _up_to_date(old: RecordResult, new: RecordResult, out_dir: Path) -> bool:
+    # a run with the PDF report also serves a campaign without one (not the other way round)
+    analysis = {k: v for k, v in old.settings.items() if k != "pdf"} == {k: v for k, v in new.settings.items()
+                                                                        if k != "pdf"}
+    pdf_ok = old.settings.get("pdf", False) or not new.settings.get("pdf", False)
+    same = (old.ok and old.record_sha256 == new.record_sha256 and analysis and pdf_ok
+            and old.prior_sha256 == new.prior_sha256 and old.friction_uq_version == new.friction_uq_version)
+    return same and all((out_dir / name).exists() for name in old.outputs.values())
+
+
+def _summary(doc: dict[str, Any]) -> dict[str, dict[str, float]]:
+    return {k: {s: float(doc[k][s]) for s in ("mean", "sd", "q05", "q50", "q95")} for k in SUMMARY_VARIABLES}
+
+
+def _peak_rss_mb() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB on Linux
+
+
+def run_record(task: RecordTask) -> RecordResult:
+    """Analyse one record (or find it up to date); never prints, never raises for a bad record."""
+    from ..priors import default_prior_path
+    from ..record import read_record
+    from ..run import run_file, safe_stem
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    out = Path(task.out_dir)
+    base = RecordResult(path=str(task.path), status="failed", settings=task.settings)
+    try:
+        record = read_record(task.path)
+        material = record.apparatus.sample.material
+        prior = Path(task.priors_path) if task.priors_path else default_prior_path(material)
+        stem = safe_stem(record.campaign, record.test_id)
+        base = dataclasses.replace(
+            base, campaign=record.campaign, test_id=record.test_id, material=material,
+            record_sha256=record.sha256, prior_file=str(prior),
+            prior_sha256=file_sha256(prior) if prior.is_file() else None)
+        stored = result_path(out, stem)
+        if stored.exists():
+            try:
+                old = read_result(stored)
+            except FrictionUQError:
+                old = None
+            if old is not None and _up_to_date(old, base, out):
+                return dataclasses.replace(old, status="skipped", path=str(task.path))
+        buf_out, buf_err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(buf_out), contextlib.redirect_stderr(buf_err):
+            run = run_file(task.path, priors_path=task.priors_path, out_dir=out, seed=task.seed,
+                           dispersion=task.dispersion, hoop=task.hoop, pdf=task.pdf, progress=False, table=False,
+                           diagnose=task.diagnose)
+        doc = json.loads(run.outputs["json"].read_text())
+        notes = [line.removeprefix("friction-uq: note: ") for line in buf_err.getvalue().splitlines() if line.strip()]
+        result = dataclasses.replace(
+            base, status="done", outputs={k: p.name for k, p in run.outputs.items()}, summary=_summary(doc),
+            converged=bool(doc.get("converged")), notes=notes, seconds=time.perf_counter() - t0,
+            cpu_seconds=time.process_time() - c0, peak_rss_mb=_peak_rss_mb(),
+            causes=[c["name"] for c in doc["discrepancy"]["causes"]] if "discrepancy" in doc else None)
+        write_result(result, stored)
+        return result
+    except FrictionUQError as exc:
+        return dataclasses.replace(base, message=str(exc), seconds=time.perf_counter() - t0)
+    except Exception as exc:  # noqa: BLE001 - one record's crash must not stop a campaign of a hundred
+        return dataclasses.replace(base, message=f"{task.path}: unexpected {type(exc).__name__}: {exc}",
+                                   seconds=time.perf_counter() - t0)

@@ -1,0 +1,148 @@
+"""The campaign's outputs: ``campaign.json`` (schema below), ``campaign.nc`` and the text summary.
+
+``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 1``): ``records`` (each
+record's path, set-up, test id, ``status`` done | skipped | failed, the refusal ``message``,
+seconds), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
+scatter ``sigma`` with 90 % intervals, each test's effective sample size, the Monte Carlo variance
+of the hyper-log-likelihood, or ``refused`` with the reason), ``friction_law`` (``best``: one of
+constant, velocity, pressure, pressure+velocity or null; ``chosen_model``; ``ranking``: every
+model with ELPD, dELPD and its SE against the top; ``posterior`` of the chosen (else top) model's
+parameters in f units; ``models``: the same for every model; ``nu`` the campaign's nu),
+``flagged`` (set-ups and tests), ``causes`` (per set-up tally of the per-record causes) and
+``statements`` (the sentences the summary prints).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import __version__
+from .._atomic import atomic_path
+from .analysis import CampaignAnalysis, f_law_draws
+from .job import RecordResult
+
+SCHEMA = "friction-uq/campaign"
+SCHEMA_VERSION = 1
+
+
+def statements(ca: CampaignAnalysis) -> list[str]:
+    """The campaign's conclusions in sentences (what the terminal and the report's first page say)."""
+    out = []
+    for name, p in ca.pooled.items():
+        if p.refused:
+            out.append(p.refused)
+        else:
+            out.append(f"pooled {name}: population mean {p.mu['q50']:.4g} [{p.mu['q05']:.4g}, {p.mu['q95']:.4g}], "
+                       f"between-test scatter {p.sigma['q50']:.2g} [{p.sigma['q05']:.2g}, {p.sigma['q95']:.2g}] "
+                       f"(90 %; {len(p.tests)} tests, smallest ESS {min(p.ess.values()):.0f}, "
+                       f"MC variance {p.mc_variance:.2g})")
+    if ca.best:
+        post = ca.law_posterior
+        parts = [f"{k} {v['q50']:.3g} [{v['q05']:.3g}, {v['q95']:.3g}]" for k, v in post.items()]
+        out.append(f"friction law: {ca.best} (model {ca.chosen}); " + ", ".join(parts))
+    out.extend(ca.sentences)
+    for f in ca.flagged:
+        if "setup" in f:
+            off = f["offset"]
+            rel = f" relative to {f['relative_to']}" if "relative_to" in f else ""
+            out.append(f"flagged: set-up {f['setup']} does not follow the shared law{rel}: kappa offset "
+                       f"{off['q50'] * 100:+.0f} % [{off['q05'] * 100:+.0f}, {off['q95'] * 100:+.0f}], dELPD "
+                       f"{f['d_elpd']:.1f} (SE {f['d_se']:.1f})")
+            if "note" in f:
+                out.append(str(f["note"]))
+            out.extend(str(c) for c in f["causes"].values())
+        else:
+            out.append(f"flagged: test {f['test']} lies {f['below_median_by']:.1f} below the others' leave-one-out "
+                       "log density under the chosen law")
+    return out
+
+
+def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *, seed: int,
+                 settings: dict[str, Any]) -> dict[str, Any]:
+    counts = {s: sum(r.status == s for r in results) for s in ("done", "skipped", "failed")}
+    doc: dict[str, Any] = {
+        "schema": SCHEMA, "schema_version": SCHEMA_VERSION, "friction_uq_version": __version__, "seed": seed,
+        "settings": settings, "counts": counts,
+        "records": [{"path": r.path, "campaign": r.campaign, "test_id": r.test_id, "status": r.status,
+                     "message": r.message, "seconds": r.seconds, "converged": r.converged, "notes": r.notes}
+                    for r in results],
+    }
+    if ca is None:
+        doc |= {"pooled": {}, "friction_law": {"best": None, "ranking": []}, "flagged": [], "causes": {},
+                "statements": ["no record was analysed: nothing to pool"]}
+        return doc
+    models = {}
+    for name, fit in ca.fits.items():
+        draws = f_law_draws(fit, ca.nu, seed=seed)
+        models[name] = {k: {"q05": float(np.quantile(v, 0.05)), "q50": float(np.median(v)),
+                            "q95": float(np.quantile(v, 0.95))} for k, v in draws.items()}
+    doc |= {
+        "pooled": {k: p.to_json() for k, p in ca.pooled.items()},
+        "friction_law": {"best": ca.best, "chosen_model": ca.chosen, "ranking": ca.ranking,
+                         "posterior": ca.law_posterior, "models": models,
+                         "nu": {"mean": ca.nu[0], "sd": ca.nu[1]}},
+        "flagged": ca.flagged,
+        "causes": ca.tallies,
+        "statements": statements(ca),
+    }
+    return doc
+
+
+def write_json(doc: dict[str, Any], path: Path) -> Path:
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(json.dumps(doc, indent=2, default=float) + "\n")
+    return path
+
+
+def _group(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_]", "_", name)
+
+
+def write_netcdf(ca: CampaignAnalysis, path: Path) -> Path:
+    """Grid hyper-posteriors, the per-test points and every law's draws as an xarray DataTree."""
+    import xarray as xr
+
+    groups: dict[str, xr.Dataset] = {}
+    for name, p in ca.pooled.items():
+        if p.log_post is not None:
+            groups[f"pooled_{name}"] = xr.Dataset({"log_posterior": (("sigma", "mu"), p.log_post)},
+                                                  coords={"mu": p.grid_mu, "sigma": p.grid_sigma})
+    if ca.law_data is not None:
+        d = ca.law_data
+        groups["tests"] = xr.Dataset(
+            {k: ("test", getattr(d, k)) for k in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")}
+            | {"setup": ("test", np.array(d.setups, dtype=str))}, coords={"test": np.array(d.labels, dtype=str)})
+        for name, fit in ca.fits.items():
+            groups[f"law_{_group(name)}"] = xr.Dataset(
+                {"draws": (("draw", "parameter"), fit.draws)},
+                coords={"parameter": list(fit.model.params)},
+                attrs={"model": name, "kappa_bar": fit.kbar, "p_ref": fit.p_ref, "units": "kappa / kappa_bar"})
+    dt = xr.DataTree.from_dict({"/": xr.Dataset(attrs={"friction_uq_version": __version__,
+                                                       "best_law": ca.best or "none"})}
+                               | {f"/{k}": v for k, v in groups.items()})
+    with atomic_path(path) as tmp:
+        dt.to_netcdf(tmp, engine="h5netcdf")
+    return path
+
+
+def summary_text(doc: dict[str, Any]) -> str:
+    """Plain-text campaign summary: one line per record, then the statements."""
+    lines = [f"{'record':<28} {'set-up':<7} {'test':<8} {'status':<8} {'s':>6}  message"]
+    for r in doc["records"]:
+        lines.append(f"{Path(r['path']).name:<28} {r['campaign'] or '-'!s:<7} {r['test_id'] or '-'!s:<8} "
+                     f"{r['status']:<8} {r['seconds']:>6.1f}  {r['message'] or ''}")
+    c = doc["counts"]
+    lines.append(f"{c['done']} analysed, {c['skipped']} up to date, {c['failed']} failed")
+    ranking = doc["friction_law"].get("ranking") or []
+    if ranking:
+        lines.append(f"{'model':<32} {'ELPD':>8} {'SE':>6} {'dELPD':>7} {'dSE':>6}")
+        for m in ranking:
+            lines.append(f"{m['model']:<32} {m['elpd']:>8.1f} {m['se']:>6.1f} {m['d_elpd']:>7.1f} {m['d_se']:>6.1f}")
+    lines.extend(doc["statements"])
+    return "\n".join(lines)

@@ -1,0 +1,135 @@
+"""Friction law across tests and set-ups on hand-made campaigns with a known law; flags; the tally of
+per-record causes; the campaign report drawn from the result."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from friction_uq.campaign import RecordResult
+from friction_uq.campaign.analysis import RecordPosterior, analyse_tests, choose
+from friction_uq.campaign.flags import causes_sentence, setup_flags, tally_causes
+from friction_uq.campaign.laws import Elpd, Model
+from friction_uq.campaign.outputs import campaign_doc, summary_text, write_netcdf
+from friction_uq.priors import PRIORS_DIR
+from friction_uq.report.campaign_pages import write_campaign_report
+
+PRIOR = str(PRIORS_DIR / "I1.toml")
+NU = 0.4
+
+
+def f_velocity(V):
+    """The bundled data's law: f_s 0.075, f_d 0.035, v_c 8 m/s."""
+    return 0.035 + 0.040 * np.exp(-V / 8.0)
+
+
+def _test(rng, label, setup, V, p, f_true, *, offset=1.0):
+    """A test's draws as a run stores them: kappa to 0.7 %, nu from the hoop gauge to 0.013."""
+    kappa_true = f_true * NU / (1 - NU) * offset
+    k_sd = 0.007 * kappa_true
+    k = rng.normal(kappa_true + rng.normal(0, k_sd), k_sd, 1000)
+    nu = rng.normal(NU + rng.normal(0, 0.013), 0.013, 1000)
+    return RecordPosterior(label, setup, k * (1 - nu) / nu, k, nu, rng.normal(p, 0.05 * p, 1000),
+                           {"mean": V, "sd": 1e-3, "q05": V, "q50": V, "q95": V}, PRIOR)
+
+
+@pytest.fixture(scope="module")
+def three_setups():
+    """A and C follow the velocity law; B reads kappa 20 % high (plug friction). C's pressure falls
+    with V, so pressure and velocity are not confounded across the campaign."""
+    rng = np.random.default_rng(42)
+    tests = []
+    for setup, p_of_v, off in (("A", lambda v: 9e6 * v, 1.0), ("B", lambda v: 15e6 * v, 1.2),
+                               ("C", lambda v: 170e6 - 9e6 * v, 1.0)):
+        for k, V in enumerate(np.linspace(5.5, 12.5, 5)):
+            tests.append(_test(rng, f"{setup}-0{k + 1}", setup, V, p_of_v(V), f_velocity(V), offset=off))
+    return analyse_tests(tests, tally_causes([]), seed=1)
+
+
+def test_the_velocity_law_is_found_and_the_odd_setup_flagged(three_setups):
+    ca = three_setups
+    assert ca.best == "velocity"
+    assert ca.chosen == "velocity + offset B"
+    flagged = [f for f in ca.flagged if "setup" in f]
+    assert [f["setup"] for f in flagged] == ["B"]
+    off = flagged[0]["offset"]
+    assert off["q05"] < 0.2 < off["q95"]
+    post = ca.law_posterior
+    for name, truth in (("f_s", 0.075), ("f_d", 0.035), ("v_c", 8.0)):
+        assert post[name]["q05"] < truth < post[name]["q95"], (name, post[name])
+    top = ca.ranking[0]
+    pressure = next(r for r in ca.ranking if r["model"] == "pressure + offset B")
+    assert pressure["d_elpd"] > 4 and pressure["d_elpd"] > 2 * pressure["d_se"] or top["model"] != "pressure + offset B"
+
+
+def test_campaign_outputs_from_the_analysis(three_setups, tmp_path):
+    results = [RecordResult(path=f"{t.label}.h5", status="done", campaign=t.setup, test_id=t.label)
+               for t in three_setups.tests]
+    doc = campaign_doc(results, three_setups, seed=1, settings={})
+    doc = json.loads(json.dumps(doc, default=float))
+    law = doc["friction_law"]
+    assert law["best"] == "velocity" and law["ranking"][0]["d_elpd"] == 0.0
+    assert {"f_s", "f_d", "v_c", "offset_B", "scatter_rel"} <= set(law["posterior"])
+    assert set(doc["pooled"]) == {"f", "kappa"} and doc["flagged"][0]["setup"] == "B"
+    text = summary_text(doc)
+    assert "friction law: velocity (model velocity + offset B)" in text
+    assert "flagged: set-up B does not follow the shared law: kappa offset +" in text
+    pdf = write_campaign_report(three_setups, doc, tmp_path / "campaign.pdf")
+    assert pdf.read_bytes()[:4] == b"%PDF" and pdf.read_bytes().count(b"/Type /Page\n") + \
+        pdf.read_bytes().count(b"/Type /Page ") >= 5
+    import xarray as xr
+
+    dt = xr.open_datatree(write_netcdf(three_setups, tmp_path / "campaign.nc"), engine="h5netcdf")
+    assert dt.attrs["best_law"] == "velocity" and "law_velocity___offset_B" in dt.children
+    dt.close()
+
+
+def test_a_constant_friction_campaign_names_constant_and_flags_nothing():
+    rng = np.random.default_rng(7)
+    tests = [_test(rng, f"A-0{k}", "A", V, 9e6 * V, 0.05) for k, V in enumerate(np.linspace(5, 13, 6))]
+    ca = analyse_tests(tests, tally_causes([]), seed=2)
+    assert ca.best == "constant" and ca.flagged == []
+    assert ca.law_posterior["f"]["q05"] < 0.05 < ca.law_posterior["f"]["q95"]
+
+
+def test_choose_takes_the_simplest_nested_contender_or_says_the_data_do_not_separate():
+    models = {m.name: m for m in (Model("velocity"), Model("pressure"), Model("pressure+velocity"),
+                                  Model("velocity", "B"), Model("pressure", "B"))}
+    row = lambda m, d, se: {"model": m, "d_elpd": d, "d_se": se}
+    nested = [row("pressure+velocity", 0.0, 0.0), row("velocity", 1.0, 1.5), row("pressure", 9.0, 2.0)]
+    assert choose(nested, models).name == "velocity"
+    apart = [row("velocity + offset B", 0.0, 0.0), row("pressure + offset B", 1.4, 1.9), row("velocity", 9.0, 1.0)]
+    assert choose(apart, models) is None
+
+
+def _results_with_causes():
+    rs = []
+    for k in range(5):
+        rs.append(RecordResult(path=f"B-0{k}.h5", status="done", campaign="B", test_id=f"B-0{k}",
+                               causes=["plug friction", "plug friction"] + (["gauge gain"] if k == 0 else [])))
+        rs.append(RecordResult(path=f"A-0{k}.h5", status="done", campaign="A", test_id=f"A-0{k}",
+                               causes=[] if k < 4 else None))
+    rs.append(RecordResult(path="bad.h5", status="failed", message="bad.h5: not a record"))
+    return rs
+
+
+def test_causes_are_tallied_per_setup():
+    t = tally_causes(_results_with_causes())
+    assert t == {"A": {"tests": 5, "diagnosed": 4, "causes": {}},
+                 "B": {"tests": 5, "diagnosed": 5, "causes": {"gauge gain": 1, "plug friction": 5}}}
+    assert causes_sentence("B", t["B"]) == "set-up B: 5 tests, 5 diagnosed; plug friction named in 5, gauge gain named in 1"
+    assert causes_sentence("A", t["A"]) == "set-up A: 5 tests, 4 diagnosed; no cause named"
+
+
+def test_with_two_setups_the_causes_name_the_one_that_is_off():
+    t = tally_causes(_results_with_causes())
+    base = Elpd("velocity", 10.0, 1.0, np.zeros(10), np.zeros(10), 0)
+    off = Elpd("velocity + offset B", 25.0, 1.0, np.r_[np.full(5, 0.2), np.full(5, 2.8)], np.zeros(10), 0)
+    delta = {"q05": 0.15, "q50": 0.2, "q95": 0.25}
+    flags = setup_flags(base, {"B": (off, delta)}, ["A", "B"], t)
+    assert len(flags) == 1 and flags[0]["relative_to"] == "A" and flags[0]["named_by_causes"] == "B"
+    assert flags[0]["causes"]["B"].endswith("plug friction named in 5, gauge gain named in 1")
+    small = Elpd("velocity + offset B", 12.0, 1.0, np.r_[np.full(5, 0.0), np.full(5, 0.4)], np.zeros(10), 0)
+    assert setup_flags(base, {"B": (small, delta)}, ["A", "B"], t) == []

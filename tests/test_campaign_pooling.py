@@ -1,0 +1,65 @@
+"""Hierarchical pooling from stored draws: the closed form for normal posteriors, the implied prior of
+kappa against Monte Carlo, and the refusal when too few draws carry weight."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from friction_uq.campaign.pooling import StoredDraws, implied_kappa_log_prior, pool
+from friction_uq.priors import PRIORS_DIR, load_priors
+
+
+def _normal_tests(rng, means, sd, n):
+    return [StoredDraws(f"T{i}", "A", rng.normal(m, sd, n), np.zeros(n)) for i, m in enumerate(means)]
+
+
+def test_pooling_normal_posteriors_matches_the_closed_form():
+    """Flat sampling prior and normal posteriors: L(mu, sigma) = prod_i N(m_i; mu, sqrt(sigma^2 + s^2))."""
+    rng = np.random.default_rng(11)
+    means = rng.normal(0.05, 0.006, 10)
+    s = 0.002
+    # draws made exactly normal (quantiles), so the Monte Carlo error does not blur the comparison
+    z = stats.norm.ppf((np.arange(1000) + 0.5) / 1000)
+    tests = [StoredDraws(f"T{i}", "A", m + s * z, np.zeros(z.size)) for i, m in enumerate(means)]
+    p = pool(tests, "f")
+    assert p.refused is None
+    mu, sg = np.meshgrid(p.grid_mu, p.grid_sigma)
+    exact = sum(stats.norm.logpdf(m, mu, np.sqrt(sg**2 + s**2)) for m in means)
+    exact -= np.log(np.exp(exact - exact.max()).sum()) + exact.max()
+    post_mu = np.exp(exact).sum(axis=0)
+    assert p.mu["mean"] == pytest.approx(np.sum(post_mu * p.grid_mu), abs=2e-5)
+    post_s = np.exp(exact).sum(axis=1)
+    assert p.sigma["mean"] == pytest.approx(np.sum(post_s * p.grid_sigma), rel=0.02)
+    assert p.mu["q05"] < 0.05 < p.mu["q95"] and p.sigma["q05"] < 0.006 < p.sigma["q95"]
+    assert p.mc_variance < 0.01 and min(p.ess.values()) > 300
+
+
+def test_too_few_draws_carrying_weight_is_refused_not_reported():
+    rng = np.random.default_rng(2)
+    tests = _normal_tests(rng, [0.05] * 30, 0.01, 40)  # identical tests, wide posteriors, few draws
+    p = pool(tests, "f")
+    assert p.refused is not None
+    assert p.mc_variance > 1
+    assert "pooling f refused: the Monte Carlo variance of the hyper-log-likelihood is" in p.refused
+
+
+def test_one_test_is_not_pooled():
+    p = pool(_normal_tests(np.random.default_rng(0), [0.05], 0.01, 100), "kappa")
+    assert p.refused == "pooling kappa needs at least 2 analysed tests, 1 given"
+
+
+def test_implied_prior_of_kappa_matches_monte_carlo():
+    """pi(kappa) by quadrature against a histogram of f nu/(1-nu) from 5e5 prior draws."""
+    priors = load_priors(PRIORS_DIR / "I1.toml")
+    rng = np.random.default_rng(5)
+    f = priors["f"].rvs(rng, 500_000)
+    nu = priors["nu"].rvs(rng, 500_000)
+    k = f * nu / (1 - nu)
+    edges = np.array([0.01, 0.02, 0.03, 0.04, 0.06, 0.1, 0.2])
+    hist, _ = np.histogram(k, bins=edges)
+    mc = hist / k.size / np.diff(edges)
+    centres = np.linspace(edges[:-1], edges[1:], 41)
+    quad = np.exp(implied_kappa_log_prior(centres, priors)).mean(axis=0)
+    np.testing.assert_allclose(quad, mc, rtol=0.04)
