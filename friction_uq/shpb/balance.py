@@ -19,7 +19,7 @@ Noise. The residual carries the transmitted gauge's noise and the input gauge's 
 and reflected windows, 156 us apart, independent), times the impedance ratio: variance
 sd_t^2 + 2 r^2 sd_i^2, lag-1 coefficient the variance-weighted mean of the two channels' (the
 sum of two AR(1) series is close to AR(1) when their coefficients are close: 0.18 and 0.28 on
-the LANL record). Dispersion low-passes the transported noise a little; the same noise model is
+the LANL record); with a gain factor gamma the input gauge's part is scaled by gamma. Dispersion low-passes the transported noise a little; the same noise model is
 kept for every model so that all are scored on the same footing.
 """
 
@@ -121,6 +121,7 @@ class BalanceObservation:
         ratio = (ib.area * ib.young_modulus) / self.force_scale
         nt, ni = self.waves.noise["transmitted"], self.waves.noise["input"]
         var_t, var_i = nt.sd**2, 2.0 * (ratio * ni.sd) ** 2
+        self._var = (var_t, var_i)
         self.sd = math.sqrt(var_t + var_i)
         self.rho = (var_t * nt.rho + var_i * ni.rho) / (var_t + var_i)
         self.rho_long_run = (var_t * nt.rho_eff + var_i * ni.rho_eff) / (var_t + var_i)
@@ -145,17 +146,24 @@ class BalanceObservation:
     def residual(self, settings: BarSettings) -> np.ndarray:
         return self.observed - self.predict(settings)
 
+    def noise_sd(self, gain_factor: float = 1.0) -> float:
+        """Residual noise sd (strain): the prediction carries the input gauge's noise times gamma."""
+        var_t, var_i = self._var
+        return math.sqrt(var_t + gain_factor**2 * var_i)
+
     def loglike(self, settings: BarSettings, *, noise_scale: float = 1.0) -> float:
         """Exact AR(1) Gaussian log-likelihood of the residual, noise sd times ``noise_scale``."""
-        return float(ar1_loglike(self.residual(settings), noise_scale * self.sd, self.rho))
+        sd = noise_scale * self.noise_sd(settings.gain_factor)
+        return float(ar1_loglike(self.residual(settings), sd, self.rho))
 
-    def misfit(self, resid: np.ndarray) -> Misfit:
+    def misfit(self, resid: np.ndarray, *, gain_factor: float = 1.0) -> Misfit:
         e = np.asarray(resid, float)
-        w = whiten(e, sd=self.sd, rho=self.rho)
+        sd = self.noise_sd(gain_factor)
+        w = whiten(e, sd=sd, rho=self.rho)
         rms_force = self.force_scale * float(np.sqrt(np.mean(e * e)))
         return Misfit(
-            level=float(e.mean()) / ar1_mean_sd(self.sd, self.rho_long_run, e.size),
-            rms=float(np.sqrt(np.mean((e / self.sd) ** 2))),
+            level=float(e.mean()) / ar1_mean_sd(sd, self.rho_long_run, e.size),
+            rms=float(np.sqrt(np.mean((e / sd) ** 2))),
             chi2_dof=float(np.mean(w * w)),
             longest_run=longest_sign_run(w),
             rms_force=rms_force,

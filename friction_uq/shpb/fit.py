@@ -100,7 +100,8 @@ def _mode(obs: BalanceObservation, model: CombinedModel, params: tuple[Parameter
     def profile_noise() -> None:  # the noise scale's conditional mode, sqrt(chi2/dof), in closed form
         if params[-1].name == "noise_scale":
             values, _ = _split(params, z)
-            chi2 = obs.misfit(obs.residual(model.settings(values))).chi2_dof
+            settings = model.settings(values)
+            chi2 = obs.misfit(obs.residual(settings), gain_factor=settings.gain_factor).chi2_dof
             z[-1] = float(NOISE_SCALE.to_unbounded(math.sqrt(chi2)))
 
     for _ in range(2):  # coordinate grid, twice
@@ -143,7 +144,7 @@ def _hessian(fun, z: np.ndarray) -> np.ndarray:
 
 def block_elpd(obs: BalanceObservation, resid: np.ndarray, scale: np.ndarray, log_weights: np.ndarray, *,
                block: float = BLOCK) -> Elpd:
-    """PSIS-LOO over blocks of residual draws (S, n) with noise sd ``scale`` (S,) times the pre-pulse sd."""
+    """PSIS-LOO over blocks of residual draws (S, n) with noise sd ``scale`` (S,) times ``obs.sd``."""
     blen = max(1, int(round(block / obs.record.sample_interval)))
     lengths = np.diff(np.append(np.arange(0, resid.shape[1], blen), resid.shape[1]))
     ll = ar1_block_loo(resid / scale[:, None], sd=obs.sd, rho=obs.rho, block=blen)
@@ -174,15 +175,18 @@ def fit_balance(obs: BalanceObservation, model: CombinedModel, *, rng: np.random
     smoothed, k = array_stats.psislw(log_w - log_w.max())
     smoothed = np.asarray(smoothed) - np.logaddexp.reduce(np.asarray(smoothed))
     draws = {p.name: np.asarray(p.from_unbounded(z[:, i]), float) for i, p in enumerate(params)}
-    scale = draws.get("noise_scale", np.ones(n_draws))
-    split = [_split(params, zi)[0] for zi in z]
-    resid = np.array([obs.residual(model.settings(v)) for v in split])
+    split = [model.settings(_split(params, zi)[0]) for zi in z]
+    resid = np.array([obs.residual(st) for st in split])
+    gains = np.array([st.gain_factor for st in split])
+    relative_sd = np.array([obs.noise_sd(g) for g in gains]) / obs.sd
+    scale = draws.get("noise_scale", np.ones(n_draws)) * relative_sd
     elpd = block_elpd(obs, resid, scale, smoothed, block=block)
     mode, mode_scale = _split(params, zm)
     mode_all = dict(mode, **({"noise_scale": mode_scale} if scaled_noise else {}))
     settings = model.settings(mode)
+    misfit = obs.misfit(obs.residual(settings), gain_factor=settings.gain_factor)
     return BalanceFit(model, mode_all, draws, smoothed, float(np.asarray(k).ravel()[0]),
-                      obs.misfit(obs.residual(settings)), elpd, obs.loglike(settings, noise_scale=mode_scale))
+                      misfit, elpd, obs.loglike(settings, noise_scale=mode_scale))
 
 
 def summaries(fit: BalanceFit) -> Mapping[str, dict[str, float]]:
