@@ -3,16 +3,17 @@
 Two parts. On hand-made two-bar records with a hidden effect (a transmitted gain error, a bar
 wave speed off its stated value), the selection must name it and measure it within its posterior.
 On the real LANL copper record (``../shared/data/real/lanl-hoppybar-cu/``, skipped with a reason
-when absent), measured with seed 0 (seeds 1 and 2 in brackets where they differ):
+when absent), measured with seed 0 (blocks with Pareto k > 0.7 left out by refitting):
 
 * nominal model (gain 200 V/V, c0 = 4975 m/s, no dispersion): chi2/dof 3403 against the
   pre-pulse noise, RMS 3351 N = 31.5 % of the peak F_2;
-* step 1: wave_speed dELPD 1090 +- 168 (decisive); gauge_gain 58 +- 53, dispersion 27 +- 60
+* step 1: wave_speed dELPD 1091 +- 191 (decisive); dispersion 41 +- 80, gauge_gain -13 +- 31
   (not decisive); fitted c = 4830 m/s [4828, 4832], reflection time 2 d / c = 157.8 us (the
   file's calibrated 156.6 us; nominal 153.2 us); after it chi2/dof 235, RMS 8.3 %;
-* step 2 on top: dispersion 184 +- 122 (1.5 SE: improves, not decisive; chi2/dof 150, RMS
-  6.6 %), gauge_gain 27 +- 20 (gamma 0.971 [0.963, 0.979]); selection stops;
-* all three mechanisms: gamma = 0.989 +- 0.0035 (197.8 V/V), the header's 500 excluded.
+* step 2 on top: dispersion 180 +- 172 (1 SE: improves, not decisive; chi2/dof 150, RMS
+  6.6 %), gauge_gain 35 +- 28 (gamma 0.971 [0.964, 0.980]); selection stops;
+* all three mechanisms: gamma = 0.9886 +- 0.0040, 197.7 V/V [196.6, 199.0]; the header's 500
+  (gamma 2.5) is 379 sd away.
 """
 
 from __future__ import annotations
@@ -80,7 +81,7 @@ def write_record(path: Path, *, gain_error: float, rod_speed: float, seed: int) 
 def test_hidden_gain_and_wave_speed_are_named_and_measured(tmp_path: Path) -> None:
     # truth: gain factor 1.25, c / c0 = 5000 / 5100
     rec = read_lanl_raw(write_record(tmp_path / "hidden.raw", gain_error=1.25, rod_speed=5100.0, seed=5))
-    result = diagnose_balance(BalanceObservation(rec), seed=1)
+    result = diagnose_balance(BalanceObservation(rec), seed=1, n_draws=100)
     assert set(result.causes) == {"gauge_gain", "wave_speed"}
     assert "dispersion" not in result.causes
     f = result.final
@@ -93,7 +94,7 @@ def test_hidden_gain_and_wave_speed_are_named_and_measured(tmp_path: Path) -> No
 
 def test_clean_record_names_nothing(tmp_path: Path) -> None:
     rec = read_lanl_raw(write_record(tmp_path / "clean.raw", gain_error=1.0, rod_speed=5000.0, seed=6))
-    result = diagnose_balance(BalanceObservation(rec), seed=2)
+    result = diagnose_balance(BalanceObservation(rec), seed=2, n_draws=100)
     assert result.causes == ()
     assert result.nominal.misfit.chi2_dof < 1.5
 
@@ -143,7 +144,7 @@ def test_lanl_wave_speed_is_the_named_cause(lanl) -> None:
     step = result.steps[0]
     assert step.added == "wave_speed" and result.causes[0] == "wave_speed"
     best = step.candidates[0]
-    # decisive by the rule with room: measured 1090 +- 168 (6.5 SE); the other two within 1.1 SE of 0
+    # decisive by the rule with room: measured 1091 +- 191 (5.7 SE); the other two within 0.6 SE of 0
     assert best.delpd > 4.0 * best.se
     assert all(not c.decisive for c in step.candidates[1:])
     ib = obs.record.input_bar
@@ -166,8 +167,8 @@ def test_lanl_dispersion_improves_but_is_not_decisive(lanl) -> None:
     step = result.steps[1]
     assert step.added is None
     disp = next(c for c in step.candidates if c.mechanism == "dispersion")
-    # dELPD 184 +- 122: positive by more than one SE, short of two; chi2/dof 235 -> 150
-    assert disp.se < disp.delpd < 2.0 * disp.se
+    # dELPD 180 +- 172: positive, about one SE, short of the rule's two; chi2/dof 235 -> 150
+    assert 0.0 < disp.delpd < 2.0 * disp.se
     assert disp.fit.misfit.chi2_dof < 0.75 * step.base.misfit.chi2_dof
 
 
