@@ -181,3 +181,21 @@ def test_lanl_gain_is_the_header_200_not_500(lanl) -> None:
     # and 200 stands within the model error still in the residual: the fitted gain (measured
     # 197.7 V/V, sd 0.8) is within the fit's residual RMS (6.6 % of the peak force) of 200
     assert abs(math.log(s["mean"])) < full.misfit.relative_rms
+
+
+def test_registry_documents_each_mechanism() -> None:
+    from friction_uq.shpb.mechanisms import GAIN_LOG_SD, MECHANISMS, lognormal_logpdf
+
+    assert list(MECHANISMS) == ["gauge_gain", "wave_speed", "dispersion"]
+    for m in MECHANISMS.values():
+        assert m.meaning and m.signature, m.name
+        for p in m.parameters:
+            assert p.contains(1.0) and p.name in m.prior_log_sd, (m.name, p.name)
+    # the gain prior puts the header's other statement (500 against 200) at two prior sd
+    assert math.log(2.5) / GAIN_LOG_SD == pytest.approx(2.0)
+    drop = lognormal_logpdf(1.0, log_sd=GAIN_LOG_SD) - lognormal_logpdf(2.5, log_sd=GAIN_LOG_SD)
+    assert drop == pytest.approx(2.0 + math.log(2.5))  # z^2 / 2 and the 1 / x of the density
+    with pytest.raises(ValueError, match=r"bar mechanism 'dispersion' is already registered"):
+        from friction_uq.shpb.mechanisms import register
+
+        register(MECHANISMS["dispersion"])

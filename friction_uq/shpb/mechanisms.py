@@ -56,6 +56,8 @@ class BarMechanism:
         Log prior density of its parameters (natural scale).
     apply : Callable[[BarSettings, Mapping[str, float]], BarSettings]
         The settings with this mechanism switched on at the given parameter values.
+    prior_log_sd : Mapping[str, float]
+        Prior log-sd of each parameter around 1: where the fit searches for the mode (+-3 of it).
     """
 
     name: str
@@ -64,6 +66,7 @@ class BarMechanism:
     signature: str
     log_prior: Callable[[Mapping[str, float]], float]
     apply: Callable[[BarSettings, Mapping[str, float]], BarSettings]
+    prior_log_sd: Mapping[str, float] = dataclasses.field(default_factory=dict)
 
 
 MECHANISMS: dict[str, BarMechanism] = {}
@@ -93,6 +96,7 @@ register(BarMechanism(
     signature="F_2 a constant fraction off F_1 through the whole pulse: rise, plateau and unloading scale together",
     log_prior=lambda v: lognormal_logpdf(v["gain_factor"], log_sd=GAIN_LOG_SD),
     apply=lambda s, v: dataclasses.replace(s, gain_factor=float(v["gain_factor"])),
+    prior_log_sd={"gain_factor": GAIN_LOG_SD},
 ))
 
 register(BarMechanism(
@@ -102,6 +106,7 @@ register(BarMechanism(
     signature="F_1 - F_2 shaped like the derivative of the pulse: of opposite signs on the rise and the unloading",
     log_prior=lambda v: lognormal_logpdf(v["speed_factor"], log_sd=SPEED_LOG_SD),
     apply=lambda s, v: dataclasses.replace(s, speed_factor=float(v["speed_factor"])),
+    prior_log_sd={"speed_factor": SPEED_LOG_SD},
 ))
 
 register(BarMechanism(
@@ -130,6 +135,10 @@ class CombinedModel:
 
     def log_prior(self, values: Mapping[str, float]) -> float:
         return sum(m.log_prior(values) for m in self.mechanisms)
+
+    def prior_log_sd(self, name: str) -> float:
+        """Prior log-sd of a parameter (0.1 when its mechanism does not say)."""
+        return next((m.prior_log_sd[name] for m in self.mechanisms if name in m.prior_log_sd), 0.1)
 
     def settings(self, values: Mapping[str, float]) -> BarSettings:
         s = BarSettings()
