@@ -1,6 +1,6 @@
 """Name the bar-level causes of the force-balance misfit of the real LANL copper record.
 
-    python examples/lanl_diagnose.py [--record PATH] [--seed N]
+    python examples/lanl_diagnose.py [--record PATH] [--seed N] [--prepulse-noise]
 
 Starts from the nominal model of the record (the header's transmitted gain, 200 V/V; the stated
 rod wave speed c0 = 4975 m/s; no dispersion correction): the transmitted gauge predicted from the
@@ -54,6 +54,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--record", type=Path, default=RECORD, help="the LANL .raw file")
     parser.add_argument("--seed", type=int, default=0, help="seed of the posterior draws")
+    parser.add_argument("--prepulse-noise", action="store_true",
+                        help="score with the pre-pulse noise alone (no fitted noise scale): shows why it is not the default")
     args = parser.parse_args(argv)
     if not args.record.is_file():
         print(f"error: record not found: {args.record} (the shared data directory is not beside the repository)",
@@ -62,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         record = read_lanl_raw(args.record)
         obs = BalanceObservation(record)
-        result = diagnose_balance(obs, seed=args.seed)
+        result = diagnose_balance(obs, seed=args.seed, scaled_noise=not args.prepulse_noise)
     except FrictionUQError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -98,7 +100,8 @@ def main(argv: list[str] | None = None) -> int:
               f"(stated c0 {ib.wave_speed:.0f}); reflection time 2 d / c = {t * 1e6:.1f} us "
               f"(file's calibrated value {2 * ib.gauge_distance / ib.timing_wave_speed * 1e6:.1f} us)")
     # the gain measured with every mechanism in (not only the named ones): what the record says of it
-    g = fit_balance(obs, combine(MECHANISMS), rng=np.random.default_rng(args.seed))
+    g = fit_balance(obs, combine(MECHANISMS), rng=np.random.default_rng(args.seed),
+                    scaled_noise=not args.prepulse_noise)
     s = g.summary("gain_factor")
     print(f"transmitted gain under [{g.name}]: {s['mean'] * obs.header_gain:.1f} V/V "
           f"[{s['q05'] * obs.header_gain:.1f}, {s['q95'] * obs.header_gain:.1f}], gamma {s['mean']:.4f} +- {s['sd']:.4f} "
