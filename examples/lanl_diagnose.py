@@ -55,7 +55,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--record", type=Path, default=RECORD, help="the LANL .raw file")
     parser.add_argument("--seed", type=int, default=0, help="seed of the posterior draws")
     parser.add_argument("--prepulse-noise", action="store_true",
-                        help="score with the pre-pulse noise alone (no fitted noise scale): shows why it is not the default")
+                        help="score with the pre-pulse noise alone (no fitted noise scale): "
+                             "shows why it is not the default")
     args = parser.parse_args(argv)
     if not args.record.is_file():
         print(f"error: record not found: {args.record} (the shared data directory is not beside the repository)",
@@ -104,7 +105,8 @@ def main(argv: list[str] | None = None) -> int:
                     scaled_noise=not args.prepulse_noise)
     s = g.summary("gain_factor")
     print(f"transmitted gain under [{g.name}]: {s['mean'] * obs.header_gain:.1f} V/V "
-          f"[{s['q05'] * obs.header_gain:.1f}, {s['q95'] * obs.header_gain:.1f}], gamma {s['mean']:.4f} +- {s['sd']:.4f} "
+          f"[{s['q05'] * obs.header_gain:.1f}, {s['q95'] * obs.header_gain:.1f}], "
+          f"gamma {s['mean']:.4f} +- {s['sd']:.4f} "
           f"(header: 200 'Transmitted Bar Gain', 500 'Calibrated Gain': {(2.5 - s['mean']) / s['sd']:.0f} sd away); "
           f"{misfit_line(g)}")
     return 0

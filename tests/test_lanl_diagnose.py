@@ -149,8 +149,9 @@ def test_lanl_wave_speed_is_the_named_cause(lanl) -> None:
     assert all(not c.decisive for c in step.candidates[1:])
     ib = obs.record.input_bar
     s = best.fit.summary("speed_factor")
-    # off nominal: c0 lies > 100 posterior sd away (measured 4830 m/s, sd 1.5 m/s)
-    assert (1.0 - s["mean"]) / s["sd"] > 100.0
+    # off nominal: c0 lies ~100 posterior sd away (measured 4830 m/s, sd 1.3 m/s, with the noise
+    # scale fitted); > 50 asks for a speed off nominal by far more than the posterior allows
+    assert (1.0 - s["mean"]) / s["sd"] > 50.0
     # the travel time found agrees with the file's own calibrated reflection time (156.6 us, an
     # independent measurement) to within the copper specimen's elastic transit time (3.2 mm at
     # ~3.8 km/s: 0.84 us), which the balance model also loads on the bars, plus the 0.1 us sample:

@@ -19,8 +19,9 @@ Noise. The residual carries the transmitted gauge's noise and the input gauge's 
 and reflected windows, 156 us apart, independent), times the impedance ratio: variance
 sd_t^2 + 2 r^2 sd_i^2, lag-1 coefficient the variance-weighted mean of the two channels' (the
 sum of two AR(1) series is close to AR(1) when their coefficients are close: 0.18 and 0.28 on
-the LANL record); with a gain factor gamma the input gauge's part is scaled by gamma. Dispersion low-passes the transported noise a little; the same noise model is
-kept for every model so that all are scored on the same footing.
+the LANL record); with a gain factor gamma the input gauge's part is scaled by gamma.
+Dispersion low-passes the transported noise a little; the same noise model is kept for every
+model so that all are scored on the same footing.
 """
 
 from __future__ import annotations
