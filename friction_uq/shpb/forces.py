@@ -16,15 +16,13 @@ from typing import Literal
 
 import numpy as np
 
-from ..errors import SignalError
 from ..physics import bars as eq
-from ..signals import NoiseEstimate, prepulse_noise, pulse_arrival, transport, window_mask
+from ..signals import NoiseEstimate, transport
 from .record import BarProperties, TwoBarRecord
+from .waves import PULSE_END_FRACTION, gauge_waves
 
 #: Fraction of the peak transmitted force above which the balance is assessed (the loading).
 BALANCE_LEVEL = 0.5
-#: Fraction of its peak below which a wave has ended (after its peak): where its window stops.
-PULSE_END_FRACTION = 0.1
 
 #: Which wave speeds set the gauge-to-face travel times (see :func:`transport_speeds`).
 WaveSpeed = Literal["timing", "rod"]
@@ -83,23 +81,6 @@ class TwoBarForces:
     def loading(self) -> np.ndarray:
         """Boolean mask of the loading window."""
         return (self.time >= self.window[0]) & (self.time < self.window[1])
-
-
-def _stated_gain(bar: BarProperties) -> float:
-    values = set(bar.gains.values())
-    if len(values) != 1:
-        raise SignalError(
-            f"the {bar.name} bar's gain fields disagree ({dict(bar.gains)}): pass the gain explicitly"
-        )
-    return values.pop()
-
-
-def _pulse_end(y: np.ndarray, *, start: float) -> float:
-    """First index after the peak of ``y[start:]`` where ``y`` falls below PULSE_END_FRACTION of it."""
-    i0 = int(np.floor(start))
-    k = i0 + int(np.argmax(y[i0:]))
-    below = np.flatnonzero(y[k:] < PULSE_END_FRACTION * y[k])
-    return float(k + below[0]) if below.size else float(y.size)
 
 
 def _loading_window(force: np.ndarray) -> tuple[int, int]:
@@ -197,29 +178,9 @@ def two_bar_forces(
             raise ValueError(f"{name} must be a positive finite number (V/V), received {g!r}")
     ib, tb = record.input_bar, record.transmitted_bar
     c_in, c_tr = transport_speeds(record, wave_speed=wave_speed)
-    g_in = _stated_gain(ib) if input_gain is None else float(input_gain)
-    n, dt = record.n_samples, record.sample_interval
-
-    # a pulse must end before its reflection comes back to the input gauge: search peaks within that
-    span = int(2.0 * ib.gauge_distance / c_in / dt)
-    x_in = ib.strain(record.input_volts, gain=g_in)
-    noise_in, arr_inc = prepulse_noise(x_in, polarity=+1, span=span)
-    y_in = x_in - noise_in.offset
-    x_tr = tb.strain(record.transmitted_volts, gain=float(gain))
-    noise_tr, arr_tr = prepulse_noise(x_tr, polarity=+1, span=span)
-    y_tr = x_tr - noise_tr.offset
-
-    sep = arr_inc + 2.0 * ib.gauge_distance / c_in / dt  # the reflected front reaches the input gauge
-    margin = max(8.0, 0.01 * (sep - arr_inc))
-    arr_ref = pulse_arrival(
-        x_in, offset=noise_in.offset, sd=noise_in.sd, start=int(sep - margin), span=span, polarity=-1
-    )
-    end_inc = _pulse_end(np.where(window_mask(n, 0, sep - margin), y_in, 0.0), start=arr_inc)
-    end_ref = _pulse_end(-y_in, start=arr_ref)
-    end_tra = _pulse_end(y_tr, start=arr_tr)
-    inc = np.where(window_mask(n, 0, min(end_inc + margin, sep - margin)), y_in, 0.0)
-    ref = np.where(window_mask(n, sep - margin, end_ref + margin), y_in, 0.0)
-    tra = np.where(window_mask(n, 0, end_tra + margin), y_tr, 0.0)
+    gw = gauge_waves(record, gain=gain, input_gain=input_gain, reflection_speed=c_in)
+    dt = record.sample_interval
+    g_in = gw.input_gain
 
     def moved(wave: np.ndarray, bar: BarProperties, speed: float, distance: float) -> np.ndarray:
         return transport(
@@ -232,9 +193,9 @@ def two_bar_forces(
             dispersion=dispersion,
         )
 
-    eps_i = moved(inc, ib, c_in, +ib.gauge_distance)
-    eps_r = moved(ref, ib, c_in, -ib.gauge_distance)
-    eps_t = moved(tra, tb, c_tr, -tb.gauge_distance)
+    eps_i = moved(gw.incident, ib, c_in, +ib.gauge_distance)
+    eps_r = moved(gw.reflected, ib, c_in, -ib.gauge_distance)
+    eps_t = moved(gw.transmitted, tb, c_tr, -tb.gauge_distance)
     f1 = eq.input_force(eps_i, eps_r, area=ib.area, young_modulus=ib.young_modulus)
     f2 = eq.transmitted_force(eps_t, area=tb.area, young_modulus=tb.young_modulus)
 
@@ -243,7 +204,6 @@ def two_bar_forces(
     balance = float(np.mean(np.abs(f1[w] - f2[w])) / np.mean(f2[w]))
     impulse = float((np.sum(f1[w]) - np.sum(f2[w])) / np.sum(f2[w]))
     t0 = float(record.time[0])
-    arrivals = {"incident": arr_inc, "reflected": arr_ref, "transmitted": arr_tr}
     for a in (eps_i, eps_r, eps_t, f1, f2):
         a.setflags(write=False)
     return TwoBarForces(
@@ -256,8 +216,8 @@ def two_bar_forces(
         input_gain=g_in,
         transmitted_gain=float(gain),
         wave_speeds=(c_in, c_tr),
-        noise=MappingProxyType({"input": noise_in, "transmitted": noise_tr}),
-        arrivals=MappingProxyType({k: t0 + v * dt for k, v in arrivals.items()}),
+        noise=gw.noise,
+        arrivals=MappingProxyType({k: t0 + v * dt for k, v in gw.arrivals.items()}),
         window=(t0 + start * dt, t0 + stop * dt),
         balance_error=balance,
         impulse_error=impulse,
