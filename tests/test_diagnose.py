@@ -59,6 +59,7 @@ def test_decisive_rule():
     assert beyond(10.0, 4.0, 40)  # > 2 SE
     assert not beyond(10.0, 6.0, 40)
     assert beyond(500.0, 400.0, 40)  # strong, concentrated evidence
+    assert not beyond(49.0, 61.0, 40)  # strong but within one SE: a clean record's model differences
 
 
 def _config(**kw) -> SimulationConfig:

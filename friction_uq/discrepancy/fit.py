@@ -203,7 +203,7 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     res = None
     for alt in ({}, *extra_starts):
         za = np.array([float(p.to_unbounded(alt.get(p.name, start[p.name]))) for p in params])
-        r = optimize.least_squares(residuals, za, method="trf", x_scale=width, diff_step=1e-6,
+        r = optimize.least_squares(residuals, za, method="trf", x_scale=width, diff_step=1e-6, xtol=1e-12, ftol=1e-10,
                                    max_nfev=60 * (len(z0) + 1))
         if res is None or r.cost < res.cost:
             res = r

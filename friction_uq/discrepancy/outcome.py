@@ -76,7 +76,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
                                  "whole-record fit of the final model"},
         "residual_rms": {ch: {ph: {"before": b, "after": a} for ph, (b, a) in phases.items()}
                          for ch, phases in dg.rms.items()},
-        "rule": "a mechanism is decisive when its dELPD exceeds 4 and either 2 SE or 40; the cause is the decisive "
+        "rule": "a mechanism is decisive when its dELPD exceeds 4 and either 2 SE or both 40 and 1 SE; the cause is the decisive "
                 "one with the largest dELPD; others within the same margin of it (40 replaced by max(40, 10 % of the "
                 "best)) are not separable from it; then the search goes on with the cause in the model",
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode",

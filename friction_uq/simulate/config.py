@@ -150,6 +150,7 @@ class SimulationConfig:
     elements: int = 20
     cfl: float = 0.8
     damping: float = 0.2
+    min_substeps: int = 1  # not a TOML key: fits fix the time step so the output is smooth in the parameters
     apparatus: Apparatus = field(default_factory=default_apparatus)
     source: str = "<config>"
 

@@ -114,7 +114,7 @@ def run_model(config: SimulationConfig, *, loading: Loading | None = None) -> Mo
     egr = sample.young_modulus * config.gap / radius
     c_max = cell.max_wave_speed(young_modulus=sample.young_modulus, density=sample.density, nu=nu, den=den)
     dt_crit = cell.critical_time_step(element_length=h, wave_speed=c_max, damping=config.damping)
-    n_sub = max(1, math.ceil(dt_out / (config.cfl * dt_crit)))
+    n_sub = max(1, math.ceil(dt_out / (config.cfl * dt_crit)), config.min_substeps)
     if n_sub > MAX_SUBSTEPS:
         raise ValueError(f"the sample's wave speed {c_max:.0f} m/s needs {n_sub} time steps per sample (at most "
                          f"{MAX_SUBSTEPS}): check its modulus, density and Poisson ratio")
