@@ -265,7 +265,7 @@ def run_file(
             "seed": seed if seed < 2**63 else str(seed),  # netCDF attributes hold int64
             "prior_file": str(p_path), "prior_data_conflict": int(bool(conflict.flagged)),
         })
-        nc_bytes = bytes(dt.to_netcdf(None, engine="h5netcdf"))
+        nc_bytes = netcdf_bytes(dt)
         stages["outputs"] = time.perf_counter() - t
         t = time.perf_counter()
         pdf_bytes = None
@@ -333,6 +333,21 @@ def run_file(
         print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, conflict, lines))
     return RunResult(prep, samples, summary, conv, lab, outputs, seconds, conflict, tuple(said), stages, sens,
                      wrc, diag)
+
+
+def netcdf_bytes(dt) -> bytes:
+    """The DataTree as netCDF bytes. Written through a private temporary file, not to memory: inside a
+    Dask worker xarray guards a write with a distributed lock named after its target, and an
+    in-memory buffer has no name the scheduler knows."""
+    import tempfile
+
+    try:
+        with tempfile.TemporaryDirectory(prefix="friction-uq-") as d:
+            path = Path(d) / "run.nc"
+            dt.to_netcdf(path, engine="h5netcdf")
+            return path.read_bytes()
+    except OSError as exc:
+        raise OutputError(f"{tempfile.gettempdir()}: cannot build the netCDF output there ({os_error_text(exc)})") from None
 
 
 def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,
