@@ -68,6 +68,8 @@ class Likelihood:
         Include the tube's axial Poisson term in the hoop prediction (when the model is built here).
     hoop_mode : {"level", "series"}
         How the hoop reading enters (:class:`~.hoop.HoopTerm`).
+    hoop_discrepancy : float
+        Relative sd of the hoop model's error on the level ("level" mode).
     model : ClosedFormModel or None
         The forward model over ``data``; None: ``ClosedFormModel(data, hoop=hoop,
         axial_poisson=axial_poisson)``.
@@ -81,7 +83,7 @@ class Likelihood:
 
     def __init__(
         self, data: StationaryData, *, hoop: bool | None = None, axial_poisson: bool = True, hoop_mode: str = "level",
-        model: ClosedFormModel | None = None,
+        model: ClosedFormModel | None = None, hoop_discrepancy: float = HOOP_DISCREPANCY,
     ) -> None:
         _check_data(data)
         if model is not None:
@@ -95,7 +97,7 @@ class Likelihood:
         self.data = data
         self.model = model
         self.force = ForceTerm(data)
-        self.hoop = HoopTerm(data, prediction=model.hoop, mode=hoop_mode) if hoop else None
+        self.hoop = HoopTerm(data, prediction=model.hoop, mode=hoop_mode, discrepancy=hoop_discrepancy) if hoop else None
         self.names = HOOP_PARAMETERS if hoop else FORCE_PARAMETERS
         self.hoop_mode = hoop_mode
 
@@ -144,11 +146,12 @@ class Likelihood:
             out = {k: np.add.reduceat(v, idx, axis=-1) if v.shape[-1] == self.data.n else v for k, v in out.items()}
         return out
 
-    def simulate(self, theta: np.ndarray, *, rng: np.random.Generator) -> dict[str, np.ndarray]:
+    def simulate(self, theta: np.ndarray, *, rng: np.random.Generator, hoop: bool = True) -> dict[str, np.ndarray]:
         """Replicated data (posterior predictive) for parameter vectors, with AR(1) noise.
 
         True F_io(t) is taken as the latent estimate given r; F_eo = r F_io (eq. 5, 13). Each
         replicate and channel also gets a constant offset error of the data's ``sd_offset_*``.
+        ``hoop=False``: the forces only (the same draws as a likelihood without the hoop term).
 
         Returns
         -------
@@ -167,7 +170,7 @@ class Likelihood:
             "F_eo": r[:, None] * x + ar1_noise(shape, sd=d.sd_eo, rho=d.rho_eo, rng=rng)
             + rng.normal(0.0, math.sqrt(fo.var_offset_eo), (len(x), 1)),
         }
-        if self.hoop is not None:
+        if self.hoop is not None and hoop:
             pred = self.hoop.predict(theta[:, 0], theta[:, 1], theta[:, 2])
             out["hoop"] = pred + ar1_noise(shape, sd=self.hoop.sd, rho=self.hoop.rho, rng=rng) \
                 + rng.normal(0.0, self.hoop.offset, (len(x), 1))
