@@ -88,7 +88,8 @@ class Likelihood:
         _check_data(data)
         if model is not None:
             if hoop is not None and bool(hoop) != (model.hoop is not None):
-                raise ValueError(f"hoop={hoop} but the model {'predicts' if model.hoop else 'does not predict'} the hoop gauge")
+                does = "predicts" if model.hoop else "does not predict"
+                raise ValueError(f"hoop={hoop} but the model {does} the hoop gauge")
             hoop = model.hoop is not None
         elif hoop is None:
             hoop = data.hoop is not None and data.sd_hoop is not None
@@ -97,7 +98,8 @@ class Likelihood:
         self.data = data
         self.model = model
         self.force = ForceTerm(data)
-        self.hoop = HoopTerm(data, prediction=model.hoop, mode=hoop_mode, discrepancy=hoop_discrepancy) if hoop else None
+        self.hoop = (HoopTerm(data, prediction=model.hoop, mode=hoop_mode, discrepancy=hoop_discrepancy)
+                     if hoop else None)
         self.names = HOOP_PARAMETERS if hoop else FORCE_PARAMETERS
         self.hoop_mode = hoop_mode
 
