@@ -85,15 +85,16 @@ def _segments(data: StationaryData, segment_duration: float) -> tuple[int, np.nd
 
 def pointwise_log_likelihood(
     samples: PosteriorSamples, data: StationaryData, *, segment_duration: float = 10e-6, batch: int = 1024,
-    axial_poisson: bool = True,
+    axial_poisson: bool = True, likelihood: Likelihood | None = None,
 ) -> dict[str, np.ndarray]:
     """Log-likelihood per draw and time segment, shape (chain, draw, n_segments) per term.
 
     Segments of ``segment_duration`` (10 us) are used rather than single samples because the
     noise is autocorrelated (leave-one-segment-out, libraries.md). Per draw the segments sum to
     the total log-likelihood. Keys "F_eo" (force term) and "hoop" (with the hoop term).
+    ``likelihood``: the one the samples were drawn with (None: built from ``axial_poisson``).
     """
-    lk = Likelihood(data, hoop=samples.hoop, axial_poisson=axial_poisson)
+    lk = likelihood if likelihood is not None else Likelihood(data, hoop=samples.hoop, axial_poisson=axial_poisson)
     seg, _ = _segments(data, segment_duration)
     flat = samples.array().reshape(-1, len(samples.names))
     parts: dict[str, list[np.ndarray]] = {}
@@ -106,7 +107,7 @@ def pointwise_log_likelihood(
 
 def build_datatree(
     samples: PosteriorSamples, data: StationaryData, priors: Priors, *, seed: int, n_prior: int = 4000,
-    segment_duration: float = 10e-6, axial_poisson: bool = True,
+    segment_duration: float = 10e-6, axial_poisson: bool = True, likelihood: Likelihood | None = None,
 ) -> xr.DataTree:
     """ArviZ DataTree of a posterior run (dims ("chain", "draw") in every sampled group).
 
@@ -125,7 +126,8 @@ def build_datatree(
     prior_theta = priors.subset(names).rvs(rng, n_prior)[None]
     prior = {n: prior_theta[..., i] for i, n in enumerate(names)} | derived_draws(prior_theta, data)
 
-    pw = pointwise_log_likelihood(samples, data, segment_duration=segment_duration, axial_poisson=axial_poisson)
+    pw = pointwise_log_likelihood(samples, data, segment_duration=segment_duration, axial_poisson=axial_poisson,
+                                  likelihood=likelihood)
     _, seg_t = _segments(data, segment_duration)
     observed = {"F_io": np.asarray(data.F_io), "F_eo": np.asarray(data.F_eo)}
     if samples.hoop and data.hoop is not None:
@@ -350,13 +352,15 @@ def _smooth_ratio(F_eo: np.ndarray, F_io: np.ndarray, width: int) -> np.ndarray:
 
 def ratio_ppc(
     samples: PosteriorSamples, data: StationaryData, *, seed: int, n_draws: int = 200, smooth: float = 10e-6,
+    likelihood: Likelihood | None = None,
 ) -> RatioPPC:
-    """Posterior predictive check of the force ratio (see :class:`RatioPPC`)."""
+    """Posterior predictive check of the force ratio (see :class:`RatioPPC`); ``likelihood``: the
+    analysis' (its forces are replicated; None: a force-only one is built)."""
     rng = np.random.default_rng(seed)
     flat = samples.array().reshape(-1, len(samples.names))
     pick = flat[rng.choice(len(flat), size=min(n_draws, len(flat)), replace=False)]
-    lk = Likelihood(data, hoop=False)
-    rep = lk.simulate(pick[:, :2], rng=rng)
+    lk = likelihood if likelihood is not None else Likelihood(data, hoop=False)
+    rep = lk.simulate(pick, rng=rng, hoop=False)
     width = max(1, int(round(smooth * data.sample_rate)))
     replicated = _smooth_ratio(rep["F_eo"], rep["F_io"], width)
     observed = _smooth_ratio(np.asarray(data.F_eo, float), np.asarray(data.F_io, float), width)

@@ -43,10 +43,12 @@ from .diagnostics import (
     summarize,
 )
 from .errors import OutputError, check_seed, os_error_text
+from .likelihood import Likelihood
 from .prior_sensitivity import FUnderPrior, PriorDataConflict
 from .priors import PRIORS_DIR, Priors, default_prior_path, load_priors
 from .record import read_record
 from .sampler import PosteriorSamples, sample_posterior, stderr_progress
+from .settings import AnalysisSettings
 
 JSON_VARIABLES = ("f", "nu", "kappa", "p_mean", "tau_mean", "V", "ratio")
 
@@ -184,11 +186,15 @@ def run_file(
 
     record = read_record(path)
     prep = prepare(record, window=window, dispersion=dispersion)
+    settings = AnalysisSettings(window=window, dispersion=dispersion, hoop=hoop)
     p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
     priors = load_priors(p_path)
     alternatives = alternative_nu_priors(p_path, priors)
-    left_out = hoop_unusable(prep) if hoop and prep.data.hoop is not None else None
-    use_hoop = bool(hoop and prep.data.hoop is not None and left_out is None)
+    left_out = hoop_unusable(prep) if settings.hoop and prep.data.hoop is not None else None
+    use_hoop = bool(settings.hoop and prep.data.hoop is not None and left_out is None)
+    # the likelihood of this analysis, built once and passed to every stage that needs it
+    likelihood = Likelihood(prep.data, hoop=use_hoop, axial_poisson=settings.axial_poisson,
+                            hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: --out must be a directory, and this is a file")
@@ -216,15 +222,18 @@ def run_file(
 
         t = time.perf_counter()
         samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
-                                   progress=stderr_progress if progress else None, notify=note)
+                                   progress=stderr_progress if progress else None, notify=note,
+                                   likelihood=likelihood)
         stages["sampling"] = time.perf_counter() - t
         t = time.perf_counter()
-        dt = build_datatree(samples, prep.data, priors, seed=seed)
+        dt = build_datatree(samples, prep.data, priors, seed=seed, likelihood=likelihood)
+        dt.attrs["analysis_settings"] = settings.to_attr()  # provenance: how the likelihood was built
         conv = convergence(dt, samples)
         summary = summarize(dt)
         stages["datatree"] = time.perf_counter() - t
         t = time.perf_counter()
-        sens = nu_sensitivity(prep.data, alternatives, seed=seed, hoop=use_hoop, done={"default": samples})
+        sens = nu_sensitivity(prep.data, alternatives, seed=seed, hoop=use_hoop, done={"default": samples},
+                              likelihood=likelihood)
         n_rerun = sum(s.method == "sampled" for k, s in sens.items() if k != "default")
         say(f"sensitivity to the nu prior: {len(alternatives) - 1} alternatives, {len(alternatives) - 1 - n_rerun} "
             f"by importance reweighting, {n_rerun} sampled afresh")
@@ -235,7 +244,7 @@ def run_file(
         t = time.perf_counter()
         band = f_given_nu(samples, np.linspace(0.15, 0.49, 69))
         share = nu_variance_share(samples)
-        ppc = ratio_ppc(samples, prep.data, seed=seed)
+        ppc = ratio_ppc(samples, prep.data, seed=seed, likelihood=likelihood)
         # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
         lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
         V = sliding_velocity_summary(prep)
@@ -273,7 +282,7 @@ def run_file(
             from .report.pdf import ReportInputs, render_report
 
             inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
-                                  conflict, whole_record=wrc, diagnosis=diag)
+                                  conflict, whole_record=wrc, diagnosis=diag, likelihood=likelihood)
             pdf_bytes = render_report(inputs)
         stages["pdf"] = time.perf_counter() - t
 
@@ -300,6 +309,7 @@ def run_file(
             "hoop_term": use_hoop,
             "hoop_left_out": left_out,
             "dispersion_correction": dispersion,
+            "analysis_settings": settings.to_json(),
             "nu_variance_share_of_f": share,
             "f_under_nu_priors": {k: s.to_json() for k, s in sens.items()},
             "prior_data_conflict": conflict.to_json(),

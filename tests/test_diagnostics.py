@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from friction_uq import diagnostics as dg
+from friction_uq.likelihood import Likelihood
 from friction_uq.physics import cell, design
 from friction_uq.priors import default_prior_path, load_priors
 from friction_uq.sampler import PosteriorSamples, sample_posterior
@@ -150,6 +151,19 @@ def test_nu_sensitivity_orders_the_widths(data, run_force):
 
 
 # ---------------------------------------------------------------- posterior predictive
+
+
+def test_the_analysis_likelihood_passed_down_gives_the_same_numbers(run_hoop, data):
+    """run builds the likelihood once (hoop term on) and passes it to the diagnostics: the same
+    pointwise log-likelihood and the same replicated forces as the ones built inside."""
+    lk = Likelihood(data, hoop=True)
+    a = dg.pointwise_log_likelihood(run_hoop, data)
+    b = dg.pointwise_log_likelihood(run_hoop, data, likelihood=lk)
+    assert a.keys() == b.keys() == {"F_eo", "hoop"}
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k])
+    np.testing.assert_array_equal(dg.ratio_ppc(run_hoop, data, seed=1).replicated,
+                                  dg.ratio_ppc(run_hoop, data, seed=1, likelihood=lk).replicated)
 
 
 def test_ratio_ppc_covers_a_well_specified_record_and_flags_a_drift(run_force, data):

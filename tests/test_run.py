@@ -44,6 +44,16 @@ def test_json_has_the_contract_keys(paper_run):
     assert doc["kappa"]["q50"] == pytest.approx(doc["f"]["q50"] * doc["nu"]["q50"] / (1 - doc["nu"]["q50"]), rel=0.02)
 
 
+def test_analysis_settings_are_in_the_provenance(paper_run):
+    """The frozen settings the likelihood was built from, in the JSON and the DataTree's root attrs."""
+    _, out, _ = paper_run
+    want = {"window": None, "dispersion": False, "hoop": True, "hoop_mode": "level", "axial_poisson": True,
+            "hoop_discrepancy": 0.03}
+    assert json.loads((out / "paper_P-01.json").read_text())["analysis_settings"] == want
+    dt = xr.open_datatree(out / "paper_P-01.nc", engine="h5netcdf")
+    assert json.loads(dt.attrs["analysis_settings"]) == want
+
+
 def test_the_papers_case_contains_0049(paper_run):
     """physics.md: F_eo/F_io ~ 0.14 gives f ~ 0.049 with nu = 0.4; the 90 % interval must contain it."""
     _, out, _ = paper_run

@@ -161,6 +161,19 @@ def test_same_seed_same_numbers_other_seed_other_numbers(paper_data):
     assert not np.array_equal(a.draws["f"][0], a.draws["f"][1])
 
 
+def test_a_likelihood_built_once_gives_the_same_draws(paper_data):
+    """run builds the likelihood once and passes it down; the draws equal those of one built inside."""
+    kw = dict(hoop=False, max_steps=200, n_ensembles=2)
+    lk = Likelihood(paper_data, hoop=False)
+    with pytest.warns(ConvergenceWarning, match=r"max_steps=200"):
+        a = sample_posterior(paper_data, DEFAULT, seed=5, **kw)
+    with pytest.warns(ConvergenceWarning, match=r"max_steps=200"):
+        b = sample_posterior(paper_data, DEFAULT, seed=5, likelihood=lk, **kw)
+    np.testing.assert_array_equal(a.array(), b.array())
+    with pytest.raises(SamplingError, match="has the hoop term off against hoop=True"):
+        sample_posterior(paper_data, DEFAULT, seed=5, hoop=True, likelihood=lk)
+
+
 def test_progress_callback_and_stderr_line(paper_data, capsys):
     seen: list[Progress] = []
     with pytest.warns(ConvergenceWarning, match="max_steps=300"):

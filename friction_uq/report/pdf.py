@@ -43,6 +43,7 @@ class ReportInputs:
     conflict: PriorDataConflict | None = None
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
+    likelihood: object | None = None  # friction_uq.likelihood.Likelihood, built once by run
 
 
 def _fmt(v: float) -> str:
@@ -135,7 +136,8 @@ def render_report(r: ReportInputs) -> bytes:
             lambda: page_ppc(r.ppc),
         ]
         if r.samples.hoop:
-            builders.append(lambda: page_hoop(r.samples, p.data, p.forces, seed=r.samples.seed))
+            builders.append(lambda: page_hoop(r.samples, p.data, p.forces, seed=r.samples.seed,
+                                              likelihood=r.likelihood))
         for build in builders:
             fig = build()
             pdf.savefig(fig)

@@ -138,17 +138,19 @@ def page_ppc(ppc: RatioPPC, *, number: int = 7) -> Figure:
     return fig
 
 
-def page_hoop(samples: PosteriorSamples, data, forces, *, number: int = 8, n_draws: int = 200, seed: int = 0) -> Figure:
+def page_hoop(samples: PosteriorSamples, data, forces, *, number: int = 8, n_draws: int = 200, seed: int = 0,
+              likelihood=None) -> Figure:
     """The hoop gauge against the model: whole record, window prediction band, residual shape.
 
     The likelihood uses the window level only (3 % model discrepancy); this page shows what the
     level hides: the shape of the reading as the sample slides past the gauge, against the
-    shape the Janssen pressure and the tube kernel predict.
+    shape the Janssen pressure and the tube kernel predict. ``likelihood``: the analysis' (with
+    the hoop term), whose model predicts the reading; None: one is built.
     """
     from ..likelihood import Likelihood
 
     fig, axes = figure(f"{number}. Tube hoop gauge against the model (posterior draws)", nrows=1, ncols=2)
-    lk = Likelihood(data, hoop=True)
+    lk = likelihood if likelihood is not None and likelihood.has_hoop else Likelihood(data, hoop=True)
     rng = np.random.default_rng(seed)
     flat = samples.array().reshape(-1, len(samples.names))
     pick = flat[rng.choice(len(flat), size=min(n_draws, len(flat)), replace=False)]

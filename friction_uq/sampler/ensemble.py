@@ -80,6 +80,7 @@ def sample_posterior(
     checkpoint_seconds: float = 2.0,
     notify: Callable[[str], None] | None = None,
     axial_poisson: bool = True,
+    likelihood: Likelihood | None = None,
 ) -> PosteriorSamples:
     """Sample the posterior of (f, nu[, hoop_gain]) for one stationary phase.
 
@@ -109,6 +110,9 @@ def sample_posterior(
         Receives one-line notices (a checkpoint set aside).
     axial_poisson : bool
         Include the tube's axial Poisson term in the hoop prediction.
+    likelihood : Likelihood or None
+        The analysis' likelihood over ``data``, built once by the caller; None: built here from
+        ``hoop`` and ``axial_poisson``.
 
     Returns
     -------
@@ -134,7 +138,11 @@ def sample_posterior(
             f"need n_ensembles >= 1, check_every >= 10 and max_steps >= check_every; got {n_ensembles}, "
             f"{check_every}, {max_steps}"
         )
-    likelihood = Likelihood(data, hoop=hoop, axial_poisson=axial_poisson)
+    if likelihood is None:
+        likelihood = Likelihood(data, hoop=hoop, axial_poisson=axial_poisson)
+    elif likelihood.data is not data or (hoop is not None and bool(hoop) != likelihood.has_hoop):
+        raise SamplingError(f"the likelihood given is over other data or has the hoop term "
+                            f"{'on' if likelihood.has_hoop else 'off'} against hoop={hoop}")
     names = likelihood.names
     try:
         prior = priors.subset(names)

@@ -1,0 +1,131 @@
+"""Stationary AR(1) Gaussian noise: exact log-likelihood, per-sample conditionals, and a constant
+offset error integrated out (rank-one term: matrix determinant lemma and Sherman-Morrison)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..signals import ar1_mean_sd
+
+_LOG_2PI = math.log(2.0 * math.pi)
+
+
+def ar1_pointwise(
+    resid: np.ndarray, sd: np.ndarray | float, rho: np.ndarray | float, offset: np.ndarray | float = 0.0,
+) -> np.ndarray:
+    """Conditional log densities of a stationary AR(1) Gaussian series; they sum to the exact log-likelihood.
+
+    Parameters
+    ----------
+    resid : array, shape (..., n)
+        Residuals, time along the last axis.
+    sd : float or array broadcastable to shape (...,)
+        Marginal standard deviation of the noise (same unit as ``resid``).
+    rho : float or array broadcastable to shape (...,)
+        Lag-1 coefficient, |rho| < 1.
+    offset : float or array broadcastable to shape (...,)
+        Standard deviation of an unknown constant added to the series (integrated out); 0: none.
+
+    Returns
+    -------
+    array, shape (..., n)
+        log p(e_1) = log N(e_1; 0, sd^2) and log p(e_t | e_{t-1}) = log N(e_t; rho e_{t-1}, sd^2 (1 - rho^2))
+        (with an offset: the conditionals given all earlier samples).
+    """
+    resid = np.asarray(resid, float)
+    sd = np.asarray(sd, float)
+    rho = np.asarray(rho, float)
+    offset = np.asarray(offset, float)
+    if np.any(offset > 0.0):
+        shape = resid.shape[:-1]
+        return _offset_pointwise_shift(resid, np.broadcast_to(sd, shape), np.broadcast_to(rho, shape),
+                                       np.broadcast_to(np.maximum(offset, 1e-150), shape))
+    var = sd**2
+    var_c = var * (1.0 - rho**2)  # conditional variance of e_t given e_{t-1}
+    out = np.empty(np.broadcast_shapes(resid.shape, sd.shape + (1,), rho.shape + (1,)))
+    out[..., 0] = -0.5 * (_LOG_2PI + np.log(var) + resid[..., 0] ** 2 / var)
+    innov = resid[..., 1:] - rho[..., None] * resid[..., :-1]
+    innov *= innov
+    innov /= -2.0 * var_c[..., None]
+    innov += (-0.5 * (_LOG_2PI + np.log(var_c)))[..., None]
+    out[..., 1:] = innov
+    return out
+
+
+def ar1_loglike(
+    resid: np.ndarray, sd: np.ndarray | float, rho: np.ndarray | float, offset: np.ndarray | float = 0.0,
+) -> np.ndarray:
+    """Exact log-likelihood of a stationary AR(1) Gaussian series along the last axis.
+
+    log L = -n/2 log(2 pi sd^2) - (n-1)/2 log(1 - rho^2)
+            - [(1 - rho^2) e_1^2 + sum_{t>=2} (e_t - rho e_{t-1})^2] / (2 sd^2 (1 - rho^2)).
+
+    Shapes and ``offset`` as :func:`ar1_pointwise`; returns shape (...,). With an offset, adds
+    :func:`ar1_offset_correction`.
+    """
+    resid = np.asarray(resid, float)
+    sd = np.asarray(sd, float)
+    rho = np.asarray(rho, float)
+    n = resid.shape[-1]
+    one = 1.0 - rho**2
+    d = resid[..., 1:] - rho[..., None] * resid[..., :-1]
+    q = one * resid[..., 0] ** 2 + np.sum(d * d, axis=-1)
+    out = -0.5 * n * (_LOG_2PI + np.log(sd**2)) - 0.5 * (n - 1) * np.log(one) - q / (2.0 * sd**2 * one)
+    if np.any(np.asarray(offset) > 0.0):
+        out = out + ar1_offset_correction(resid.sum(-1), resid[..., 0] + resid[..., -1], n=n, sd=sd, rho=rho, offset=offset)
+    return out
+
+
+def offset_sd(sd: float, rho: float, n_baseline: int) -> float:
+    """Standard deviation of the mean of ``n_baseline`` AR(1) samples: the error of an offset removed
+    with the mean of a pre-pulse segment (:func:`friction_uq.signals.ar1_mean_sd`)."""
+    return ar1_mean_sd(sd, rho, n_baseline)
+
+
+def ar1_offset_correction(
+    sum_u: np.ndarray, ends_u: np.ndarray, *, n: int, sd: np.ndarray | float, rho: np.ndarray | float,
+    offset: np.ndarray | float,
+) -> np.ndarray:
+    """log N(u; 0, S + c^2 1 1') - log N(u; 0, S) for S the AR(1) covariance (sd, rho) and c = ``offset``.
+
+    Needs only sum(u) and u_1 + u_n: with P = S^-1, 1'Pu = [(1-rho)^2 sum(u) + rho(1-rho)(u_1 + u_n)]
+    / (sd^2 (1-rho^2)) and 1'P1 = [(1-rho^2) + (n-1)(1-rho)^2] / (sd^2 (1-rho^2)); the correction is
+    c^2 (1'Pu)^2 / (2 (1 + c^2 1'P1)) - log(1 + c^2 1'P1) / 2 (Sherman-Morrison, determinant lemma).
+    """
+    sd, rho, c2 = np.asarray(sd, float), np.asarray(rho, float), np.asarray(offset, float) ** 2
+    var_c = sd**2 * (1.0 - rho**2)
+    g = ((1.0 - rho) ** 2 * sum_u + rho * (1.0 - rho) * ends_u) / var_c
+    h = ((1.0 - rho**2) + (n - 1) * (1.0 - rho) ** 2) / var_c
+    return 0.5 * c2 * g * g / (1.0 + c2 * h) - 0.5 * np.log1p(c2 * h)
+
+
+def _offset_pointwise_shift(resid: np.ndarray, sd: np.ndarray, rho: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """Per-sample conditional log densities of u = delta + AR(1), delta ~ N(0, offset^2) (recursive form).
+
+    Innovations eta_1 = u_1 = delta + e_1 (variance sd^2), eta_t = u_t - rho u_{t-1} = (1-rho) delta + w_t
+    (variance sd^2 (1-rho^2)): a regression on delta, whose predictive densities follow from
+    cumulative sums.
+    """
+    n = resid.shape[-1]
+    var = sd[..., None] ** 2
+    var_t = np.concatenate([np.broadcast_to(var, var.shape), np.broadcast_to(var * (1.0 - rho[..., None] ** 2), var.shape[:-1] + (n - 1,))], axis=-1)
+    x = np.concatenate([np.ones(var.shape), np.broadcast_to((1.0 - rho[..., None]), var.shape[:-1] + (n - 1,))], axis=-1)
+    eta = np.concatenate([resid[..., :1], resid[..., 1:] - rho[..., None] * resid[..., :-1]], axis=-1)
+    a = np.cumsum(x * eta / var_t, axis=-1)
+    b = 1.0 / offset[..., None] ** 2 + np.cumsum(x * x / var_t, axis=-1)
+    a_prev = np.concatenate([np.zeros(var.shape), a[..., :-1]], axis=-1)
+    b_prev = np.concatenate([np.broadcast_to(1.0 / offset[..., None] ** 2, var.shape), b[..., :-1]], axis=-1)
+    mean = x * a_prev / b_prev
+    v = var_t + x * x / b_prev
+    return -0.5 * (_LOG_2PI + np.log(v) + (eta - mean) ** 2 / v)
+
+
+def _innovations(x: np.ndarray, rho: float) -> np.ndarray:
+    """AR(1) innovations along the last axis: sqrt(1 - rho^2) x_1, x_t - rho x_{t-1}."""
+    x = np.asarray(x, float)
+    out = np.empty_like(x)
+    out[..., 0] = math.sqrt(1.0 - rho**2) * x[..., 0]
+    out[..., 1:] = x[..., 1:] - rho * x[..., :-1]
+    return out
