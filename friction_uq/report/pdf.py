@@ -87,7 +87,7 @@ def page_summary(r: ReportInputs) -> Figure:
     for line in lines:
         color = "firebrick" if line.startswith("WARNING") else "black"
         # wrapped here, not by matplotlib (whose wrap=True measures the text word by word)
-        text = "\n".join(textwrap.wrap(line, 118))
+        text = "\n".join(textwrap.wrap(line, 112))
         ax.text(0.0, y, text, fontsize=10, va="top", transform=ax.transAxes, color=color)
         y -= 0.034 * (text.count("\n") + 1) + 0.016
     rows = []
@@ -104,7 +104,7 @@ def page_summary(r: ReportInputs) -> Figure:
     prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
             f"seed {r.samples.seed}, friction-uq {r.version}")
     ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
-    ax.text(0.80, 0.40, "Pages\n 1 raw gauges\n 2 waves, forces, equilibrium\n 3 window and noise\n"
+    ax.text(0.84, 0.97, "Pages\n 1 raw gauges\n 2 waves, forces, equilibrium\n 3 window and noise\n"
             " 4 posterior vs prior\n 5 nu -> f\n 6 convergence\n 7 predictive check"
             + ("\n 8 hoop gauge vs model" if r.samples.hoop else "")
             + (f"\n{whole_record_page(r):2d} whole test vs gauges" if r.whole_record is not None else "")
