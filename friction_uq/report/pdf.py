@@ -87,7 +87,7 @@ def page_summary(r: ReportInputs) -> Figure:
     for line in lines:
         color = "firebrick" if line.startswith("WARNING") else "black"
         # wrapped here, not by matplotlib (whose wrap=True measures the text word by word)
-        text = "\n".join(textwrap.wrap(line, 112))
+        text = "\n".join(textwrap.wrap(line, 100))
         ax.text(0.0, y, text, fontsize=10, va="top", transform=ax.transAxes, color=color)
         y -= 0.034 * (text.count("\n") + 1) + 0.016
     rows = []
