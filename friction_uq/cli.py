@@ -158,32 +158,27 @@ def build_parser() -> argparse.ArgumentParser:
 
     _add_campaign_parser(sub)
 
-    s = sub.add_parser("run", help="joint posterior of f and nu, uncertainty propagation, PDF report",
-                       description="The main job: sample the posterior of f and nu for one record and "
-                       "write <campaign>_<test_id>.nc, .json and .pdf.")
-    s.add_argument("file", type=Path, help="test record (test.h5)")
-    s.add_argument("--priors", type=Path, help="prior file (TOML; default: the package's <material>.toml)")
-    s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
-    s.add_argument("--seed", type=_seed, default=20161, help="random seed, 0 <= seed < 2**64 (default 20161)")
-    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds on the record's time base (default: automatic); write --window=T0:T1 when T0 is negative")
-    s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
-    s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
-    s.add_argument("--no-pdf", action="store_true", help="skip the PDF report")
-    s.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    s.add_argument("--diagnose", action="store_true",
-                   help="also fit each mechanism of the catalogue and name the cause of a misfit")
-
-    s = sub.add_parser("diagnose", help="run, then name the cause of a misfit: each mechanism fitted and compared",
-                       description="The main job plus the mechanism catalogue: each extension of the baseline "
-                       "fitted to the whole record, ranked by expected log predictive density; the cause named "
-                       "when the evidence is decisive. Same outputs as run, with a 'discrepancy' block.")
-    s.add_argument("file", type=Path, help="test record (test.h5)")
-    s.add_argument("--priors", type=Path, help="prior file (TOML; default: priors/<material>.toml)")
-    s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
-    s.add_argument("--seed", type=int, default=20161, help="random seed (default 20161)")
-    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds (default: automatic)")
-    s.add_argument("--no-pdf", action="store_true", help="skip the PDF report")
-    s.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    run_help = ("run", "joint posterior of f and nu, uncertainty propagation, PDF report",
+                "The main job: sample the posterior of f and nu for one record and write "
+                "<campaign>_<test_id>.nc, .json and .pdf.")
+    diagnose_help = ("diagnose", "run, then name the cause of a misfit: each mechanism fitted and compared",
+                     "The main job plus the mechanism catalogue: each extension of the baseline fitted to the whole "
+                     "record, ranked by expected log predictive density; the cause named when the evidence is "
+                     "decisive. Same outputs as run, with a 'discrepancy' block.")
+    for name, short, long in (run_help, diagnose_help):  # one job, one set of options
+        s = sub.add_parser(name, help=short, description=long)
+        s.add_argument("file", type=Path, help="test record (test.h5)")
+        s.add_argument("--priors", type=Path, help="prior file (TOML; default: the package's <material>.toml)")
+        s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
+        s.add_argument("--seed", type=_seed, default=20161, help="random seed, 0 <= seed < 2**64 (default 20161)")
+        s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds on the record's time base (default: automatic); write --window=T0:T1 when T0 is negative")
+        s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
+        s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
+        s.add_argument("--no-pdf", action="store_true", help="skip the PDF report")
+        s.add_argument("--quiet", action="store_true", help="no progress on stderr")
+        if name == "run":
+            s.add_argument("--diagnose", action="store_true",
+                           help="also fit each mechanism of the catalogue and name the cause of a misfit")
     return p
 
 
@@ -266,7 +261,7 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         run_file(
             args.file, priors_path=args.priors, out_dir=args.out, seed=args.seed, window=args.window,
-            dispersion=getattr(args, "dispersion", False), hoop=not getattr(args, "no_hoop", False),
+            dispersion=args.dispersion, hoop=not args.no_hoop,
             pdf=not args.no_pdf, progress=not args.quiet,
             diagnose=args.command == "diagnose" or args.diagnose,
         )

@@ -40,6 +40,7 @@ from scipy import stats
 
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
+from ..models.parameters import summarize_draws
 from .elpd import Elpd, ar1_block_loo, elpd_difference, takeuchi_block_loo
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
@@ -94,7 +95,7 @@ class ModelFit:
     lik: WholeRecordLikelihood | None = None
 
     def f_summary(self) -> dict[str, float]:
-        return _summary(self.f_effective)
+        return summarize_draws(self.f_effective)
 
 
 @dataclass(frozen=True)
@@ -137,12 +138,6 @@ class Diagnosis:
     @property
     def ranking(self) -> tuple[Ranked, ...]:
         return self.rounds[0] if self.rounds else ()
-
-
-def _summary(v: np.ndarray) -> dict[str, float]:
-    q = np.quantile(v, [0.05, 0.5, 0.95])
-    return {"mean": float(np.mean(v)), "sd": float(np.std(v, ddof=1)), "q05": float(q[0]), "q50": float(q[1]),
-            "q95": float(q[2])}
 
 
 class Diagnoser:
@@ -193,8 +188,7 @@ class Diagnoser:
                 st[p.name] = start.get(p.name, v.mechanism.start[p.name])
         self._n_fit += 1
         rng = np.random.default_rng(np.random.SeedSequence([self.seed, 9, self._n_fit]))
-        lo, mid, hi = (float(self.modulus.to_unbounded(self.modulus_prior.ppf(q))) for q in (0.16, 0.5, 0.84))
-        scales = {"sample_modulus": (mid, 0.5 * (hi - lo)), **self.base_scales}
+        scales = {"sample_modulus": self.modulus.gaussian_stand_in(self.modulus_prior), **self.base_scales}
         for v in variants:
             scales.update(v.mechanism.prior_z())
         # the baseline from several nu (the closed form's, and either side of the prior): see fit.py

@@ -34,6 +34,7 @@ import numpy as np
 from scipy import optimize
 
 from ..analysis import Prepared
+from ..models.parameters import summarize_draws
 from ..models.simulator import SimulatorModel
 from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, tolerance_sd, whiten
 
@@ -56,10 +57,7 @@ class WholeRecordFit:
     whitened: np.ndarray | None = None  # whitened data residual at the mode
 
     def summary(self, name: str) -> dict[str, float]:
-        v = self.draws[name]
-        q = np.quantile(v, [0.05, 0.5, 0.95])
-        return {"mean": float(v.mean()), "sd": float(v.std(ddof=1)), "q05": float(q[0]), "q50": float(q[1]),
-                "q95": float(q[2])}
+        return summarize_draws(self.draws[name])
 
 
 class WholeRecordLikelihood:

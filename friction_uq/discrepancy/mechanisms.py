@@ -70,11 +70,7 @@ class Mechanism:
     def prior_z(self) -> dict[str, tuple[float, float]]:
         """Gaussian stand-ins of the priors in each parameter's unbounded coordinate (centre, sd), from the
         prior's 16 % and 84 % quantiles: what the mode search uses (the exact prior weighs the draws)."""
-        out = {}
-        for p in self.parameters:
-            lo, mid, hi = (float(p.to_unbounded(self.priors[p.name].ppf(q))) for q in (0.16, 0.5, 0.84))
-            out[p.name] = (mid, max(0.5 * (hi - lo), 1e-3))
-        return out
+        return {p.name: p.gaussian_stand_in(self.priors[p.name]) for p in self.parameters}
 
     def log_prior(self, values: Mapping[str, float]) -> float:
         return float(sum(self.priors[p.name].logpdf(values[p.name]) for p in self.parameters))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..models.parameters import summarize_draws
 from .diagnose import Diagnosis, ModelFit, Ranked
 from .whole_record import CHANNEL_LABELS
 
@@ -11,17 +12,11 @@ from .whole_record import CHANNEL_LABELS
 HOOP_GAIN_FINDING = 0.03
 
 
-def _summary(v: np.ndarray) -> dict[str, float]:
-    q = np.quantile(v, [0.05, 0.5, 0.95])
-    return {"mean": float(np.mean(v)), "sd": float(np.std(v, ddof=1)), "q05": float(q[0]), "q50": float(q[1]),
-            "q95": float(q[2])}
-
-
 def _entry(r: Ranked) -> dict[str, object]:
     v = r.fit.variants[-1]
-    params = {p.name: _summary(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
+    params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
     return {"name": v.mechanism.name, "channel": v.channel, "model": r.fit.label, "delpd": r.delpd, "se": r.se,
-            "decisive": r.decisive, "parameters": params, "f_effective": _summary(r.fit.f_effective)}
+            "decisive": r.decisive, "parameters": params, "f_effective": summarize_draws(r.fit.f_effective)}
 
 
 def _describe(dg: Diagnosis) -> str:
@@ -70,7 +65,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
         "f_extended": dg.final.f_summary(),
         "f_baseline_stationary": f_without,
         "f_baseline_whole_record": dg.baseline.f_summary(),
-        "nu_extended": _summary(dg.final.fit.draws["nu"]),
+        "nu_extended": summarize_draws(dg.final.fit.draws["nu"]),
         "hoop_gain": {"value": hoop, "finding": abs(hoop - 1.0) > HOOP_GAIN_FINDING,
                       "meaning": "calibration factor of the tube hoop gauge (recorded / true), profiled in the "
                                  "whole-record fit of the final model"},

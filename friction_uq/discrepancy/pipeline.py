@@ -34,10 +34,7 @@ def run_diagnose(prep: Prepared, priors: Priors, start: Mapping[str, float], *, 
                  say: Callable[[str], None] = lambda msg: None) -> Diagnosis:
     """:func:`.diagnose.diagnose` with the run's f and nu priors (and their Gaussian stand-ins for the
     mode search), started from the stationary posterior's medians."""
-    scales = {}
-    for par in (F, NU):
-        lo, mid, hi = (float(par.to_unbounded(priors[par.name].ppf(q))) for q in (0.16, 0.5, 0.84))
-        scales[par.name] = (mid, max(0.5 * (hi - lo), 1e-3))
+    scales = {par.name: par.gaussian_stand_in(priors[par.name]) for par in (F, NU)}
     return diagnose(prep, f_nu_log_prior(priors), start, hoop=hoop or prep.record.has_hoop, seed=seed,
                     progress=lambda m: say(f"diagnose: {m}"), base_scales=scales)
 

@@ -77,8 +77,22 @@ class Parameter:
             return z if math.isinf(self.high) else -z
         return math.log(self.high - self.low) - np.logaddexp(0.0, -z) - np.logaddexp(0.0, z)
 
+    def gaussian_stand_in(self, prior) -> tuple[float, float]:
+        """(centre, sd) in the unbounded coordinate of a Gaussian standing in for ``prior`` (anything with
+        ``ppf``): its median and half the distance between its 16 % and 84 % quantiles."""
+        lo, mid, hi = (float(self.to_unbounded(prior.ppf(q))) for q in (0.16, 0.5, 0.84))
+        return mid, max(0.5 * (hi - lo), 1e-3)
+
     def to_json(self) -> dict[str, object]:
         return {"name": self.name, "unit": self.unit, "low": self.low, "high": self.high, "meaning": self.meaning}
+
+
+def summarize_draws(v: np.ndarray) -> dict[str, float]:
+    """mean, sd, q05, q50, q95 of draws (the summary every output uses)."""
+    v = np.asarray(v, float)
+    q = np.quantile(v, [0.05, 0.5, 0.95])
+    return {"mean": float(np.mean(v)), "sd": float(np.std(v, ddof=1)), "q05": float(q[0]), "q50": float(q[1]),
+            "q95": float(q[2])}
 
 
 class ParameterSet:
