@@ -37,7 +37,7 @@ from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.likelihood import Likelihood  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
-from friction_uq.sampler import LogPosterior, start_ball, to_theta  # noqa: E402
+from friction_uq.sampler import LogPosterior, start_ball  # noqa: E402
 from friction_uq.simulate import simulate_to_file  # noqa: E402
 
 #: Hidden mechanism -> config edit at a detectable strength (and the truth's f at the window).
@@ -83,7 +83,7 @@ def analyse(path: str, priors, seed: int, max_causes: int):
     prep = prepare(rec)
     lp = LogPosterior(Likelihood(prep.data, hoop=True), priors)
     z_map, _ = start_ball(lp, priors, nwalkers=8, n_ensembles=1, rng=np.random.default_rng(seed))
-    th = to_theta(z_map[None])[0]
+    th = lp.to_theta(z_map)
 
     def log_prior(v):
         return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))

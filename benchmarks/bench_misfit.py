@@ -32,7 +32,7 @@ from friction_uq.errors import FrictionUQError
 from friction_uq.likelihood import Likelihood
 from friction_uq.priors import default_prior_path, load_priors
 from friction_uq.record import read_record
-from friction_uq.sampler import LogPosterior, start_ball, to_theta
+from friction_uq.sampler import LogPosterior, start_ball
 from friction_uq.simulate import load_config, simulate_to_file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -82,7 +82,7 @@ def analyse(path: str, priors, seed: int):
     prep = prepare(rec)
     lp = LogPosterior(Likelihood(prep.data, hoop=True), priors)
     z_map, _ = start_ball(lp, priors, nwalkers=8, n_ensembles=1, rng=np.random.default_rng(seed))
-    th = to_theta(z_map[None])[0]
+    th = lp.to_theta(z_map)
     log_prior = lambda v: float(priors.logpdf(np.array([[v["f"], v["nu"], th[2]]]))[0])  # noqa: E731
     return check_whole_record(prep, log_prior, {"f": th[0], "nu": th[1]}, hoop=True, seed=seed)
 

@@ -100,7 +100,7 @@ def main(argv: list[str]) -> int:
     from friction_uq.likelihood import Likelihood
     from friction_uq.priors import default_prior_path, load_priors
     from friction_uq.record import read_record
-    from friction_uq.sampler import LogPosterior, sample_posterior, start_ball, to_theta
+    from friction_uq.sampler import LogPosterior, sample_posterior, start_ball
 
     rec = read_record(a.record)
     prep = prepare(rec)
@@ -117,7 +117,7 @@ def main(argv: list[str]) -> int:
     z_map, _ = start_ball(log_post, priors.subset(lk.names), nwalkers=8, n_ensembles=1,
                           rng=np.random.default_rng(a.seed))
     z, nuts_s = nuts_run(log_post, z_map, seed=a.seed)
-    f_nuts = to_theta(z)[..., 0]
+    f_nuts = lk.parameters.as_dict(log_post.to_theta(z))["f"]
     nuts_ess = ess_bulk(f_nuts)
 
     print(f"{rec.campaign} {rec.test_id}, hoop term {'on' if hoop else 'off'}, parameters {', '.join(lk.names)}")

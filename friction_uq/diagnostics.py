@@ -19,7 +19,7 @@ tau_mean = r <x> / (2 pi R L) (eq. 18, with <x> the window mean of the latent tr
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import arviz_base
@@ -52,21 +52,20 @@ QUANTILES = (0.05, 0.5, 0.95)
 # ----------------------------------------------------------------------------------------------
 
 
-def derived_draws(theta: np.ndarray, data: StationaryData) -> dict[str, np.ndarray]:
-    """kappa, ratio, tau_mean (Pa), p_mean (Pa) for parameter vectors.
+def derived_draws(values: Mapping[str, np.ndarray], data: StationaryData) -> dict[str, np.ndarray]:
+    """kappa, ratio, tau_mean (Pa), p_mean (Pa) for named draws.
 
     Parameters
     ----------
-    theta : array, shape (..., ndim)
-        Columns (f, nu[, hoop_gain]).
+    values : mapping
+        Draws by parameter name (``f``, ``nu`` are used), arrays of one shape.
     data : StationaryData
 
     Returns
     -------
-    dict of arrays of shape theta.shape[:-1]
+    dict of arrays of the draws' shape
     """
-    theta = np.asarray(theta, float)
-    f, nu = theta[..., 0], theta[..., 1]
+    f, nu = np.asarray(values["f"], float), np.asarray(values["nu"], float)
     R, L = data.radius, data.length
     r = cell.force_ratio(f, nu, radius=R, length=L)
     var_io, var_eo = data.sd_io**2, data.sd_eo**2
@@ -119,12 +118,13 @@ def build_datatree(
     Provenance (seed, prior file, steps, tau, acceptance, convergence) goes into the root attrs.
     """
     names = samples.names
-    theta = samples.array()
-    post = {n: samples.draws[n] for n in names} | derived_draws(theta, data)
+    post = {n: samples.draws[n] for n in names}
+    post |= derived_draws(post, data)
 
     rng = np.random.default_rng(seed)
-    prior_theta = priors.subset(names).rvs(rng, n_prior)[None]
-    prior = {n: prior_theta[..., i] for i, n in enumerate(names)} | derived_draws(prior_theta, data)
+    prior_sub = priors.subset(names)
+    prior = dict(zip(prior_sub.names, np.moveaxis(prior_sub.rvs(rng, n_prior)[None], -1, 0)))
+    prior |= derived_draws(prior, data)
 
     pw = pointwise_log_likelihood(samples, data, segment_duration=segment_duration, axial_poisson=axial_poisson,
                                   likelihood=likelihood)
@@ -357,15 +357,16 @@ def ratio_ppc(
     """Posterior predictive check of the force ratio (see :class:`RatioPPC`); ``likelihood``: the
     analysis' (its forces are replicated; None: a force-only one is built)."""
     rng = np.random.default_rng(seed)
-    flat = samples.array().reshape(-1, len(samples.names))
-    pick = flat[rng.choice(len(flat), size=min(n_draws, len(flat)), replace=False)]
     lk = likelihood if likelihood is not None else Likelihood(data, hoop=False)
+    n_all = samples.n_chains * samples.n_draws
+    idx = rng.choice(n_all, size=min(n_draws, n_all), replace=False)
+    pick = lk.parameters.vector({n: samples.flat(n)[idx] for n in lk.names})
     rep = lk.simulate(pick, rng=rng, hoop=False)
     width = max(1, int(round(smooth * data.sample_rate)))
     replicated = _smooth_ratio(rep["F_eo"], rep["F_io"], width)
     observed = _smooth_ratio(np.asarray(data.F_eo, float), np.asarray(data.F_io, float), width)
     q = np.quantile(replicated, QUANTILES, axis=0)
-    r = lk.ratio(flat[:, :2])
+    r = lk.model.ratio(samples.draws)
     mq = np.quantile(r, [0.05, 0.95])
     inside = (observed >= q[0]) & (observed <= q[2])
     return RatioPPC(np.asarray(data.time), observed, replicated, q[0], q[1], q[2], float(mq[0]), float(mq[1]),

@@ -192,8 +192,7 @@ def prior_data_conflict(dt, samples: PosteriorSamples, priors: Priors, *, thresh
     import xarray as xr
 
     pri = priors.subset(samples.names)
-    theta = samples.array()
-    lp = {p.name: (("chain", "draw"), p.logpdf(theta[..., j])) for j, p in enumerate(pri.parameters)}
+    lp = {p.name: (("chain", "draw"), p.logpdf(samples.draws[p.name])) for p in pri.parameters}
     tree = dt.copy()
     tree["log_prior"] = xr.DataTree(xr.Dataset(lp, coords={"chain": dt["posterior"]["chain"], "draw": dt["posterior"]["draw"]}))
     ll_vars = list(dt["log_likelihood"].data_vars)

@@ -20,20 +20,43 @@ from friction_uq.simulate.config import ChannelSpec
 from friction_uq.simulate.model import run_model
 
 
+ODDS = dataclasses.replace(NU, transform="logodds")
+LOG = dataclasses.replace(F, transform="log")
+
+
 @given(st.floats(-30, 30))
 def test_interval_transform_round_trips(z):
-    for p in (F, NU, HOOP_GAIN, Parameter("x", "m", -1.0, math.inf, "a half-line")):
+    for p in (F, NU, HOOP_GAIN, Parameter("x", "m", -1.0, math.inf, "a half-line"), ODDS, LOG):
         v = p.from_unbounded(z)
         if p.contains(v):
             assert p.from_unbounded(p.to_unbounded(v)) == pytest.approx(v, rel=1e-9, abs=1e-12)
 
 
-@pytest.mark.parametrize("p", [NU, HOOP_GAIN, Parameter("x", "m", -1.0, math.inf, "a half-line")])
+@pytest.mark.parametrize("p", [NU, HOOP_GAIN, Parameter("x", "m", -1.0, math.inf, "a half-line"), ODDS, LOG])
 def test_log_jacobian_matches_a_finite_difference(p):
     z = np.linspace(-3, 3, 7)
     h = 1e-6
     fd = np.log((p.from_unbounded(z + h) - p.from_unbounded(z - h)) / (2 * h))
     np.testing.assert_allclose(p.log_jacobian(z), fd, rtol=1e-6, atol=1e-8)
+
+
+def test_declared_transforms():
+    assert ODDS.to_unbounded(0.25) == pytest.approx(math.log(1 / 3))
+    assert LOG.to_unbounded(0.05) == pytest.approx(math.log(0.05))
+    with pytest.raises(ValueError, match="log-odds transform needs a support inside"):
+        Parameter("x", "m", 0.0, 2.0, "", transform="logodds")
+    with pytest.raises(ValueError, match="unknown transform"):
+        Parameter("x", "m", 0.0, 2.0, "", transform="probit")
+
+
+def test_parameter_set_transforms_are_the_parameters_own():
+    ps = ParameterSet((LOG, ODDS, HOOP_GAIN))
+    theta = np.array([[0.05, 0.4, 1.0], [0.06, 0.35, 0.9]])
+    z = ps.to_unbounded(theta)
+    for i, p in enumerate(ps):
+        np.testing.assert_allclose(z[:, i], p.to_unbounded(theta[:, i]))
+    np.testing.assert_allclose(ps.from_unbounded(z), theta, rtol=1e-12)
+    np.testing.assert_allclose(ps.log_jacobian(z), sum(p.log_jacobian(z[:, i]) for i, p in enumerate(ps)))
 
 
 def test_parameters_are_addressed_by_name():

@@ -17,13 +17,10 @@ from friction_uq.sampler import (
     ConvergenceWarning,
     LogPosterior,
     Progress,
-    _log_jacobian,
     integrated_time,
     sample_posterior,
     start_ball,
     stderr_progress,
-    to_theta,
-    to_z,
 )
 from test_sbc import closed_form_data
 
@@ -53,13 +50,24 @@ def test_integrated_time_matches_emcee():
     np.testing.assert_allclose(integrated_time(x), ref, rtol=1e-10)
 
 
-def test_parametrisation_roundtrip_and_jacobian():
+def test_parametrisation_roundtrip_and_jacobian(paper_data):
+    params = LogPosterior(Likelihood(paper_data, hoop=True), WIDE.subset(("f", "nu", "hoop_gain"))).parameters
+    assert params.names == ("f", "nu", "hoop_gain")
     theta = np.array([[0.05, 0.4, 1.02], [0.5, 0.2, 0.9]])
-    np.testing.assert_allclose(to_theta(to_z(theta)), theta, rtol=1e-13)
-    for z in to_z(theta):
+    np.testing.assert_allclose(params.from_unbounded(params.to_unbounded(theta)), theta, rtol=1e-13)
+    for z in params.to_unbounded(theta):
         h = 1e-6
-        J = np.array([(to_theta(z + h * e) - to_theta(z - h * e)) / (2 * h) for e in np.eye(3)]).T
-        assert _log_jacobian(to_theta(z)) == pytest.approx(math.log(abs(np.linalg.det(J))), rel=1e-7)
+        J = np.array([(params.from_unbounded(z + h * e) - params.from_unbounded(z - h * e)) / (2 * h)
+                      for e in np.eye(3)]).T
+        assert params.log_jacobian(z) == pytest.approx(math.log(abs(np.linalg.det(J))), rel=1e-7)
+    # the closed form's coordinates: eq. 17's ridge log f + log(nu/(1-nu)) = log kappa is a straight line
+    z = params.to_unbounded(theta)
+    np.testing.assert_allclose(z[:, 0] + z[:, 1], np.log(theta[:, 0] * theta[:, 1] / (1 - theta[:, 1])), rtol=1e-12)
+
+
+def test_log_posterior_refuses_priors_over_other_parameters(paper_data):
+    with pytest.raises(ValueError, match="the likelihood's parameters are f, nu, hoop_gain"):
+        LogPosterior(Likelihood(paper_data, hoop=True), WIDE.subset(("f", "nu")))
 
 
 def test_start_ball_inside_support_when_map_sits_on_a_bound(paper_data):

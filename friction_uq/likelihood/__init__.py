@@ -10,8 +10,9 @@ eq. 13/17 and the tube-kernel hoop prediction); the observations a
 * the hoop term (:mod:`.hoop`): the tube gauge against the model, by its window level (default)
   or sample by sample;
 
-with the AR(1) algebra in :mod:`.ar1`. Parameter vectors are rows in the model's parameter order,
-(f, nu) or (f, nu, hoop_gain); SI units, forces in N, strains in strain.
+with the AR(1) algebra in :mod:`.ar1`. Parameter vectors are rows in the order of the model's
+:class:`~friction_uq.models.ParameterSet` (``Likelihood.parameters``) and are read by name through it;
+SI units, forces in N, strains in strain.
 """
 
 from __future__ import annotations
@@ -28,12 +29,8 @@ from .ar1 import ar1_loglike, ar1_offset_correction, ar1_pointwise, offset_sd
 from .force import ForceTerm
 from .hoop import HOOP_DISCREPANCY, HOOP_MODES, HoopTerm
 
-#: Parameter names without / with the hoop term.
-FORCE_PARAMETERS = ("f", "nu")
-HOOP_PARAMETERS = ("f", "nu", "hoop_gain")
-
 __all__ = [
-    "FORCE_PARAMETERS", "HOOP_DISCREPANCY", "HOOP_MODES", "HOOP_PARAMETERS", "ForceTerm", "HoopTerm", "Likelihood",
+    "HOOP_DISCREPANCY", "HOOP_MODES", "ForceTerm", "HoopTerm", "Likelihood",
     "ar1_loglike", "ar1_noise", "ar1_offset_correction", "ar1_pointwise", "gauge_kernel", "offset_sd",
 ]
 
@@ -77,8 +74,10 @@ class Likelihood:
     Attributes
     ----------
     model : ClosedFormModel
+    parameters : ParameterSet
+        The model's parameters: (f, nu) or (f, nu, hoop_gain); columns of parameter vectors.
     names : tuple of str
-        Column names of parameter vectors: ("f", "nu") or ("f", "nu", "hoop_gain").
+        Their names.
     """
 
     def __init__(
@@ -100,8 +99,15 @@ class Likelihood:
         self.force = ForceTerm(data)
         self.hoop = (HoopTerm(data, prediction=model.hoop, mode=hoop_mode, discrepancy=hoop_discrepancy)
                      if hoop else None)
-        self.names = HOOP_PARAMETERS if hoop else FORCE_PARAMETERS
+        self.parameters = model.parameters
         self.hoop_mode = hoop_mode
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return self.parameters.names
+
+    def _values(self, theta: np.ndarray) -> dict[str, np.ndarray]:
+        return self.parameters.as_dict(np.atleast_2d(np.asarray(theta, float)))
 
     @property
     def has_hoop(self) -> bool:
@@ -109,8 +115,7 @@ class Likelihood:
 
     def ratio(self, theta: np.ndarray) -> np.ndarray:
         """r = F_eo/F_io = expm1(f beta(nu)) per parameter vector (eq. 5 and 13), shape theta.shape[:-1]."""
-        theta = np.asarray(theta, float)
-        return self.model.ratio({"f": theta[..., 0], "nu": theta[..., 1]})
+        return self.model.ratio(self.parameters.as_dict(np.asarray(theta, float)))
 
     def __call__(self, theta: np.ndarray) -> np.ndarray:
         """Total log-likelihood.
@@ -124,11 +129,11 @@ class Likelihood:
         -------
         array, shape (nwalkers,); -inf where the model overflows (f beta beyond ~700).
         """
-        theta = np.atleast_2d(np.asarray(theta, float))
+        v = self._values(theta)
         with np.errstate(over="ignore", invalid="ignore"):  # far-out proposals (f beta > 700) overflow
-            out = self.force.loglike(self.ratio(theta))
+            out = self.force.loglike(self.model.ratio(v))
             if self.hoop is not None:
-                out = out + self.hoop.loglike(theta[:, 0], theta[:, 1], theta[:, 2])
+                out = out + self.hoop.loglike(v["f"], v["nu"], v["hoop_gain"])
         return np.where(np.isfinite(out), out, -np.inf)
 
     def pointwise(self, theta: np.ndarray, *, segment: int | None = None) -> dict[str, np.ndarray]:
@@ -139,10 +144,10 @@ class Likelihood:
         observation); per draw they sum to :meth:`__call__`.
         The AR(1) conditionals make the per-time split exact.
         """
-        theta = np.atleast_2d(np.asarray(theta, float))
-        out = {"F_eo": self.force.pointwise(self.ratio(theta))}
+        v = self._values(theta)
+        out = {"F_eo": self.force.pointwise(self.model.ratio(v))}
         if self.hoop is not None:
-            out["hoop"] = self.hoop.pointwise(theta[:, 0], theta[:, 1], theta[:, 2])
+            out["hoop"] = self.hoop.pointwise(v["f"], v["nu"], v["hoop_gain"])
         if segment is not None:
             idx = np.arange(0, self.data.n, segment)
             out = {k: np.add.reduceat(v, idx, axis=-1) if v.shape[-1] == self.data.n else v for k, v in out.items()}
@@ -160,8 +165,8 @@ class Likelihood:
         dict
             "F_io", "F_eo" (N) and, with the hoop term, "hoop" (strain), each shape (ndraw, n).
         """
-        theta = np.atleast_2d(np.asarray(theta, float))
-        r = self.ratio(theta)
+        v = self._values(theta)
+        r = self.model.ratio(v)
         x = self.force.latent_internal_force(r)
         d = self.data
         shape = x.shape
@@ -173,7 +178,7 @@ class Likelihood:
             + rng.normal(0.0, math.sqrt(fo.var_offset_eo), (len(x), 1)),
         }
         if self.hoop is not None and hoop:
-            pred = self.hoop.predict(theta[:, 0], theta[:, 1], theta[:, 2])
+            pred = self.hoop.predict(v["f"], v["nu"], v["hoop_gain"])
             out["hoop"] = pred + ar1_noise(shape, sd=self.hoop.sd, rho=self.hoop.rho, rng=rng) \
                 + rng.normal(0.0, self.hoop.offset, (len(x), 1))
         return out

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 
 import numpy as np
 from scipy.ndimage import uniform_filter1d
@@ -187,11 +188,14 @@ class ClosedFormModel:
     """
 
     name = "closed form"
+    #: The closed form's coordinates: eq. 17 fixes log f + log(nu / (1 - nu)) = log kappa, a straight
+    #: ridge in (log f, log-odds nu); the gauge factor on a log scale.
+    PARAMETERS = (replace(F, transform="log"), replace(NU, transform="logodds"), replace(HOOP_GAIN, transform="log"))
 
     def __init__(self, data: StationaryData, *, hoop: bool = True, **hoop_options: object) -> None:
         self.radius, self.length = data.radius, data.length
         self.hoop = HoopPrediction(data, **hoop_options) if hoop else None  # type: ignore[arg-type]
-        self.parameters = ParameterSet((F, NU, HOOP_GAIN) if hoop else (F, NU))
+        self.parameters = ParameterSet(self.PARAMETERS if hoop else self.PARAMETERS[:2])
 
     def ratio(self, values: Mapping[str, np.ndarray | float]) -> np.ndarray:
         """F_eo / F_io in the stationary phase for named values (eq. 5, 13)."""

@@ -28,6 +28,12 @@ class Parameter:
         Physical support (open interval); the sampler's transform maps it to the real line.
     meaning : str
         One line for the report.
+    transform : {"auto", "log", "logodds"}
+        The map to the real line used by samplers and mode searches: "auto" from the support (log
+        for a half-line, logit for an interval); "log": log(value - low) whatever the upper bound;
+        "logodds": log(value / (1 - value)) (support inside [0, 1]). A model picks the coordinates in
+        which its posterior is simplest (the closed form: log f + log(nu/(1-nu)) = log kappa, eq. 17,
+        a straight ridge); values mapped back beyond the support are the prior's to reject.
     """
 
     name: str
@@ -35,10 +41,17 @@ class Parameter:
     low: float
     high: float
     meaning: str
+    transform: str = "auto"
 
     def __post_init__(self) -> None:
         if not self.low < self.high:
             raise ValueError(f"parameter {self.name}: empty support [{self.low}, {self.high}]")
+        if self.transform not in ("auto", "log", "logodds"):
+            raise ValueError(f"parameter {self.name}: unknown transform {self.transform!r}")
+        if self.transform == "log" and math.isinf(self.low):
+            raise ValueError(f"parameter {self.name}: a log transform needs a finite lower bound")
+        if self.transform == "logodds" and not (0.0 <= self.low and self.high <= 1.0):
+            raise ValueError(f"parameter {self.name}: a log-odds transform needs a support inside [0, 1]")
 
     def contains(self, value: np.ndarray | float) -> np.ndarray:
         """True where ``value`` lies strictly inside the support."""
@@ -48,9 +61,11 @@ class Parameter:
     def to_unbounded(self, value: np.ndarray | float) -> np.ndarray:
         """Map the support to the real line (log for a half-line, logit for an interval)."""
         v = np.asarray(value, float)
+        if self.transform == "logodds":
+            return np.log(v) - np.log1p(-v)
         if math.isinf(self.high) and math.isinf(self.low):
             return v
-        if math.isinf(self.high):
+        if math.isinf(self.high) or self.transform == "log":
             return np.log(v - self.low)
         if math.isinf(self.low):
             return -np.log(self.high - v)
@@ -60,9 +75,11 @@ class Parameter:
     def from_unbounded(self, z: np.ndarray | float) -> np.ndarray:
         """Inverse of :meth:`to_unbounded`."""
         z = np.asarray(z, float)
+        if self.transform == "logodds":
+            return 1.0 / (1.0 + np.exp(-z))
         if math.isinf(self.high) and math.isinf(self.low):
             return z
-        if math.isinf(self.high):
+        if math.isinf(self.high) or self.transform == "log":
             return self.low + np.exp(z)
         if math.isinf(self.low):
             return self.high - np.exp(-z)
@@ -71,8 +88,12 @@ class Parameter:
     def log_jacobian(self, z: np.ndarray | float) -> np.ndarray:
         """log |d value / d z| of :meth:`from_unbounded`."""
         z = np.asarray(z, float)
+        if self.transform == "logodds":
+            return -np.logaddexp(0.0, -z) - np.logaddexp(0.0, z)
         if math.isinf(self.high) and math.isinf(self.low):
             return np.zeros_like(z)
+        if self.transform == "log":
+            return z
         if math.isinf(self.high) or math.isinf(self.low):
             return z if math.isinf(self.high) else -z
         return math.log(self.high - self.low) - np.logaddexp(0.0, -z) - np.logaddexp(0.0, z)
@@ -84,7 +105,8 @@ class Parameter:
         return mid, max(0.5 * (hi - lo), 1e-3)
 
     def to_json(self) -> dict[str, object]:
-        return {"name": self.name, "unit": self.unit, "low": self.low, "high": self.high, "meaning": self.meaning}
+        return {"name": self.name, "unit": self.unit, "low": self.low, "high": self.high, "meaning": self.meaning,
+                "transform": self.transform}
 
 
 def summarize_draws(v: np.ndarray) -> dict[str, float]:
@@ -126,10 +148,30 @@ class ParameterSet:
 
     def as_dict(self, theta: np.ndarray) -> dict[str, np.ndarray]:
         """Columns of ``theta`` (shape (..., len(self))) by name."""
+        return dict(zip(self.names, self._columns(np.asarray(theta, float))))
+
+    def to_unbounded(self, theta: np.ndarray) -> np.ndarray:
+        """Parameter vectors (last axis in this set's order) -> unbounded coordinates, each parameter by its
+        own transform (:meth:`Parameter.to_unbounded`)."""
         theta = np.asarray(theta, float)
-        if theta.shape[-1] != len(self):
-            raise ValueError(f"parameter vectors have {theta.shape[-1]} entries, the model has {len(self)}: {self.names}")
-        return {p.name: theta[..., i] for i, p in enumerate(self._params)}
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.stack([p.to_unbounded(v) for p, v in zip(self._params, self._columns(theta))], axis=-1)
+
+    def from_unbounded(self, z: np.ndarray) -> np.ndarray:
+        """Inverse of :meth:`to_unbounded`."""
+        z = np.asarray(z, float)
+        with np.errstate(over="ignore"):
+            return np.stack([p.from_unbounded(v) for p, v in zip(self._params, self._columns(z))], axis=-1)
+
+    def log_jacobian(self, z: np.ndarray) -> np.ndarray:
+        """log |d theta / d z| of :meth:`from_unbounded` (a sum over the parameters: the map is diagonal)."""
+        z = np.asarray(z, float)
+        return sum(p.log_jacobian(v) for p, v in zip(self._params, self._columns(z)))
+
+    def _columns(self, a: np.ndarray) -> list[np.ndarray]:
+        if a.shape[-1] != len(self):
+            raise ValueError(f"parameter vectors have {a.shape[-1]} entries, the model has {len(self)}: {self.names}")
+        return [a[..., i] for i in range(len(self))]
 
     def vector(self, values: Mapping[str, np.ndarray | float]) -> np.ndarray:
         """Stack named values into vectors (last axis in this set's order)."""

@@ -153,8 +153,8 @@ def page_hoop(samples: PosteriorSamples, data, forces, *, number: int = 8, n_dra
     lk = likelihood if likelihood is not None and likelihood.has_hoop else Likelihood(data, hoop=True)
     rng = np.random.default_rng(seed)
     flat = samples.array().reshape(-1, len(samples.names))
-    pick = flat[rng.choice(len(flat), size=min(n_draws, len(flat)), replace=False)]
-    pred = lk.hoop.predict(pick[:, 0], pick[:, 1], pick[:, 2])
+    pick = lk.parameters.as_dict(flat[rng.choice(len(flat), size=min(n_draws, len(flat)), replace=False)])
+    pred = lk.hoop.predict(pick["f"], pick["nu"], pick["hoop_gain"])
     q = np.quantile(pred, [0.05, 0.5, 0.95], axis=0)
     t = np.asarray(data.time) * US
     ax = axes[0]

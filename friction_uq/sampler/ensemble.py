@@ -16,7 +16,7 @@ from ..likelihood import Likelihood
 from ..priors import Priors
 from ..window import StationaryData
 from . import checkpoint
-from .model import LogPosterior, start_ball, to_theta
+from .model import LogPosterior, start_ball
 from .moves import BlockDEMove
 from .results import ConvergenceWarning, PosteriorSamples, Progress, SamplerSettings
 
@@ -229,7 +229,7 @@ def sample_posterior(
                math.ceil((n - burn) * n_all / settings.max_draws))
     kept = chain[burn::thin]  # (nkeep, all walkers, ndim)
     z = np.stack([np.transpose(kept[:, b], (1, 0, 2)).reshape(-1, ndim) for b in blocks])  # walker-major chains
-    theta = to_theta(z)
+    theta = log_post.to_theta(z)
     flat = theta.reshape(-1, ndim)
     ll = np.concatenate([likelihood(flat[i:i + 8192]) for i in range(0, len(flat), 8192)]).reshape(z.shape[:2])
     lprior = prior.logpdf(flat).reshape(z.shape[:2])
@@ -237,7 +237,7 @@ def sample_posterior(
     acceptance = np.array([accepted[b].mean() / n for b in blocks])
     return PosteriorSamples(
         names=names,
-        draws={nm: theta[..., i] for i, nm in enumerate(names)},
+        draws=likelihood.parameters.as_dict(theta),
         log_likelihood=ll,
         log_prior=lprior,
         acceptance=acceptance,
@@ -250,7 +250,7 @@ def sample_posterior(
         seed=int(seed),
         hoop=likelihood.has_hoop,
         nwalkers=nwalkers,
-        map_estimate=dict(zip(names, map(float, to_theta(z_map)))),
+        map_estimate={n: float(v) for n, v in likelihood.parameters.as_dict(log_post.to_theta(z_map)).items()},
         prior_path=priors.path,
         prior_description=prior.describe(),
         settings=settings,

@@ -1,4 +1,9 @@
-"""The density emcee samples: parametrisation z = (log f, logit nu, log g), log posterior, start ball."""
+"""The density emcee samples, log posterior and start ball.
+
+emcee walks in the unbounded coordinates z of the likelihood's named parameters (each by its own
+transform: :meth:`friction_uq.models.ParameterSet.from_unbounded`, logit on a bounded support); the
+density in z carries the transform's log Jacobian.
+"""
 
 from __future__ import annotations
 
@@ -14,50 +19,33 @@ from ..physics import cell
 from ..priors import Priors
 
 
-# ----------------------------------------------------------------------------------------------
-# Parametrisation
-# ----------------------------------------------------------------------------------------------
-
-
-def to_theta(z: np.ndarray) -> np.ndarray:
-    """(log f, log(nu/(1-nu)), log g) -> (f, nu, g), row-wise (any number of columns >= 2)."""
-    z = np.asarray(z, float)
-    theta = np.exp(z)
-    theta[..., 1] = 1.0 / (1.0 + np.exp(-z[..., 1]))
-    return theta
-
-
-def to_z(theta: np.ndarray) -> np.ndarray:
-    """Inverse of :func:`to_theta`."""
-    theta = np.asarray(theta, float)
-    with np.errstate(divide="ignore"):
-        z = np.log(theta)
-        z[..., 1] = np.log(theta[..., 1] / (1.0 - theta[..., 1]))
-    return z
-
-
-def _log_jacobian(theta: np.ndarray) -> np.ndarray:
-    """log |d theta / d z| = log f + log(nu (1 - nu)) [+ log g]."""
-    out = np.log(theta[..., 0]) + np.log(theta[..., 1] * (1.0 - theta[..., 1]))
-    if theta.shape[-1] > 2:
-        out = out + np.sum(np.log(theta[..., 2:]), axis=-1)
-    return out
-
-
 class LogPosterior:
     """Vectorised log posterior density in z (emcee's ``log_prob_fn`` with ``vectorize=True``)."""
 
     def __init__(self, likelihood: Likelihood, priors: Priors) -> None:
+        if tuple(priors.names) != likelihood.names:
+            raise ValueError(f"priors over {', '.join(priors.names)}, the likelihood's parameters are "
+                             f"{', '.join(likelihood.names)}")
         self.likelihood = likelihood
         self.priors = priors
+        self.parameters = likelihood.parameters
+
+    def to_theta(self, z: np.ndarray) -> np.ndarray:
+        """Unbounded coordinates -> parameter vectors."""
+        return self.parameters.from_unbounded(z)
+
+    def to_z(self, theta: np.ndarray) -> np.ndarray:
+        """Parameter vectors -> unbounded coordinates."""
+        return self.parameters.to_unbounded(theta)
 
     def __call__(self, z: np.ndarray) -> np.ndarray:
         """z: shape (nwalkers, ndim) -> shape (nwalkers,); -inf outside the prior support."""
         z = np.atleast_2d(np.asarray(z, float))
         with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-            theta = to_theta(z)
-            lp = self.priors.logpdf(theta) + _log_jacobian(theta)
-        ok = np.isfinite(lp)
+            theta = self.to_theta(z)
+            lp = self.priors.logpdf(theta) + self.parameters.log_jacobian(z)
+        inside = np.all([p.contains(theta[..., i]) for i, p in enumerate(self.parameters)], axis=0)
+        ok = np.isfinite(lp) & inside
         out = np.full(len(z), -np.inf)
         if ok.any():
             ll = self.likelihood(theta[ok])
@@ -71,15 +59,16 @@ class LogPosterior:
 
 
 def _initial_guess(likelihood: Likelihood, priors: Priors) -> np.ndarray:
-    """Parameter vector from the least-squares force ratio and the prior medians (f, nu, g)."""
+    """Parameter vector from the least-squares force ratio and the prior medians (the other parameters)."""
     d = likelihood.data
     nu = float(priors["nu"].ppf(0.5))
     r0 = likelihood.force.r0
     sd_r = math.hypot(d.sd_eo, r0 * d.sd_io) / (abs(float(np.mean(d.F_io))) * math.sqrt(d.n))
     r = max(r0, 3.0 * sd_r, 1e-6)
     f = float(math.log1p(r) / cell.beta(nu, radius=d.radius, length=d.length))
-    theta = [f, nu] + ([float(priors["hoop_gain"].ppf(0.5))] if len(priors.names) > 2 else [])
-    return np.array(theta)
+    values = {n: float(priors[n].ppf(0.5)) for n in likelihood.names}
+    values.update(f=f, nu=nu)
+    return likelihood.parameters.vector(values)
 
 
 def _hessian(fun: Callable[[np.ndarray], np.ndarray], z: np.ndarray, h: float = 1e-4) -> np.ndarray:
@@ -111,10 +100,10 @@ def start_ball(
     The ball's sd is a tenth of the Laplace approximation's (inverse Hessian at the optimum);
     walkers falling outside the prior support are redrawn.
     """
-    z0 = to_z(_initial_guess(log_post.likelihood, priors))
+    z0 = log_post.to_z(_initial_guess(log_post.likelihood, priors))
     if not np.isfinite(log_post(z0)[0]):
         raise SamplingError(
-            f"the starting point {dict(zip(priors.names, to_theta(z0)))} has zero prior or likelihood; "
+            f"the starting point {dict(zip(priors.names, log_post.to_theta(z0)))} has zero prior or likelihood; "
             "check the priors against the data"
         )
     res = optimize.minimize(lambda z: -float(log_post(z)[0]), z0, method="Nelder-Mead",
