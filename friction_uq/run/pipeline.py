@@ -13,24 +13,20 @@ The checkpoint is removed once the outputs are written.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
-import math
 import os
-import re
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
-from . import __version__
-from ._atomic import output_lock, remove_orphans, write_together
-from .analysis import Identification, Prepared, identify, prepare
-from .discrepancy.check import WholeRecordCheck
-from .diagnostics import (
+from .. import __version__
+from .._atomic import output_lock, remove_orphans, write_together
+from ..analysis import Identification, Prepared, identify, prepare
+from ..discrepancy.check import WholeRecordCheck
+from ..diagnostics import (
     Convergence,
     VariableSummary,
     build_datatree,
@@ -42,13 +38,15 @@ from .diagnostics import (
     ratio_ppc,
     summarize,
 )
-from .errors import OutputError, check_seed, os_error_text
-from .likelihood import Likelihood
-from .prior_sensitivity import FUnderPrior, PriorDataConflict
-from .priors import PRIORS_DIR, Priors, default_prior_path, load_priors
-from .record import read_record
-from .sampler import PosteriorSamples, sample_posterior, stderr_progress
-from .settings import AnalysisSettings
+from ..errors import OutputError, check_seed, os_error_text
+from ..likelihood import Likelihood
+from ..prior_sensitivity import FUnderPrior, PriorDataConflict
+from ..priors import default_prior_path, load_priors
+from ..record import read_record
+from ..sampler import PosteriorSamples, sample_posterior, stderr_progress
+from ..settings import AnalysisSettings
+from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
+from .outputs import netcdf_bytes, safe_stem, sha256_hex, summary_table
 
 JSON_VARIABLES = ("f", "nu", "kappa", "p_mean", "tau_mean", "V", "ratio")
 
@@ -68,79 +66,6 @@ class RunResult:
     sensitivity: dict[str, FUnderPrior] = dataclasses.field(default_factory=dict)
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
-
-
-def safe_stem(campaign: str, test_id: str) -> str:
-    """``<campaign>_<test_id>`` with anything but letters, digits, '.', '-' and '_' replaced by '_'."""
-    return re.sub(r"[^A-Za-z0-9._-]", "_", f"{campaign}_{test_id}").lstrip(".")
-
-
-def sliding_velocity_summary(p: Prepared) -> VariableSummary:
-    """V over the window: mean and its standard error, normal quantiles.
-
-    V = V_io - V_eo (eq. 7) is measured, not a model parameter; its uncertainty is the noise of
-    the two output gauges averaged over the window (effective AR(1) sample size) plus the error
-    of the offsets removed from them (pre-pulse estimates).
-    """
-    app = p.record.apparatus
-    ch = p.forces.channels
-    io, eo = app.internal_output_bar, app.external_output_bar
-    n_io, n_eo = ch["internal_output_bar"].noise, ch["external_output_bar"].noise
-    v = np.asarray(p.data.V, float)
-    sd = math.hypot(n_io.window_mean_sd(len(v), scale=io.wave_speed), n_eo.window_mean_sd(len(v), scale=eo.wave_speed))
-    m = float(np.mean(v))
-    q = stats.norm.ppf([0.05, 0.5, 0.95], loc=m, scale=sd)
-    return VariableSummary(m, sd, float(q[0]), float(q[1]), float(q[2]), float("nan"), float("nan"))
-
-
-def alternative_nu_priors(default_path: Path, priors: Priors) -> dict[str, Priors]:
-    """The priors used and the nu alternatives ``<material>-nu-*.toml``.
-
-    Alternatives are looked up beside the prior file used, then among the files shipped in the
-    package (:data:`~friction_uq.priors.PRIORS_DIR`; a label found beside the file wins). Each
-    keeps the used f (and hoop gain) prior and swaps nu only, so the posteriors of f differ by the
-    nu prior alone. A material without alternatives gets none (the report then shows f under the
-    one prior used).
-    """
-    out: dict[str, Priors] = {"default": priors}
-    material = priors.material or Path(default_path).stem
-    used = Path(default_path).resolve()
-    for folder in dict.fromkeys([Path(default_path).resolve().parent, PRIORS_DIR]):
-        for alt in sorted(folder.glob(f"{material}-nu-*.toml")):
-            label = alt.stem.removeprefix(f"{material}-")
-            if alt.resolve() == used or label in out:
-                continue
-            other = load_priors(alt)
-            out[label] = dataclasses.replace(priors.replace(other["nu"]), path=str(alt), description=other.description)
-    return out
-
-
-def _sha256(data: bytes) -> str:
-    return hashlib.sha256(data).hexdigest()
-
-
-def hoop_unusable(p: Prepared) -> str | None:
-    """Why the hoop gauge cannot enter the likelihood for this record, or None if it can.
-
-    * the channel shows no pulse above its noise (a dead or disconnected gauge);
-    * its window mean is not a swelling beyond 3 standard errors (noise of the mean and offset);
-    * the tube differs from the one the influence function was fitted to (bore 10 mm, outer
-      24 mm, nu_t 0.29; physics.md section 6): the kernel would be wrong.
-    """
-    t = p.record.apparatus.tube
-    if not (abs(t.inner_diameter - 0.010) < 1e-6 and abs(t.outer_diameter - 0.024) < 1e-6
-            and abs(t.poisson_ratio - 0.29) < 1e-3):
-        return (f"the tube influence function is fitted to a 10/24 mm tube with nu_t = 0.29, this record's tube is "
-                f"{t.inner_diameter * 1e3:g}/{t.outer_diameter * 1e3:g} mm with nu_t = {t.poisson_ratio:g}")
-    info = p.forces.channels["tube_hoop"]
-    if not info.detected:
-        return "tube_hoop shows no pulse above its noise (a dead or disconnected gauge?)"
-    se = info.noise.window_mean_sd(p.data.n)
-    mean = float(np.mean(p.data.hoop))
-    if not mean < -3.0 * se:  # compression positive: a swelling tube reads negative
-        return (f"tube_hoop shows no swelling over the window (mean {mean * 1e6:+.2f} microstrain, standard "
-                f"error {se * 1e6:.2f})")
-    return None
 
 
 def run_file(
@@ -252,14 +177,14 @@ def run_file(
         t = time.perf_counter()
         wrc = diag = None
         if whole_record or diagnose:
-            from .discrepancy import pipeline
+            from ..discrepancy import pipeline
 
             start = {"f": summary["f"].q50, "nu": summary["nu"].q50}
             say("the whole test simulated with the posterior, against every gauge")
             wrc = pipeline.whole_record_check(prep, priors, start, hoop=use_hoop, seed=seed)
             pipeline.add_whole_record(dt, wrc)
             if diagnose:
-                from .discrepancy import outcome
+                from ..discrepancy import outcome
 
                 say("diagnose: fitting each mechanism of the catalogue to the whole record")
                 diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say)
@@ -268,7 +193,7 @@ def run_file(
         t = time.perf_counter()
 
         dt.attrs.update({
-            "friction_uq_version": __version__, "record": str(record.path), "record_sha256": record.sha256,
+            "friction_uq_version": __version__, "record": str(record.path), "recordsha256_hex": record.sha256,
             "test_id": record.test_id, "campaign": record.campaign, "window_s": [prep.window.t0, prep.window.t1],
             "dispersion_correction": int(dispersion), "hoop_term": int(use_hoop),
             "seed": seed if seed < 2**63 else str(seed),  # netCDF attributes hold int64
@@ -279,7 +204,7 @@ def run_file(
         t = time.perf_counter()
         pdf_bytes = None
         if pdf:
-            from .report.pdf import ReportInputs, render_report
+            from ..report.pdf import ReportInputs, render_report
 
             inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
                                   conflict, whole_record=wrc, diagnosis=diag, likelihood=likelihood)
@@ -304,7 +229,7 @@ def run_file(
             "converged": conv.ok,
             "test_id": record.test_id,
             "campaign": record.campaign,
-            "record_sha256": record.sha256,
+            "recordsha256_hex": record.sha256,
             "prior_file": str(p_path),
             "hoop_term": use_hoop,
             "hoop_left_out": left_out,
@@ -317,8 +242,8 @@ def run_file(
             "lab_point_estimate_nominal_nu": {"nu": lab.nu, "f": lab.f, "ratio": lab.ratio},
             "ess_per_second": conv.ess_per_second,
             "notes": said,
-            "outputs": {"netcdf": {"file": names["netcdf"].name, "sha256": _sha256(nc_bytes)},
-                        "pdf": None if pdf_bytes is None else {"file": names["pdf"].name, "sha256": _sha256(pdf_bytes)}},
+            "outputs": {"netcdf": {"file": names["netcdf"].name, "sha256": sha256_hex(nc_bytes)},
+                        "pdf": None if pdf_bytes is None else {"file": names["pdf"].name, "sha256": sha256_hex(pdf_bytes)}},
             "friction_uq_version": __version__,
         }
         if wrc is not None:
@@ -344,42 +269,3 @@ def run_file(
     return RunResult(prep, samples, summary, conv, lab, outputs, seconds, conflict, tuple(said), stages, sens,
                      wrc, diag)
 
-
-def netcdf_bytes(dt) -> bytes:
-    """The DataTree as netCDF bytes. Written through a private temporary file, not to memory: inside a
-    Dask worker xarray guards a write with a distributed lock named after its target, and an
-    in-memory buffer has no name the scheduler knows."""
-    import tempfile
-
-    try:
-        with tempfile.TemporaryDirectory(prefix="friction-uq-") as d:
-            path = Path(d) / "run.nc"
-            dt.to_netcdf(path, engine="h5netcdf")
-            return path.read_bytes()
-    except OSError as exc:
-        raise OutputError(f"{tempfile.gettempdir()}: cannot build the netCDF output there ({os_error_text(exc)})") from None
-
-
-def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,
-                  outputs: dict[str, Path], seconds: float, conflict: PriorDataConflict | None = None,
-                  findings: list[str] | None = None) -> str:
-    """The table the terminal ends with."""
-    units = {"p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
-    lines = [f"{campaign} {test_id}: posterior (90 % credible intervals)",
-             f"{'quantity':<10} {'unit':<5} {'q50':>10} {'q05':>10} {'q95':>10} {'mean':>10} {'sd':>10}"]
-    for name in ("f", "nu", "kappa", "hoop_gain", "ratio", "p_mean", "tau_mean", "V"):
-        if name not in allv:
-            continue
-        v = allv[name]
-        u, s = units.get(name, ("-", 1.0))
-        lines.append(f"{name:<10} {u:<5} {v.q50 * s:>10.4g} {v.q05 * s:>10.4g} {v.q95 * s:>10.4g} "
-                     f"{v.mean * s:>10.4g} {v.sd * s:>10.4g}")
-    lines.append(f"convergence {'OK' if conv.ok else 'NOT REACHED'}: R-hat max {conv.r_hat_max:.4f}, "
-                 f"ESS min {min(conv.ess_bulk_min, conv.ess_tail_min):.0f}, {conv.ess_per_second:.0f} ESS/s; "
-                 f"{seconds:.1f} s in all")
-    if conflict is not None:
-        lines.append(conflict.sentence())
-    lines += findings or []
-    for k, pth in outputs.items():
-        lines.append(f"wrote {pth}")
-    return "\n".join(lines)

@@ -1,0 +1,10 @@
+"""``friction-uq run``: from one record to the posterior, its propagation and the report
+(:mod:`.pipeline`), with what it decides from its inputs (:mod:`.inputs`) and how it names and
+writes its outputs (:mod:`.outputs`)."""
+
+from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
+from .outputs import netcdf_bytes, safe_stem, summary_table
+from .pipeline import JSON_VARIABLES, RunResult, run_file
+
+__all__ = ["JSON_VARIABLES", "RunResult", "alternative_nu_priors", "hoop_unusable", "netcdf_bytes", "run_file",
+           "safe_stem", "sliding_velocity_summary", "summary_table"]

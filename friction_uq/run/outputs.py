@@ -1,0 +1,63 @@
+"""How a run's results are named and written: the file stem, the netCDF bytes, the terminal table."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from pathlib import Path
+
+from ..diagnostics import Convergence, VariableSummary
+from ..errors import OutputError, os_error_text
+from ..prior_sensitivity import PriorDataConflict
+
+
+def safe_stem(campaign: str, test_id: str) -> str:
+    """``<campaign>_<test_id>`` with anything but letters, digits, '.', '-' and '_' replaced by '_'."""
+    return re.sub(r"[^A-Za-z0-9._-]", "_", f"{campaign}_{test_id}").lstrip(".")
+
+
+
+def sha256_hex(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+
+def netcdf_bytes(dt) -> bytes:
+    """The DataTree as netCDF bytes. Written through a private temporary file, not to memory: inside a
+    Dask worker xarray guards a write with a distributed lock named after its target, and an
+    in-memory buffer has no name the scheduler knows."""
+    import tempfile
+
+    try:
+        with tempfile.TemporaryDirectory(prefix="friction-uq-") as d:
+            path = Path(d) / "run.nc"
+            dt.to_netcdf(path, engine="h5netcdf")
+            return path.read_bytes()
+    except OSError as exc:
+        raise OutputError(f"{tempfile.gettempdir()}: cannot build the netCDF output there ({os_error_text(exc)})") from None
+
+
+
+def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,
+                  outputs: dict[str, Path], seconds: float, conflict: PriorDataConflict | None = None,
+                  findings: list[str] | None = None) -> str:
+    """The table the terminal ends with."""
+    units = {"p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
+    lines = [f"{campaign} {test_id}: posterior (90 % credible intervals)",
+             f"{'quantity':<10} {'unit':<5} {'q50':>10} {'q05':>10} {'q95':>10} {'mean':>10} {'sd':>10}"]
+    for name in ("f", "nu", "kappa", "hoop_gain", "ratio", "p_mean", "tau_mean", "V"):
+        if name not in allv:
+            continue
+        v = allv[name]
+        u, s = units.get(name, ("-", 1.0))
+        lines.append(f"{name:<10} {u:<5} {v.q50 * s:>10.4g} {v.q05 * s:>10.4g} {v.q95 * s:>10.4g} "
+                     f"{v.mean * s:>10.4g} {v.sd * s:>10.4g}")
+    lines.append(f"convergence {'OK' if conv.ok else 'NOT REACHED'}: R-hat max {conv.r_hat_max:.4f}, "
+                 f"ESS min {min(conv.ess_bulk_min, conv.ess_tail_min):.0f}, {conv.ess_per_second:.0f} ESS/s; "
+                 f"{seconds:.1f} s in all")
+    if conflict is not None:
+        lines.append(conflict.sentence())
+    lines += findings or []
+    for k, pth in outputs.items():
+        lines.append(f"wrote {pth}")
+    return "\n".join(lines)
