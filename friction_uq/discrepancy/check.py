@@ -16,7 +16,7 @@ import numpy as np
 
 from ..analysis import Prepared
 from ..models import SimulatorModel, measured_loading
-from .diagnose import NU_STARTS
+from .extended import NU_STARTS
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .misfit import MisfitDecision, decide
 from .whole_record import WholeRecord, compare_whole_record

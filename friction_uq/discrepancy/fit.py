@@ -12,7 +12,11 @@ tolerated model error (:func:`~.whole_record.tolerance_sd`: 1-2 % of the signal 
 scaled by sd / s_t is AR(1) with the gauge's coefficient. Without it the 0.1 %-level differences
 between any two simulators of the test (time step, mesh, a rounded constant) would read as physics
 on the high-signal channels. The hoop gauge's calibration factor enters linearly and is profiled
-out (its generalised least-squares value for each parameter vector).
+out (its generalised least-squares value for each parameter vector). Each channel's offset error
+(the pre-pulse mean is uncertain) and each output bar gauge's gain error (its calibration, 1 %:
+an error correlated over the whole record, which the per-sample tolerance alone would treat as
+averaging out) enter linearly with Gaussian priors and are marginalised: least squares on the
+whitened residuals with one pseudo-residual per nuisance gives the marginal quadratic form exactly.
 
 The posterior is approximated by a normal distribution in the unbounded coordinates of the
 parameters (:meth:`~friction_uq.models.Parameter.to_unbounded`) around its mode, found by
@@ -39,6 +43,14 @@ from ..models.simulator import SimulatorModel
 from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, tolerance_sd, whiten
 
 LogPrior = Callable[[Mapping[str, float]], float]
+#: Calibration errors of the output bar gauges marginalised in the whole-record likelihood (relative sd):
+#: a bar gauge's calibration and the bar's E and c are known to about 1 % (the level part of
+#: :data:`~.whole_record.TOLERANCE`, correlated over the record as a calibration error is).
+GAIN_SD = {"internal_output_bar": 0.01, "external_output_bar": 0.01}
+#: Step (unbounded coordinate) of the central differences giving the Laplace precision.
+JACOBIAN_STEP = 1e-3
+#: Blocks apart whose scores are taken as correlated in :func:`robust_covariance` (Bartlett weights).
+ROBUST_LAGS = 4
 
 
 @dataclass(frozen=True)
@@ -55,6 +67,7 @@ class WholeRecordFit:
     cov_z: np.ndarray | None = None
     jacobian: np.ndarray | None = None  # d(whitened data residual)/dz at the mode, (n_data, n_par)
     whitened: np.ndarray | None = None  # whitened data residual at the mode
+    laplace_draws: dict[str, np.ndarray] | None = None  # the normal approximation's, when ``draws`` are robust
 
     def summary(self, name: str) -> dict[str, float]:
         return summarize_draws(self.draws[name])
@@ -76,34 +89,56 @@ class WholeRecordLikelihood:
             tol = tolerance_sd(self.measured[c], c, sample_rate=rec.sample_rate)[sl]
             self.weight[c] = nz.sd / np.hypot(nz.sd, tol)
         self._log_weight = sum(float(np.sum(np.log(w))) for w in self.weight.values())
-        # offset errors: the whitened direction of a constant offset, and the Gaussian constants
-        self._wv = {c: whiten(self.weight[c], sd=self.noise[c].sd, rho=self.noise[c].rho_long_run)
-                    for c in self.channels}
+        # the Gaussian constants (the nuisances' log determinant depends on the prediction: per call)
         self._const = 0.0
         for c in self.channels:
             nz, n = self.noise[c], len(self.weight[c])
-            self._const += (-0.5 * n * math.log(2.0 * math.pi * nz.sd**2) - 0.5 * (n - 1) * math.log(1.0 - nz.rho_long_run**2)
-                            - 0.5 * math.log1p(nz.offset_sd**2 * float(self._wv[c] @ self._wv[c])))
+            self._const += -0.5 * n * math.log(2.0 * math.pi * nz.sd**2) - 0.5 * (n - 1) * math.log(1.0 - nz.rho_long_run**2)
 
     def _raw_scaled(self, c: str, pred: np.ndarray) -> np.ndarray:
         sl = self._span(c)
         return (self.measured[c][sl] - pred[sl]) * self.weight[c]
 
-    def _offset(self, c: str, w: np.ndarray) -> float:
-        """Most probable offset error of the channel (prior N(0, offset sd^2)) given whitened residuals w."""
-        nz = self.noise[c]
-        if nz.offset_sd <= 0.0:
-            return 0.0
-        wv = self._wv[c]
-        return float(wv @ w) / (float(wv @ wv) + 1.0 / nz.offset_sd**2)
+    def _nuisance_basis(self, c: str, pred: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The channel's calibration nuisances: raw (scaled) directions, their whitened columns and prior sds.
+
+        A constant offset error (the pre-pulse mean is uncertain: sd ``offset_sd``) and, on the output bar
+        gauges, a gain error (their calibration: sd :data:`GAIN_SD`), whose direction is the prediction."""
+        nz, sl, w = self.noise[c], self._span(c), self.weight[c]
+        raw, sds = [], []
+        if nz.offset_sd > 0.0:
+            raw.append(w)
+            sds.append(nz.offset_sd)
+        if c in GAIN_SD:
+            raw.append(pred[sl] * w)
+            sds.append(GAIN_SD[c])
+        if not raw:
+            return np.zeros((len(w), 0)), np.zeros((len(w), 0)), np.zeros(0)
+        R = np.stack(raw, axis=1)
+        return R, whiten(R, sd=nz.sd, rho=nz.rho_long_run), np.array(sds)  # whitened along time, per column
+
+    def _nuisances(self, c: str, pred: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                                           np.ndarray, float]:
+        """Most probable nuisance values (prior N(0, sd^2)) given whitened residuals w: (values, raw
+        directions, whitened directions, prior sds, log det(I + Sd V^T V Sd) of their marginalisation).
+        Least squares on the whitened residual with the pseudo-residuals value / sd gives the marginal
+        likelihood's quadratic form exactly (the nuisances enter linearly)."""
+        R, V, sds = self._nuisance_basis(c, pred)
+        if not len(sds):
+            return np.zeros(0), R, V, sds, 0.0
+        A = V.T @ V + np.diag(1.0 / sds**2)
+        d = np.linalg.solve(A, V.T @ w)
+        logdet = float(np.linalg.slogdet(A)[1] + 2.0 * np.sum(np.log(sds)))
+        return d, R, V, sds, logdet
 
     def scaled_residual(self, c: str, pred: np.ndarray) -> np.ndarray:
-        """(measured - predicted - offset error) sd / s_t over the channel's span: AR(1) with the gauge's sd
-        and effective coefficient. The offset error (the pre-pulse mean is uncertain) is profiled."""
+        """(measured - predicted - nuisances) sd / s_t over the channel's span: AR(1) with the gauge's sd
+        and effective coefficient. The offset error (the pre-pulse mean is uncertain) and an output bar
+        gauge's gain error are profiled."""
         nz = self.noise[c]
         u = self._raw_scaled(c, pred)
-        d = self._offset(c, whiten(u, sd=nz.sd, rho=nz.rho_long_run))
-        return u - d * self.weight[c]
+        d, R, _, _, _ = self._nuisances(c, pred, whiten(u, sd=nz.sd, rho=nz.rho_long_run))
+        return u - R @ d
 
     def _span(self, c: str) -> slice:
         i0, _, _, i3 = self.bounds[c]
@@ -144,24 +179,59 @@ class WholeRecordLikelihood:
             pred, _ = self.strains(values)
         except ValueError:
             return -np.inf
-        w = self.whitened_from(pred)
-        return self._log_weight + self._const - 0.5 * float(w @ w)
+        w, logdet = self._whitened_logdet(pred)
+        return self._log_weight + self._const - 0.5 * logdet - 0.5 * float(w @ w)
+
+    @property
+    def n_pseudo(self) -> int:
+        """Pseudo-residuals (nuisance / its prior sd) at the end of :meth:`whitened`: one per nuisance."""
+        return sum(int(self.noise[c].offset_sd > 0.0) + int(c in GAIN_SD) for c in self.channels)
 
     def whitened_from(self, pred: Mapping[str, np.ndarray]) -> np.ndarray:
-        out, pseudo = [], []
+        return self._whitened_logdet(pred)[0]
+
+    def _whitened_logdet(self, pred: Mapping[str, np.ndarray]) -> tuple[np.ndarray, float]:
+        out, pseudo, logdet = [], [], 0.0
         for c in self.channels:
             nz = self.noise[c]
             w = whiten(self._raw_scaled(c, pred[c]), sd=nz.sd, rho=nz.rho_long_run)
-            d = self._offset(c, w)
-            out.append(w - d * self._wv[c])
-            pseudo.append(d / nz.offset_sd if nz.offset_sd > 0 else 0.0)
-        return np.concatenate(out + [np.array(pseudo)])
+            d, _, V, sds, ld = self._nuisances(c, pred[c], w)
+            out.append(w - V @ d)
+            pseudo.append(d / sds)
+            logdet += ld
+        return np.concatenate(out + pseudo), logdet
+
+
+def robust_covariance(jacobian: np.ndarray, whitened: np.ndarray, cov: np.ndarray, blocks: np.ndarray, *,
+                      lags: int = ROBUST_LAGS) -> np.ndarray:
+    """Posterior covariance widened for a model that misses the record: the Laplace covariance ``cov``
+    plus the positive part of (sandwich - cov).
+
+    The sandwich H^-1 B H^-1 (H^-1 = ``cov``) is the spread of the best-fitting parameters when the
+    model is wrong (Huber; White 1982); B is the covariance of the score summed per block of the
+    record (``blocks``: the block of each whitened residual), with the products of blocks up to
+    ``lags`` apart weighted by Bartlett's kernel (Newey-West), since a model's error is correlated
+    over longer than one block. When the model is right, B ~ H and nothing changes; where it
+    misses, the residual's structure that the parameters had to absorb widens their posterior
+    (Muller 2013, "Risk of Bayesian inference in misspecified models").
+    """
+    g = jacobian * whitened[:, None]
+    G = np.zeros((int(blocks.max()) + 1, jacobian.shape[1]))
+    np.add.at(G, blocks, g)
+    B = G.T @ G
+    for lag in range(1, lags + 1):
+        C = G[:-lag].T @ G[lag:]
+        B += (1.0 - lag / (lags + 1.0)) * (C + C.T)
+    D = cov @ B @ cov - cov
+    w, V = np.linalg.eigh(0.5 * (D + D.T))
+    return cov + (V * np.clip(w, 0.0, None)) @ V.T
 
 
 def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Mapping[str, float], *,
                      n_draws: int = 30, rng: np.random.Generator,
                      prior_scale: Mapping[str, tuple[float, float]] | None = None,
-                     importance: bool = True, extra_starts: tuple[Mapping[str, float], ...] = ()) -> WholeRecordFit:
+                     importance: bool = True, extra_starts: tuple[Mapping[str, float], ...] = (),
+                     score_blocks: np.ndarray | None = None) -> WholeRecordFit:
     """Posterior mode, Laplace approximation and importance-weighted draws (module docstring).
 
     ``start`` gives a value for every free parameter (``hoop_gain``, profiled, is not one).
@@ -171,7 +241,9 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     draws are the normal approximation's, unweighted (no simulator run per draw). ``extra_starts``
     (partial value sets overriding ``start``) are further starting points of the mode search; the
     best mode is kept (the rise of the record pins the sample's confined modulus, which a low nu with
-    a stiff sample matches as well as the right nu: two modes).
+    a stiff sample matches as well as the right nu: two modes). ``score_blocks`` (the block of each
+    whitened residual, :meth:`WholeRecordLikelihood.whitened`): the draws are taken from
+    :func:`robust_covariance` (the normal approximation's are kept in ``laplace_draws``).
     """
     params = [lik.model.parameters[n] for n in start if n != "hoop_gain"]
     names = tuple(p.name for p in params)
@@ -206,13 +278,17 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
         if res is None or r.cost < res.cost:
             res = r
     zm = res.x
-    J = res.jac
+    # the precision from central differences over JACOBIAN_STEP: the explicit stick-slip integration makes
+    # the prediction jump by a time step's worth where a slip starts one step earlier or later, and a
+    # derivative over the optimiser's 1e-6 step can read such a jump as information
+    J = np.stack([(residuals(zm + JACOBIAN_STEP * e) - residuals(zm - JACOBIAN_STEP * e)) / (2.0 * JACOBIAN_STEP)
+                  for e in np.eye(len(zm))], axis=1)
     H = J.T @ J  # Gauss-Newton precision in z (data and the Gaussian stand-ins of the priors)
     try:
         cov = np.linalg.inv(H)
         chol = np.linalg.cholesky(0.5 * (cov + cov.T))
     except np.linalg.LinAlgError:
-        chol = np.diag(np.full(len(zm), 1e-3))
+        cov, chol = None, np.diag(np.full(len(zm), 1e-3))
 
     def log_post(z: np.ndarray) -> float:
         vals = values_of(z)
@@ -223,6 +299,14 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
         return lik.loglike(vals) + lp + jac
 
     eps = rng.standard_normal((n_draws, len(zm)))
+    n_data = len(res.fun) - len(zm)
+    laplace = None
+    if score_blocks is not None and cov is not None:
+        laplace = {p.name: np.asarray(p.from_unbounded(zm[i] + eps @ chol[i]), float) for i, p in enumerate(params)}
+        try:
+            chol = np.linalg.cholesky(robust_covariance(J[:n_data], res.fun[:n_data], cov, score_blocks))
+        except np.linalg.LinAlgError:
+            pass
     z = zm + eps @ chol.T
     if importance:
         log_q = -0.5 * np.sum(eps * eps, axis=1)
@@ -235,10 +319,9 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
         log_w, k = np.full(n_draws, -math.log(n_draws)), math.nan
     draws = {p.name: np.asarray(p.from_unbounded(z[:, i]), float) for i, p in enumerate(params)}
     mode = values_of(zm)
-    n_data = len(res.fun) - len(zm)
     return WholeRecordFit(names=names, mode=mode, draws=draws, log_weights=log_w, pareto_k=k,
                           loglike_mode=lik.loglike(mode), n_calls=calls + (n_draws if importance else 0),
-                          cov_z=cov, jacobian=J[:n_data], whitened=res.fun[:n_data])
+                          cov_z=cov, jacobian=J[:n_data], whitened=res.fun[:n_data], laplace_draws=laplace)
 
 
 def _pareto_k(log_w: np.ndarray) -> float:

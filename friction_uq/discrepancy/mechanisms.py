@@ -45,10 +45,11 @@ Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, float], str | N
 
 @dataclass(frozen=True)
 class Context:
-    """Stationary-window means a mechanism needs to state its effective f: V (m/s), p (Pa), slip (m)."""
+    """Stationary-window means a mechanism needs to state its effective f: sliding speed V (m/s), wall shear
+    stress tau_mean (Pa, eq. 18 from F_eo), slip (m)."""
 
     V: float
-    p_mean: float
+    tau_mean: float
     slip: float
 
 
@@ -122,7 +123,8 @@ register(Mechanism(
     priors={"p0": _lognormal(2e8, 1.5)},
     start={"p0": 1e9},
     apply=lambda v, s, g, ch: _law(s, "hyperbolic", f0=v["f"], p0=v["p0"]),
-    f_effective=lambda v, c: float(v["f"] / (1.0 + c.p_mean / v["p0"])),
+    # at the window's shear stress: tau = f p / (1 + p/p0) gives tau / p = f - tau / p0
+    f_effective=lambda v, c: float(max(v["f"] - c.tau_mean / v["p0"], 0.0)),
     group="friction_law",
 ))
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..models.parameters import summarize_draws
 from .diagnose import Diagnosis, ModelFit, Ranked
 from .whole_record import CHANNEL_LABELS
@@ -71,9 +69,12 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
                                  "whole-record fit of the final model"},
         "residual_rms": {ch: {ph: {"before": b, "after": a} for ph, (b, a) in phases.items()}
                          for ch, phases in dg.rms.items()},
-        "rule": "a mechanism is decisive when its dELPD exceeds 4 and either 2 SE or both 40 and 1 SE; the cause is the decisive "
-                "one with the largest dELPD; others within the same margin of it (40 replaced by max(40, 10 % of the "
-                "best)) are not separable from it; then the search goes on with the cause in the model",
+        "rule": "a mechanism is decisive when its dELPD exceeds 4 and either 2 SE or, when the reference model's misfit "
+                "is detected, both 40 and 1 SE; the cause is the decisive one with the largest dELPD; others within "
+                "the same margin of it (40 replaced by max(40, 10 % of the best)) are not separable from it; then the "
+                "search goes on with the cause in the model",
+        "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
+                             for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode",
         "seconds": dg.seconds,
         "sentence": sentence(dg, f_without),

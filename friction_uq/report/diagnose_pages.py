@@ -50,9 +50,13 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
             x = dg.final.fit.draws[p.name]
             q = np.quantile(x, [0.05, 0.5, 0.95])
             lines.append(f"   {p.name} = {q[1]:.4g} [{q[0]:.4g}, {q[2]:.4g}] {p.unit}: {p.meaning}")
-    lines += ["", "Rule: decisive when dELPD > 4 and (> 2 SE or > max(40, 1 SE)); the cause is the decisive one with the",
-              "largest dELPD; others as close to it are not separable from this record; then the search goes on",
-              "with the cause in the model."]
+    m0 = dg.misfits[0] if dg.misfits else None
+    lines += ["", "Rule: decisive when dELPD > 4 and (> 2 SE, or > max(40, 1 SE) once the reference model's misfit is",
+              "detected); the cause is the decisive one with the largest dELPD; others as close to it are not",
+              "separable from this record; then the search goes on with the cause in the model."]
+    if m0 is not None:
+        lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
+                     f"{'detected' if m0.detected else 'not detected'}.")
     ax2.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=8, wrap=True, transform=ax2.transAxes)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     return fig

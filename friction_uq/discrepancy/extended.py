@@ -1,0 +1,179 @@
+"""Extended models of one record: each mechanism of the catalogue added to the baseline simulator,
+fitted to the whole record and scored by its expected log predictive density.
+
+For each mechanism (:mod:`.mechanisms`; ``gauge_gain`` once per bar gauge) the simulator driven by
+the measured incident wave, extended by the mechanism, is fitted to the whole record (:mod:`.fit`:
+posterior by a Laplace approximation; f, nu and the sample's modulus stay free, a nuisance with a
+10 % lognormal prior, the hoop gauge's gain is profiled) and scored by its expected log predictive
+density over blocks of 10 us of every gauge (:mod:`.elpd`: exact leave-one-block-out for AR(1)
+noise). The baseline is the same simulator without extension. What is named from these scores is
+:mod:`.diagnose`'s rule.
+
+The headline f under an extended model is the wall's coefficient at the stationary window's mean
+sliding speed, pressure and slip (``f_effective`` of the mechanism), summarised over the draws.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from scipy import stats
+
+from ..analysis import Prepared
+from ..models import Parameter, SimulatorModel, measured_loading
+from ..models.parameters import summarize_draws
+from .elpd import Elpd, ar1_block_loo, takeuchi_block_loo
+from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
+from .mechanisms import MECHANISMS, Context, Mechanism
+
+#: Block of the leave-one-block-out ELPD (s).
+BLOCK = 10e-6
+#: Further starting values of nu for the baseline's mode search.
+NU_STARTS = (0.33, 0.45)
+SAMPLE_MODULUS_SD_LOG = 0.1
+
+
+@dataclass(frozen=True)
+class Variant:
+    """A mechanism as fitted (gauge_gain: on one gauge)."""
+
+    mechanism: Mechanism
+    channel: str | None = None
+
+    @property
+    def label(self) -> str:
+        return self.mechanism.name + (f"[{self.channel}]" if self.channel else "")
+
+
+@dataclass(frozen=True)
+class ModelFit:
+    """One fitted model (baseline or baseline + causes + a variant) and its ELPD."""
+
+    label: str
+    variants: tuple[Variant, ...]
+    fit: WholeRecordFit
+    hoop_gain: float
+    elpd: Elpd
+    f_effective: np.ndarray
+    predicted: dict[str, np.ndarray]
+    lik: WholeRecordLikelihood | None = None
+
+    def f_summary(self) -> dict[str, float]:
+        return summarize_draws(self.f_effective)
+
+
+class Diagnoser:
+    """Fits and scores extended models of one record (module docstring)."""
+
+    def __init__(self, prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], *, hoop: bool,
+                 seed: int, n_draws: int = 60, base_scales: Mapping[str, tuple[float, float]] | None = None) -> None:
+        self.prep = prep
+        rec = prep.record
+        self.loading = measured_loading(rec, prep.forces)
+        self.hoop = hoop and rec.has_hoop
+        self.log_prior_f_nu = log_prior_f_nu
+        self.seed = seed
+        self.n_draws = n_draws
+        E0 = rec.apparatus.sample.young_modulus
+        self.E0 = E0
+        self.modulus = Parameter("sample_modulus", "Pa", E0 / 4.0, 4.0 * E0, "Young's modulus of the sample")
+        self.modulus_prior = stats.lognorm(s=SAMPLE_MODULUS_SD_LOG, scale=E0)
+        self.block = max(1, int(round(BLOCK * rec.sample_rate)))
+        d = prep.data
+        tau = float(np.mean(d.F_eo)) / (2.0 * math.pi * d.radius * d.length)  # eq. 18, 20
+        self.context = Context(V=float(np.mean(d.V)), tau_mean=tau, slip=float(np.mean(d.slip)))
+        self._n_fit = 0
+        self.base_scales = dict(base_scales or {})
+
+    def _model(self, variants: tuple[Variant, ...]) -> SimulatorModel:
+        extra = [self.modulus] + [p for v in variants for p in v.mechanism.parameters]
+        def apply(values: Mapping[str, float], settings: dict[str, Any], gains: dict[str, float]) -> None:
+            app = settings["apparatus"]
+            settings["apparatus"] = replace(app, sample=replace(app.sample, young_modulus=float(values["sample_modulus"])))
+            for v in variants:
+                v.mechanism.apply(values, settings, gains, v.channel)
+
+        return SimulatorModel(self.prep.record.apparatus, self.loading, hoop=self.hoop, extra=tuple(extra), apply=apply)
+
+    def fit(self, variants: tuple[Variant, ...], start: Mapping[str, float], label: str) -> ModelFit:
+        model = self._model(variants)
+        lik = WholeRecordLikelihood(self.prep, model)
+
+        def log_prior(values: Mapping[str, float]) -> float:
+            out = self.log_prior_f_nu(values) + float(self.modulus_prior.logpdf(values["sample_modulus"]))
+            for v in variants:
+                out += v.mechanism.log_prior(values)
+            return out
+
+        st = {"f": start["f"], "nu": start["nu"], "sample_modulus": start.get("sample_modulus", self.E0)}
+        for v in variants:
+            for p in v.mechanism.parameters:
+                st[p.name] = start.get(p.name, v.mechanism.start[p.name])
+        self._n_fit += 1
+        rng = np.random.default_rng(np.random.SeedSequence([self.seed, 9, self._n_fit]))
+        scales = {"sample_modulus": self.modulus.gaussian_stand_in(self.modulus_prior), **self.base_scales}
+        for v in variants:
+            scales.update(v.mechanism.prior_z())
+        # the baseline from several nu (the closed form's, and either side of the prior): see fit.py
+        extra = () if variants else tuple({"nu": nu, "sample_modulus": self.E0} for nu in NU_STARTS)
+        block_of = self._blocks(lik)
+        fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False,
+                               prior_scale=scales, extra_starts=extra, score_blocks=block_of)
+        pred, gain = lik.strains(fit.mode)
+        dens = []
+        for c in lik.channels:
+            i0, _, _, i3 = lik.bounds[c]
+            nz = lik.noise[c]
+            logw = np.add.reduceat(np.log(lik.weight[c]), np.arange(0, i3 - i0, self.block))
+            dens.append(ar1_block_loo(lik.scaled_residual(c, pred[c])[None], sd=nz.sd, rho=nz.rho_long_run,
+                                      block=self.block)[0] + logw)
+        elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z, block_of)
+        names = list(fit.draws)
+        S = len(fit.draws["f"])
+        f_eff = np.array([self._f_effective(variants, {n: float(fit.draws[n][s]) for n in names}) for s in range(S)])
+        return ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd, f_effective=f_eff,
+                        predicted={c: v[None] for c, v in pred.items()}, lik=lik)
+
+    def _blocks(self, lik: WholeRecordLikelihood) -> np.ndarray:
+        """The block of each whitened residual of ``lik`` (:meth:`WholeRecordLikelihood.whitened`): 10 us
+        blocks of each gauge in turn; the nuisances' pseudo-residuals (last) belong to no
+        block: they are given the first."""
+        blocks, offset = [], 0
+        for c in lik.channels:
+            i0, _, _, i3 = lik.bounds[c]
+            blocks.append(offset + np.arange(i3 - i0) // self.block)
+            offset += -(-(i3 - i0) // self.block)
+        return np.concatenate(blocks + [np.zeros(lik.n_pseudo, int)])
+
+    def predictive(self, mf: ModelFit, n: int = 30) -> dict[str, np.ndarray]:
+        """Simulated gauges for the first ``n`` draws of a fitted model (channel -> (n, samples)), hoop gain
+        profiled."""
+        draws = mf.fit.laplace_draws or mf.fit.draws  # the likelihood's posterior: the misfit decision's footing
+        rows: dict[str, list[np.ndarray]] = {}
+        for s in range(min(n, len(draws["f"]))):
+            pred, _ = mf.lik.strains({k: float(v[s]) for k, v in draws.items()})
+            for c, v in pred.items():
+                rows.setdefault(c, []).append(v)
+        return {c: np.array(v) for c, v in rows.items()}
+
+    def _f_effective(self, variants: tuple[Variant, ...], values: Mapping[str, float]) -> float:
+        f = float(values["f"])
+        for v in variants:
+            f = v.mechanism.f_effective({**values, "f": f}, self.context)
+        return f
+
+
+def candidates(exclude: tuple[str, ...] = ()) -> list[Variant]:
+    """Every mechanism of the catalogue as fitted (gauge_gain once per gauge), minus ``exclude`` and
+    the other members of an excluded mechanism's group (one friction law at a time)."""
+    out: list[Variant] = []
+    groups = {MECHANISMS[n].group for n in exclude if MECHANISMS[n].group}
+    for m in MECHANISMS.values():
+        if m.name in exclude or (m.group is not None and m.group in groups):
+            continue
+        out += [Variant(m, ch) for ch in m.channels] if m.channels else [Variant(m)]
+    return out

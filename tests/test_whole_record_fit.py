@@ -1,0 +1,95 @@
+"""The whole-record likelihood's marginalised calibration nuisances and the misspecification-robust
+covariance of its fit."""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from friction_uq.analysis import prepare
+from friction_uq.discrepancy.fit import GAIN_SD, WholeRecordLikelihood, robust_covariance
+from friction_uq.models import SimulatorModel, measured_loading
+from friction_uq.record import read_record
+from friction_uq.simulate import SimulationConfig, simulate_to_file
+from friction_uq.simulate.config import ChannelSpec
+
+
+@pytest.fixture(scope="module")
+def lik(tmp_path_factory):
+    ch = {"input_bar": ChannelSpec(white=3e-6, ar1=2e-6, ar1_coef=0.5, offset=1e-5),
+          "internal_output_bar": ChannelSpec(white=2e-6, ar1=2e-6, ar1_coef=0.4, offset=-5e-6),
+          "external_output_bar": ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, offset=1e-6, gain=1.02),
+          "tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3)}
+    path = tmp_path_factory.mktemp("wr") / "r.h5"
+    simulate_to_file(SimulationConfig(channels=MappingProxyType(ch), friction_params=MappingProxyType({"f": 0.06}),
+                                      poisson_ratio=0.4), path, seed=3)
+    rec = read_record(path)
+    prep = prepare(rec)
+    return WholeRecordLikelihood(prep, SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), hoop=True))
+
+
+def _ar1_cov(n: int, sd: float, rho: float) -> np.ndarray:
+    k = np.arange(n)
+    return sd**2 * rho ** np.abs(k[:, None] - k[None, :])
+
+
+def test_loglike_is_the_marginal_gaussian_over_offset_and_gain(lik):
+    """Offset and gain errors marginalised: the likelihood equals the dense Gaussian with covariance
+    S + sd_off^2 w w^T + sd_g^2 p p^T per channel (w the tolerance weight, p the scaled prediction)."""
+    values = {"f": 0.058, "nu": 0.41}
+    pred, _ = lik.strains(values)
+    dense = 0.0
+    for c in lik.channels:
+        nz = lik.noise[c]
+        i0, _, _, i3 = lik.bounds[c]
+        w = lik.weight[c]
+        u = (lik.measured[c][i0:i3] - pred[c][i0:i3]) * w
+        C = _ar1_cov(len(u), nz.sd, nz.rho_long_run)
+        C += nz.offset_sd**2 * np.outer(w, w)
+        if c in GAIN_SD:
+            p = pred[c][i0:i3] * w
+            C += GAIN_SD[c] ** 2 * np.outer(p, p)
+        dense += stats.multivariate_normal(np.zeros(len(u)), C, allow_singular=False).logpdf(u) + np.sum(np.log(w))
+    assert set(GAIN_SD) <= set(lik.channels)
+    assert lik.loglike(values) == pytest.approx(dense, abs=1e-6 * abs(dense))
+
+
+def test_whitened_residuals_end_with_one_pseudo_residual_per_nuisance(lik):
+    w = lik.whitened({"f": 0.06, "nu": 0.4})
+    assert len(w) == lik.n_samples + lik.n_pseudo
+    assert lik.n_pseudo == sum(lik.noise[c].offset_sd > 0 for c in lik.channels) + len(GAIN_SD)
+
+
+def _regression(rng, n, misspecified):
+    """Least squares of y = a x on blocks of 10; misspecified: the truth has a slow wave the line cannot follow."""
+    x = np.linspace(-1, 1, n)
+    y = 2.0 * x + rng.normal(0, 1, n) + (3.0 * np.sin(6 * np.pi * x) if misspecified else 0.0)
+    J = x[:, None]
+    a = float(x @ y / (x @ x))
+    r = y - a * x
+    cov = np.array([[1.0 / float(x @ x)]])
+    return J, r, cov, np.arange(n) // 10
+
+
+def test_robust_covariance_keeps_a_right_model_and_widens_a_wrong_one():
+    rng = np.random.default_rng(0)
+    J, r, cov, blocks = _regression(rng, 2000, misspecified=False)
+    right = robust_covariance(J, r, cov, blocks)
+    assert right[0, 0] >= cov[0, 0]
+    assert right[0, 0] < 1.5 * cov[0, 0]
+    J, r, cov, blocks = _regression(rng, 2000, misspecified=True)
+    wrong = robust_covariance(J, r, cov, blocks)
+    assert wrong[0, 0] > 3.0 * cov[0, 0]
+
+
+def test_pressure_friction_states_the_coefficient_at_the_window_shear_stress():
+    """tau = f p / (1 + p / p0) (the hyperbolic law): tau / p at the window's tau is f - tau / p0."""
+    from friction_uq.discrepancy.mechanisms import MECHANISMS, Context
+
+    f0, p0, p = 0.08, 1e8, 6e7
+    tau = f0 * p / (1 + p / p0)
+    got = MECHANISMS["pressure_friction"].f_effective({"f": f0, "p0": p0}, Context(V=5.0, tau_mean=tau, slip=1e-3))
+    assert got == pytest.approx(tau / p, rel=1e-12)
