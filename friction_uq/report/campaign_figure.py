@@ -5,15 +5,16 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
 from .style import RC, figure, save_figure
 
 
-if TYPE_CHECKING:  # the figure draws a comparison; it does not import the campaign stage
-    from ..campaign.compare import Comparison
+#: What is drawn is friction_uq.campaign.compare.Comparison, read by its attributes: the report sits below the campaign
+#: stage and does not import it.
+Comparison = Any
 
 
 def campaign_figure(c: Comparison, path: str | os.PathLike[str]) -> Path:

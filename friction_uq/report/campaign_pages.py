@@ -6,15 +6,16 @@ from __future__ import annotations
 import os
 import textwrap
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from .._atomic import atomic_path
 from .style import RC, figure
 
-if TYPE_CHECKING:  # the report draws the campaign's result; it does not import the campaign stage
-    from ..campaign.analysis import CampaignAnalysis
+#: What is drawn is friction_uq.campaign.analysis.CampaignAnalysis, read by its attributes: the report sits below the campaign
+#: stage and does not import it.
+CampaignAnalysis = Any
 
 
 def _text_page(title: str, lines: list[str]):
