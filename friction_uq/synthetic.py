@@ -6,7 +6,8 @@ stationary levels (eq. 15-16), the input force is their sum (eq. 5), so the refl
 F_i / (A_i E_i) - eps_i (eq. 2) and the ends of the sample move together in the plateau (eq. 6).
 The hoop gauge reads the Lame strain of the eq. 20 wall pressure, seen through the tube kernel
 (physics.md section 6) as the sample slides past it, plus the Poisson widening of the tube under
-the axial friction load it carries at the gauge. Noise is white plus AR(1), with offsets.
+the axial friction load it carries at the gauge: the closed-form model's own prediction
+(:class:`friction_uq.models.closed_form.HoopPrediction`) on the true histories. Noise is white plus AR(1), with offsets.
 
 These records test the analysis against the paper's own model. The simulator
 (:mod:`friction_uq.simulate`) adds the physics the model leaves out. Both write through
@@ -20,9 +21,11 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
+from .models.closed_form import HoopPrediction
 from .noise import white_and_ar1_noise
 from .physics import bars, cell, design, tube
 from .record import Apparatus, paper_apparatus, write_record
@@ -95,24 +98,11 @@ def closed_form_strains(test: ClosedFormTest, apparatus: Apparatus) -> tuple[np.
     V = F_io(t) / io.impedance - F_eo(t) / eo.impedance  # eq. 7 with V = C eps on each bar
     slip = np.cumsum(V) / fs
     if test.hoop:
-        p_mean = F_eo(t) / (2.0 * math.pi * R * L * test.f) if test.f > 0 else 0.0 * t
-        s = np.linspace(-L / 2, L / 2, 81)
-        shape = cell.pressure_profile(s + L / 2, p_mean=1.0, f=test.f, nu=test.nu, radius=R, length=L) \
-            if test.f > 0 else np.ones_like(s)
-        z_g = tb.gauge_offset - slip
-        # the gauge reads the kernel averaged over its width
-        kern = tube.band_response(z_g[:, None] - s[None, :], band_length=tb.gauge_width,
-                                  beta=test.hoop_beta) / tb.gauge_width
-        seen = np.trapezoid(shape[None, :] * kern, s, axis=1)
-        lame = tb.lame_hoop_strain_per_pressure
-        # friction carried by the tube at the gauge: the wall force between the input face and
-        # the gauge, F_i - sigma(z) pi R^2 (eq. 11-13); axial compression widens the tube by
-        # nu_t N / (E_t A_t) (physics.md section 6)
-        z_in = np.clip(z_g + L / 2, 0.0, L)
-        fb = test.f * float(cell.beta(test.nu, radius=R, length=L))
-        N = F_io(t) * (np.exp(fb) - np.exp(fb * (L - z_in) / L))
-        axial = tb.poisson_ratio * N / (tb.young_modulus * tb.area)
-        strains["tube_hoop"] = -(lame * p_mean * seen + axial)  # compression positive: swelling reads negative
+        # the closed form's hoop reading (eq. 8, 11-13, 20, the tube kernel and the tube's axial Poisson
+        # term) on the true force and slip histories, a knot on every sample
+        history = SimpleNamespace(tube=tb, radius=R, length=L, n=n, sample_rate=fs, F_io=F_io(t), slip=slip)
+        hoop = HoopPrediction(history, smooth=0.0, knot_step=0.0, kernel_beta=test.hoop_beta)  # type: ignore[arg-type]
+        strains["tube_hoop"] = hoop.predict(test.f, test.nu, 1.0)[0]
     truth = {
         "f": test.f, "nu": test.nu, "kappa": float(cell.kappa(test.f, test.nu)),
         "striker_velocity_true": test.striker_velocity, "F_io": F_io0, "F_eo": F_eo0,

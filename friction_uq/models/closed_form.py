@@ -37,13 +37,14 @@ the pressure term, so in the package's convention both terms enter with the minu
 local N at the gauge is used (no Saint-Venant spreading), an approximation for a term ~4 % of the
 reading. g, the calibration factor, scales the whole reading.
 
-:func:`friction_uq.synthetic.closed_form_strains` computes the same physics independently (a
-trapezoid rule over the sample and the profile of :func:`friction_uq.physics.cell.pressure_profile`
-on the true force history); the tests use it as a cross-check of this model, so it is kept apart.
+:func:`friction_uq.synthetic.closed_form_strains` reuses :class:`HoopPrediction` on the true force
+and slip histories; the tests hold it against an independent quadrature (a trapezoid rule over the
+profile of :func:`friction_uq.physics.cell.pressure_profile`).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import replace
@@ -128,7 +129,6 @@ class HoopPrediction:
         step = max(1, int(round(knot_step * data.sample_rate)))
         knots = np.unique(np.append(np.arange(0, n, step), n - 1))
         self.knots = knots
-        self.basis = _hat_basis(knots, n)
         self._left = np.clip(np.searchsorted(knots, np.arange(n), side="right") - 1, 0, len(knots) - 2)
         self._w = (np.arange(n) - knots[self._left]) / (knots[self._left + 1] - knots[self._left])
         F_k, z_k = F_io[knots], z_g[knots]
@@ -144,6 +144,12 @@ class HoopPrediction:
         self._pc_a = 0.5 - u / L  # N = F_io e^{fb a} (e^{fb b} - 1)
         self._pc_b = u / L + 0.5
         self._poisson = tb.poisson_ratio * F_k / (tb.young_modulus * tb.area)
+
+    @functools.cached_property
+    def basis(self) -> np.ndarray:
+        """(n, m) hat matrix of the linear interpolation from the knots (built when first asked for: with a
+        knot on every sample it is n x n)."""
+        return _hat_basis(self.knots, self.n)
 
     def predict_knots(self, f: np.ndarray, nu: np.ndarray, gain: np.ndarray) -> np.ndarray:
         """Predicted hoop reading at the knots, compression positive, shape (len(f), m) (strain)."""
