@@ -109,7 +109,9 @@ def test_plug_friction_is_named_and_f_recovered(tmp_path):
     assert fx["q05"] <= 0.05 <= fx["q95"], fx
     doc = outcome.to_json(dg, {"mean": 0.06, "sd": 0.003, "q05": 0.055, "q50": 0.06, "q95": 0.065})
     assert doc["cause"] == "plug_friction"
-    assert {"name", "delpd", "se", "parameters"} <= set(doc["ranking"][0])
+    assert {"name", "delpd", "se", "parameters", "draws", "ess"} <= set(doc["ranking"][0])
+    assert doc["ranking"][0]["ess"] == pytest.approx(doc["ranking"][0]["draws"])  # independent, equally weighted
+    assert doc["reference_misfit"][0]["detected"] == dg.misfits[0].detected
     assert "plug_friction" in doc["sentence"] and "with it" in doc["sentence"]
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..models.parameters import summarize_draws
 from .diagnose import Diagnosis, ModelFit, Ranked
 from .whole_record import CHANNEL_LABELS
@@ -10,11 +12,19 @@ from .whole_record import CHANNEL_LABELS
 HOOP_GAIN_FINDING = 0.03
 
 
+def effective_sample_size(log_weights: np.ndarray) -> float:
+    """Kish's effective sample size of weighted draws, 1 / sum(w^2) (the draws are independent: normal draws
+    around the mode, equally weighted unless importance-corrected)."""
+    w = np.exp(np.asarray(log_weights, float) - np.logaddexp.reduce(log_weights))
+    return float(1.0 / np.sum(w * w))
+
+
 def _entry(r: Ranked) -> dict[str, object]:
     v = r.fit.variants[-1]
     params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
     return {"name": v.mechanism.name, "channel": v.channel, "model": r.fit.label, "delpd": r.delpd, "se": r.se,
-            "decisive": r.decisive, "parameters": params, "f_effective": summarize_draws(r.fit.f_effective)}
+            "decisive": r.decisive, "parameters": params, "f_effective": summarize_draws(r.fit.f_effective),
+            "draws": int(len(r.fit.f_effective)), "ess": effective_sample_size(r.fit.fit.log_weights)}
 
 
 def _describe(dg: Diagnosis) -> str:
