@@ -23,6 +23,7 @@ Rule (documented in README.md):
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
@@ -36,6 +37,8 @@ from .whole_record import WholeRecord, compare_whole_record
 #: Decisive evidence: dELPD above DECISIVE_ELPD and above DECISIVE_SE standard errors or STRONG_ELPD.
 DECISIVE_ELPD, DECISIVE_SE, STRONG_ELPD = 4.0, 2.0, 40.0
 MAX_CAUSES = 3
+#: Processes fitting one round's extended models by default.
+MAX_WORKERS = 4
 
 #: What would separate two mechanisms that one record cannot.
 SEPARATE_BY = {
@@ -103,13 +106,17 @@ def rank(reference: ModelFit, fits: list[ModelFit], *, misfit: bool = False) -> 
 
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
              hoop: bool, seed: int, n_draws: int = 1000, progress: Callable[[str], None] | None = None,
-             base_scales: Mapping[str, tuple[float, float]] | None = None, max_causes: int = MAX_CAUSES) -> Diagnosis:
+             base_scales: Mapping[str, tuple[float, float]] | None = None, max_causes: int = MAX_CAUSES,
+             workers: int | None = None) -> Diagnosis:
     """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring).
 
     ``base_scales``: Gaussian stand-ins (centre, sd in the unbounded coordinate) of the f and nu
-    priors for the mode search.
+    priors for the mode search. ``workers``: processes fitting a round's extended models (None: the
+    machine's cores, at most :data:`MAX_WORKERS`); the result does not depend on it.
     """
     t0 = time.perf_counter()
+    if workers is None:
+        workers = min(MAX_WORKERS, os.cpu_count() or 1)
     say = progress or (lambda msg: None)
     dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales)
     say("baseline")
@@ -126,12 +133,11 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         if k == 0:
             base = reference
         misfits.append(decide(compare_whole_record(prep, reference.predicted)))
-        fits = []
         used = tuple(v.mechanism.name for v in causes)
-        for cand in candidates(exclude=used):
-            say(cand.label)
-            mode = dict(reference.fit.mode)
-            fits.append(dg.fit(tuple(causes) + (cand,), mode, "+".join([v.label for v in causes] + [cand.label])))
+        jobs = [(tuple(causes) + (cand,), dict(reference.fit.mode), "+".join([v.label for v in causes] + [cand.label]))
+                for cand in candidates(exclude=used)]
+        say(f"{len(jobs)} extended models ({', '.join(j[2] for j in jobs)}) on {workers} process(es)")
+        fits = dg.fit_many(jobs, workers=workers)
         ranked = rank(reference, fits, misfit=misfits[-1].detected)
         rounds.append(ranked)
         decisive = [r for r in ranked if r.decisive]

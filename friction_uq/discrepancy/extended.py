@@ -16,6 +16,9 @@ sliding speed, pressure and slip (``f_effective`` of the mechanism), summarised 
 from __future__ import annotations
 
 import math
+import multiprocessing
+import threading
+import zlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
@@ -86,7 +89,6 @@ class Diagnoser:
         d = prep.data
         tau = float(np.mean(d.F_eo)) / (2.0 * math.pi * d.radius * d.length)  # eq. 18, 20
         self.context = Context(V=float(np.mean(d.V)), tau_mean=tau, slip=float(np.mean(d.slip)))
-        self._n_fit = 0
         self.base_scales = dict(base_scales or {})
 
     def _model(self, variants: tuple[Variant, ...]) -> SimulatorModel:
@@ -113,8 +115,8 @@ class Diagnoser:
         for v in variants:
             for p in v.mechanism.parameters:
                 st[p.name] = start.get(p.name, v.mechanism.start[p.name])
-        self._n_fit += 1
-        rng = np.random.default_rng(np.random.SeedSequence([self.seed, 9, self._n_fit]))
+        # seeded by the model's label: the same draws whichever process fits it, in whatever order
+        rng = np.random.default_rng(np.random.SeedSequence([self.seed, 9, zlib.crc32(label.encode())]))
         scales = {"sample_modulus": self.modulus.gaussian_stand_in(self.modulus_prior), **self.base_scales}
         for v in variants:
             scales.update(v.mechanism.prior_z())
@@ -137,6 +139,29 @@ class Diagnoser:
         f_eff = np.array([self._f_effective(variants, {n: float(fit.draws[n][s]) for n in names}) for s in range(S)])
         return ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd, f_effective=f_eff,
                         predicted={c: v[None] for c, v in pred.items()}, lik=lik)
+
+    def fit_many(self, jobs: list[tuple[tuple[Variant, ...], Mapping[str, float], str]], *,
+                 workers: int = 1) -> list[ModelFit]:
+        """:meth:`fit` for each (variants, start, label) job, on ``workers`` processes (forked: they share
+        this object). A daemon process or one running other threads (a campaign's Dask worker: forking
+        a threaded process can deadlock) fits them in turn. Same results as one by one."""
+        workers = min(workers, len(jobs))
+        if (workers <= 1 or multiprocessing.current_process().daemon or threading.active_count() > 1
+                or "fork" not in multiprocessing.get_all_start_methods()):
+            return [self.fit(*job) for job in jobs]
+        global _ACTIVE
+        _ACTIVE = (self, jobs)
+        try:
+            with multiprocessing.get_context("fork").Pool(workers) as pool:
+                parts = pool.map(_fit_job, range(len(jobs)), chunksize=1)
+        finally:
+            _ACTIVE = None
+        out = []
+        for (variants, _, label), (fit, gain, elpd, f_eff, predicted) in zip(jobs, parts):
+            lik = WholeRecordLikelihood(self.prep, self._model(variants))  # closures do not cross processes
+            out.append(ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd,
+                                f_effective=f_eff, predicted=predicted, lik=lik))
+        return out
 
     def _blocks(self, lik: WholeRecordLikelihood) -> np.ndarray:
         """The block of each whitened residual of ``lik`` (:meth:`WholeRecordLikelihood.whitened`): 10 us
@@ -165,6 +190,16 @@ class Diagnoser:
         for v in variants:
             f = v.mechanism.f_effective({**values, "f": f}, self.context)
         return f
+
+
+_ACTIVE: tuple[Diagnoser, list] | None = None
+
+
+def _fit_job(i: int) -> tuple[WholeRecordFit, float, Elpd, np.ndarray, dict[str, np.ndarray]]:
+    """One job of :meth:`Diagnoser.fit_many` in a forked worker: what of the fit can be pickled."""
+    dg, jobs = _ACTIVE
+    mf = dg.fit(*jobs[i])
+    return mf.fit, mf.hoop_gain, mf.elpd, mf.f_effective, mf.predicted
 
 
 def candidates(exclude: tuple[str, ...] = ()) -> list[Variant]:
