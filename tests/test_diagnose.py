@@ -60,6 +60,31 @@ def test_decisive_rule():
     assert not beyond(10.0, 6.0, 40)
     assert beyond(500.0, 400.0, 40)  # strong, concentrated evidence
     assert not beyond(49.0, 61.0, 40)  # strong but within one SE: a clean record's model differences
+    assert not beyond(500.0, 400.0, None)  # the one-SE route is closed until the misfit check finds a misfit
+    assert beyond(500.0, 200.0, None)
+
+
+def test_extended_models_fitted_on_two_processes_are_the_same_bits(tmp_path):
+    from friction_uq.discrepancy.extended import Diagnoser, Variant
+
+    path = tmp_path / "r.h5"
+    simulate_to_file(_config(friction_params=MappingProxyType({"f": 0.06})), path, seed=31)
+    prep = prepare(read_record(path))
+    priors = load_priors(default_prior_path("I1"))
+
+    def log_prior(v):
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    dg = Diagnoser(prep, log_prior, hoop=True, seed=5, n_draws=20)
+    start = {"f": 0.06, "nu": 0.4}
+    jobs = [((Variant(MECHANISMS[n]),), start, n) for n in ("end_friction", "dispersion")]
+    one, two = dg.fit_many(jobs, workers=1), dg.fit_many(jobs, workers=2)
+    for a, b in zip(one, two):
+        assert a.label == b.label
+        for name in a.fit.draws:
+            np.testing.assert_array_equal(a.fit.draws[name], b.fit.draws[name])
+        assert a.elpd.total == b.elpd.total
+        assert b.lik is not None and b.lik.model.parameters.names == a.lik.model.parameters.names
 
 
 def _config(**kw) -> SimulationConfig:
