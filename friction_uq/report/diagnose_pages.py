@@ -8,12 +8,18 @@ Page B: per gauge, the residual of the baseline and of the extended model over t
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 
 from ..discrepancy.diagnose import DECISIVE_ELPD, Diagnosis
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from .style import figure
+
+
+#: Characters per line of the ranking page's text column.
+WRAP = 70
 
 
 def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, test: str) -> Figure:
@@ -41,8 +47,10 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     fb = dg.baseline.f_summary()
     lines = [sentence, "",
              f"f, stationary phase (eq. 17 + hoop): {f_without['q50']:.4f} [{f_without['q05']:.4f}, {f_without['q95']:.4f}]",
-             f"f, baseline over the whole record: {fb['q50']:.4f} [{fb['q05']:.4f}, {fb['q95']:.4f}]",
-             f"f, model '{dg.final.label}': {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}]",
+             f"f, baseline over the whole record: {fb['q50']:.4f} [{fb['q05']:.4f}, {fb['q95']:.4f}] "
+             f"(nu {np.median(dg.baseline.fit.draws['nu']):.3f})",
+             f"f, model '{dg.final.label}': {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] "
+             f"(nu {np.median(dg.final.fit.draws['nu']):.3f})",
              f"hoop gauge gain (profiled, final model): {dg.final.hoop_gain:.3f}", ""]
     for v in dg.causes:
         lines.append(f"{v.mechanism.name}{' (' + v.channel + ')' if v.channel else ''}: {v.mechanism.meaning}")
@@ -51,13 +59,15 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
             q = np.quantile(x, [0.05, 0.5, 0.95])
             lines.append(f"   {p.name} = {q[1]:.4g} [{q[0]:.4g}, {q[2]:.4g}] {p.unit}: {p.meaning}")
     m0 = dg.misfits[0] if dg.misfits else None
-    lines += ["", "Rule: decisive when dELPD > 4 and (> 2 SE, or > max(40, 1 SE) once the reference model's misfit is",
-              "detected); the cause is the decisive one with the largest dELPD; others as close to it are not",
-              "separable from this record; then the search goes on with the cause in the model."]
+    lines += ["", "Rule: decisive when dELPD > 4 and either > 2 SE or, once the reference model's misfit is "
+                  "detected, > max(40, 1 SE); the cause is the decisive one with the largest dELPD; others as "
+                  "close to it are not separable from this record; then the search goes on with the cause in "
+                  "the model."]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")
-    ax2.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=8, wrap=True, transform=ax2.transAxes)
+    text = "\n".join(textwrap.fill(line, WRAP) if line else line for line in lines)
+    ax2.text(0.0, 1.0, text, va="top", fontsize=8, transform=ax2.transAxes)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     return fig
 
