@@ -42,7 +42,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     if not dg.causes:
         return (f"No mechanism of the catalogue explains the record decisively better than the baseline (best "
                 f"{dg.ranking[0].fit.label}: dELPD {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f}); f = "
-                f"{f_without['q50']:.3f} [{f_without['q05']:.3f}, {f_without['q95']:.3f}] stands.")
+                f"{f_without['q50']:.3f} [{f_without['q05']:.3f}, {f_without['q95']:.3f}] stands{_hoop_finding(dg)}.")
     first = dg.ranking[0]
     v = dg.causes[0]
     name = v.mechanism.name + (f" on the {CHANNEL_LABELS.get(v.channel, v.channel)} gauge" if v.channel else "")
@@ -54,7 +54,15 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = (f"; not separable from this record: {', '.join(dg.not_separable)} (would separate them: "
                f"{dg.separate_by})")
     return (f"{_describe(dg)[0].upper()}{_describe(dg)[1:]}: {name} (dELPD {first.delpd:.0f} +- {first.se:.0f}){more}"
-            f"{sep}; f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] with it, {f_without['q50']:.3f} without.")
+            f"{sep}; f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] with it, {f_without['q50']:.3f} without"
+            f"{_hoop_finding(dg)}.")
+
+
+def _hoop_finding(dg: Diagnosis) -> str:
+    g = dg.final.hoop_gain
+    if "tube_hoop" not in dg.final.predicted or abs(g - 1.0) <= HOOP_GAIN_FINDING:
+        return ""
+    return f"; the tube hoop gauge reads {g:.2f} times the model's strain (its calibration factor, profiled)"
 
 
 def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
