@@ -1,5 +1,6 @@
 """The main job end to end, as a user runs it: outputs, their content, refusals, atomicity."""
 
+import hashlib
 import json
 
 import pytest
@@ -31,7 +32,7 @@ def test_run_writes_the_three_outputs(paper_run):
 
 
 def test_json_has_the_contract_keys(paper_run):
-    _, out, _ = paper_run
+    _, out, rec = paper_run
     doc = json.loads((out / "paper_P-01.json").read_text())
     for k in JSON_KEYS:
         assert set(STATS) <= set(doc[k]), k
@@ -40,6 +41,8 @@ def test_json_has_the_contract_keys(paper_run):
         assert k in doc
     assert doc["seed"] == 7
     assert doc["rhat_max"] < 1.01 and doc["ess_min"] > 400
+    # the record's checksum: what a campaign compares to skip an up-to-date record
+    assert doc["record_sha256"] == hashlib.sha256(rec.read_bytes()).hexdigest()
     # kappa is the product the forces fix
     assert doc["kappa"]["q50"] == pytest.approx(doc["f"]["q50"] * doc["nu"]["q50"] / (1 - doc["nu"]["q50"]), rel=0.02)
 

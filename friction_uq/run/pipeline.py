@@ -193,7 +193,7 @@ def run_file(
         t = time.perf_counter()
 
         dt.attrs.update({
-            "friction_uq_version": __version__, "record": str(record.path), "recordsha256_hex": record.sha256,
+            "friction_uq_version": __version__, "record": str(record.path), "record_sha256": record.sha256,
             "test_id": record.test_id, "campaign": record.campaign, "window_s": [prep.window.t0, prep.window.t1],
             "dispersion_correction": int(dispersion), "hoop_term": int(use_hoop),
             "seed": seed if seed < 2**63 else str(seed),  # netCDF attributes hold int64
@@ -229,7 +229,7 @@ def run_file(
             "converged": conv.ok,
             "test_id": record.test_id,
             "campaign": record.campaign,
-            "recordsha256_hex": record.sha256,
+            "record_sha256": record.sha256,
             "prior_file": str(p_path),
             "hoop_term": use_hoop,
             "hoop_left_out": left_out,
