@@ -133,3 +133,12 @@ def test_with_two_setups_the_causes_name_the_one_that_is_off():
     assert flags[0]["causes"]["B"].endswith("plug friction named in 5, gauge gain named in 1")
     small = Elpd("velocity + offset B", 12.0, 1.0, np.r_[np.full(5, 0.0), np.full(5, 0.4)], np.zeros(10), 0)
     assert setup_flags(base, {"B": (small, delta)}, ["A", "B"], t) == []
+
+
+def test_decisive_uses_students_t_for_few_tests():
+    from friction_uq.campaign.laws import decisive
+
+    assert decisive(4.3, 2.1)  # 2 SE when the number of tests is not given
+    assert not decisive(4.3, 2.1, 10)  # t(0.975, 9) = 2.26: 4.75 needed
+    assert decisive(4.3, 2.1, 1000)  # many tests: the normal 1.96
+    assert not decisive(3.9, 0.1, 1000)  # never below 4

@@ -104,7 +104,8 @@ def _nested(a: Model, b: Model) -> bool:
 
 def choose(ranking: Sequence[dict[str, object]], models: dict[str, Model]) -> Model | None:
     """The simplest model not decisively worse than the top one that all such models contain, else None."""
-    contenders = [models[str(r["model"])] for r in ranking if not decisive(float(r["d_elpd"]), float(r["d_se"]))]
+    contenders = [models[str(r["model"])] for r in ranking
+                  if not decisive(float(r["d_elpd"]), float(r["d_se"]), r.get("n_tests"))]
     for m in sorted(contenders, key=lambda m: len(m.params)):
         if all(_nested(m, other) for other in contenders):
             return m
@@ -175,9 +176,9 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     chosen = choose(ca.ranking, models)
     if chosen is None:
         top_laws = {models[str(r["model"])].law for r in ca.ranking
-                    if not decisive(float(r["d_elpd"]), float(r["d_se"]))}
+                    if not decisive(float(r["d_elpd"]), float(r["d_se"]), r.get("n_tests"))}
         ca.sentences.append("friction law: the data do not separate " + ", ".join(sorted(top_laws))
-                            + " (none is decisively better: dELPD > 4 and > 2 SE)")
+                            + " (none is decisively better: dELPD > 4 and > t(0.975, tests - 1) SE)")
         law_for_flags = models[str(ca.ranking[0]["model"])].law
     else:
         ca.chosen, ca.best = chosen.name, chosen.law

@@ -1,7 +1,7 @@
 """Set-ups and tests that do not follow the shared law, and the per-record causes tallied beside them.
 
 A set-up is flagged when the best law with a multiplicative offset on that set-up beats the law
-without it decisively (leave-one-test-out dELPD > 4 and > 2 SE). With exactly two set-ups an
+without it decisively (leave-one-test-out dELPD > 4 and > t(0.975, tests - 1) SE). With exactly two set-ups an
 offset on one is the same model as an offset on the other: the campaign then says that the two
 disagree, by how much, and lets the per-record causes (when a diagnosis named them) say which.
 
@@ -60,7 +60,7 @@ def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]
     pair = len(setups) == 2
     for s, (e, delta) in with_offset.items():
         d, se = difference(e, base)
-        if not decisive(d, se):
+        if not decisive(d, se, e.pointwise.size):
             continue
         other = [x for x in setups if x != s]
         entry: dict[str, object] = {
