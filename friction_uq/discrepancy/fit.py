@@ -1,28 +1,11 @@
 """Fit a forward model of the whole test to the whole record: Laplace approximation and draws.
 
-The whole-record likelihood compares every gauge over its span (:mod:`.whole_record`: from its
-wave's arrival to the first far-end echo) with the simulator's prediction, each residual scored by
-the exact AR(1) Gaussian log-likelihood of that gauge's pre-pulse noise, with the effective
-coefficient that reproduces the noise's long-run variance (white plus AR(1) noise whitened with its
-lag-1 coefficient would overstate what the record says about a level: a gain, f), (the reflected wave with
-twice the variance: its prediction carries the measured incident's noise), widened by the model's
-tolerance: sample t has standard deviation s_t = sqrt(sd^2 + tol_t^2), tol_t the channel's
-tolerated model error (:func:`~.whole_record.tolerance_sd`: 1-2 % of the signal on a bar gauge,
-3 % on the hoop gauge, and a timing tolerance of 0.2 us times the local slope), and the residual
-scaled by sd / s_t is AR(1) with the gauge's coefficient. Without it the 0.1 %-level differences
-between any two simulators of the test (time step, mesh, a rounded constant) would read as physics
-on the high-signal channels. The hoop gauge's calibration factor enters linearly and is profiled
-out (its generalised least-squares value for each parameter vector). Each channel's offset error
-(the pre-pulse mean is uncertain) and each output bar gauge's gain error (its calibration, 1 %:
-an error correlated over the whole record, which the per-sample tolerance alone would treat as
-averaging out) enter linearly with Gaussian priors and are marginalised: least squares on the
-whitened residuals with one pseudo-residual per nuisance gives the marginal quadratic form exactly.
-
-The posterior is approximated by a normal distribution in the unbounded coordinates of the
-parameters (:meth:`~friction_uq.models.Parameter.to_unbounded`) around its mode, found by
-Levenberg-Marquardt on the whitened residuals (with Gaussian stand-ins of the priors), with the
-Gauss-Newton matrix J^T J as precision (no finite-difference Hessian, which fails when the
-posterior is narrower than its step), and the draws are corrected by
+The likelihood is :mod:`.record_likelihood`'s. The posterior is approximated by a normal
+distribution in the unbounded coordinates of the parameters
+(:meth:`~friction_uq.models.Parameter.to_unbounded`) around its mode, found by Levenberg-Marquardt
+on the whitened residuals (with Gaussian stand-ins of the priors), with the Gauss-Newton matrix
+J^T J as precision (J by central differences over :data:`JACOBIAN_STEP`; no finite-difference
+Hessian, which fails when the posterior is narrower than its step), and the draws are corrected by
 Pareto-smoothed importance sampling against the exact posterior (the k diagnostic is returned;
 k > 0.7 says the normal approximation is poor). A simulator run costs ~10 ms, so a fit of two or
 three parameters costs about 1 s.
@@ -37,16 +20,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from ..analysis import Prepared
 from ..models.parameters import summarize_draws
-from ..models.simulator import SimulatorModel
-from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, tolerance_sd, whiten
+from .record_likelihood import GAIN_SD, WholeRecordLikelihood
+
+__all__ = ["GAIN_SD", "WholeRecordFit", "WholeRecordLikelihood", "fit_whole_record", "robust_covariance"]
 
 LogPrior = Callable[[Mapping[str, float]], float]
-#: Calibration errors of the output bar gauges marginalised in the whole-record likelihood (relative sd):
-#: a bar gauge's calibration and the bar's E and c are known to about 1 % (the level part of
-#: :data:`~.whole_record.TOLERANCE`, correlated over the record as a calibration error is).
-GAIN_SD = {"internal_output_bar": 0.01, "external_output_bar": 0.01}
 #: Step (unbounded coordinate) of the central differences giving the Laplace precision.
 JACOBIAN_STEP = 1e-3
 #: Blocks apart whose scores are taken as correlated in :func:`robust_covariance` (Bartlett weights).
@@ -71,135 +50,6 @@ class WholeRecordFit:
 
     def summary(self, name: str) -> dict[str, float]:
         return summarize_draws(self.draws[name])
-
-
-class WholeRecordLikelihood:
-    """log p(record | parameters) over every gauge's span (module docstring)."""
-
-    def __init__(self, prep: Prepared, model: SimulatorModel) -> None:
-        rec = prep.record
-        self.model = model
-        self.channels = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or model.hoop))
-        self.bounds = channel_spans(prep, self.channels)
-        self.noise = {c: channel_noise(prep, c) for c in self.channels}
-        self.measured = {c: rec.strain(c) - prep.forces.channels[c].noise.offset for c in self.channels}
-        self.weight: dict[str, np.ndarray] = {}  # sd / s_t over each span (module docstring)
-        for c in self.channels:
-            sl, nz = self._span(c), self.noise[c]
-            tol = tolerance_sd(self.measured[c], c, sample_rate=rec.sample_rate)[sl]
-            self.weight[c] = nz.sd / np.hypot(nz.sd, tol)
-        self._log_weight = sum(float(np.sum(np.log(w))) for w in self.weight.values())
-        # the Gaussian constants (the nuisances' log determinant depends on the prediction: per call)
-        self._const = 0.0
-        for c in self.channels:
-            nz, n = self.noise[c], len(self.weight[c])
-            self._const += -0.5 * n * math.log(2.0 * math.pi * nz.sd**2) - 0.5 * (n - 1) * math.log(1.0 - nz.rho_long_run**2)
-
-    def _raw_scaled(self, c: str, pred: np.ndarray) -> np.ndarray:
-        sl = self._span(c)
-        return (self.measured[c][sl] - pred[sl]) * self.weight[c]
-
-    def _nuisance_basis(self, c: str, pred: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The channel's calibration nuisances: raw (scaled) directions, their whitened columns and prior sds.
-
-        A constant offset error (the pre-pulse mean is uncertain: sd ``offset_sd``) and, on the output bar
-        gauges, a gain error (their calibration: sd :data:`GAIN_SD`), whose direction is the prediction."""
-        nz, sl, w = self.noise[c], self._span(c), self.weight[c]
-        raw, sds = [], []
-        if nz.offset_sd > 0.0:
-            raw.append(w)
-            sds.append(nz.offset_sd)
-        if c in GAIN_SD:
-            raw.append(pred[sl] * w)
-            sds.append(GAIN_SD[c])
-        if not raw:
-            return np.zeros((len(w), 0)), np.zeros((len(w), 0)), np.zeros(0)
-        R = np.stack(raw, axis=1)
-        return R, whiten(R, sd=nz.sd, rho=nz.rho_long_run), np.array(sds)  # whitened along time, per column
-
-    def _nuisances(self, c: str, pred: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                                           np.ndarray, float]:
-        """Most probable nuisance values (prior N(0, sd^2)) given whitened residuals w: (values, raw
-        directions, whitened directions, prior sds, log det(I + Sd V^T V Sd) of their marginalisation).
-        Least squares on the whitened residual with the pseudo-residuals value / sd gives the marginal
-        likelihood's quadratic form exactly (the nuisances enter linearly)."""
-        R, V, sds = self._nuisance_basis(c, pred)
-        if not len(sds):
-            return np.zeros(0), R, V, sds, 0.0
-        A = V.T @ V + np.diag(1.0 / sds**2)
-        d = np.linalg.solve(A, V.T @ w)
-        logdet = float(np.linalg.slogdet(A)[1] + 2.0 * np.sum(np.log(sds)))
-        return d, R, V, sds, logdet
-
-    def scaled_residual(self, c: str, pred: np.ndarray) -> np.ndarray:
-        """(measured - predicted - nuisances) sd / s_t over the channel's span: AR(1) with the gauge's sd
-        and effective coefficient. The offset error (the pre-pulse mean is uncertain) and an output bar
-        gauge's gain error are profiled."""
-        nz = self.noise[c]
-        u = self._raw_scaled(c, pred)
-        d, R, _, _, _ = self._nuisances(c, pred, whiten(u, sd=nz.sd, rho=nz.rho_long_run))
-        return u - R @ d
-
-    def _span(self, c: str) -> slice:
-        i0, _, _, i3 = self.bounds[c]
-        return slice(i0, i3)
-
-    def hoop_gain(self, predicted_unit: np.ndarray) -> float:
-        """Generalised least-squares gain of the hoop gauge for a prediction at gain 1."""
-        s, nz, w = self._span("tube_hoop"), self.noise["tube_hoop"], self.weight["tube_hoop"]
-        wp = whiten(predicted_unit[s] * w, sd=nz.sd, rho=nz.rho_long_run)
-        wm = whiten(self.measured["tube_hoop"][s] * w, sd=nz.sd, rho=nz.rho_long_run)
-        den = float(wp @ wp)
-        return float(wm @ wp) / den if den > 0 else 1.0
-
-    def strains(self, values: Mapping[str, float]) -> tuple[dict[str, np.ndarray], float]:
-        """Predicted strains with the hoop gain profiled; returns (strains, hoop gain)."""
-        vals = dict(values)
-        vals["hoop_gain"] = 1.0
-        pred = self.model.predict(vals).strains
-        g = 1.0
-        if "tube_hoop" in self.channels:
-            g = self.hoop_gain(pred["tube_hoop"])
-            pred = dict(pred)
-            pred["tube_hoop"] = g * pred["tube_hoop"]
-        return pred, g
-
-    def whitened(self, values: Mapping[str, float]) -> np.ndarray:
-        """AR(1)-whitened residuals of every channel with its profiled offset error, concatenated, then one
-        pseudo-residual per channel (offset / its sd): log-likelihood = const - |w|^2 / 2."""
-        pred, _ = self.strains(values)
-        return self.whitened_from(pred)
-
-    @property
-    def n_samples(self) -> int:
-        return sum(self.bounds[c][3] - self.bounds[c][0] for c in self.channels)
-
-    def loglike(self, values: Mapping[str, float]) -> float:
-        try:
-            pred, _ = self.strains(values)
-        except ValueError:
-            return -np.inf
-        w, logdet = self._whitened_logdet(pred)
-        return self._log_weight + self._const - 0.5 * logdet - 0.5 * float(w @ w)
-
-    @property
-    def n_pseudo(self) -> int:
-        """Pseudo-residuals (nuisance / its prior sd) at the end of :meth:`whitened`: one per nuisance."""
-        return sum(int(self.noise[c].offset_sd > 0.0) + int(c in GAIN_SD) for c in self.channels)
-
-    def whitened_from(self, pred: Mapping[str, np.ndarray]) -> np.ndarray:
-        return self._whitened_logdet(pred)[0]
-
-    def _whitened_logdet(self, pred: Mapping[str, np.ndarray]) -> tuple[np.ndarray, float]:
-        out, pseudo, logdet = [], [], 0.0
-        for c in self.channels:
-            nz = self.noise[c]
-            w = whiten(self._raw_scaled(c, pred[c]), sd=nz.sd, rho=nz.rho_long_run)
-            d, _, V, sds, ld = self._nuisances(c, pred[c], w)
-            out.append(w - V @ d)
-            pseudo.append(d / sds)
-            logdet += ld
-        return np.concatenate(out + pseudo), logdet
 
 
 def robust_covariance(jacobian: np.ndarray, whitened: np.ndarray, cov: np.ndarray, blocks: np.ndarray, *,

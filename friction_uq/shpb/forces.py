@@ -19,7 +19,7 @@ import numpy as np
 from ..physics import bars as eq
 from ..signals import NoiseEstimate, transport
 from .record import BarProperties, TwoBarRecord
-from .waves import PULSE_END_FRACTION, gauge_waves
+from .waves import PULSE_END_FRACTION, gauge_waves  # noqa: F401 - PULSE_END_FRACTION handed on by the package
 
 #: Fraction of the peak transmitted force above which the balance is assessed (the loading).
 BALANCE_LEVEL = 0.5
