@@ -7,7 +7,9 @@ command as a user starts it (a new process each time, imports included). Prints
    and their median;
 2. the breakdown of one in-process run: imports, signals (read, forces, window), sampling, the
    DataTree (pointwise log-likelihood, ESS, R-hat), sensitivity (nu priors by PSIS reweighting,
-   prior-data conflict), outputs (netCDF, JSON, renames), PDF;
+   prior-data conflict), analysis (the lab's identification), whole_record (the simulator fitted
+   to every gauge and the misfit decision: issue target <= 2 s), outputs (netCDF, JSON, renames),
+   PDF;
 3. ESS of f (bulk and tail; must be >= 2000), ESS per second of sampling, steps, R-hat max.
 
 On a shared machine wall times are noisy: quote CPU time beside them.
@@ -70,7 +72,7 @@ with tempfile.TemporaryDirectory() as out:
 st = dict(imports=imports, **res.stages)
 print()
 print("stage        seconds")
-for k in ("imports", "signals", "sampling", "datatree", "sensitivity", "outputs", "pdf"):
+for k in ("imports", "signals", "sampling", "datatree", "sensitivity", "analysis", "whole_record", "outputs", "pdf"):
     print(f"{{k:<12}} {{st.get(k, 0.0):7.2f}}")
 print(f"{{'sum':<12}} {{sum(st.values()):7.2f}}")
 print()
