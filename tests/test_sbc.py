@@ -14,8 +14,8 @@ model is not the likelihood's own (white + AR(1) against AR(1)), so it tests the
 whole chain.
 
 The gate of the default suite uses a 99 % binomial band (few replicas: a 95 % band fails by chance
-one seed in twenty, libraries.md); the full study (>= 100 replicas, 95 % band) is marked slow and
-is also ``benchmarks/bench_sbc.py``.
+one seed in twenty, libraries.md); the full study (>= 100 replicas, a family-wise 95 % band over its
+8 assertions) is marked slow and is also ``benchmarks/bench_sbc.py``.
 
 ``closed_form_data`` here is the synthetic-data builder shared by the other test modules of the
 likelihood, sampler and diagnostics.
@@ -190,13 +190,22 @@ def test_sbc_coverage_gate():
         assert lo <= cf <= hi, f"hoop={hoop}: f coverage {cf:.3f} outside the 99 % band [{lo:.3f}, {hi:.3f}]"
 
 
+#: The full study makes 8 coverage assertions (kappa and f, with and without the hoop term, closed-form
+#: stationary phases and whole records): each is held to the binomial band of a family-wise 95 %
+#: (Bonferroni), so that a correct sampler fails the study by chance one run in twenty, not one in
+#: three as with a 95 % band per assertion. (Kappa with the hoop term on closed-form phases, seeds
+#: 20000-20199, covers 171/200 with the sampler before its parameters were addressed by name and
+#: 170/200 after: the same statistics, other bits, on the edge of a per-assertion 95 % band.)
+FULL_STUDY_LEVEL = 1.0 - 0.05 / 8
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("source", ["closed-form", "records"])
 @pytest.mark.parametrize("hoop", [False, True])
 def test_sbc_coverage_full(hoop, source):
-    """200 replicas: coverage of kappa and f inside the binomial 95 % band around 90 %."""
+    """200 replicas: coverage of kappa and f inside the binomial band (family-wise 95 %) around 90 %."""
     n = 200
-    lo, hi = binomial_band(n, 0.9, 0.95)
+    lo, hi = binomial_band(n, 0.9, FULL_STUDY_LEVEL)
     reps = run_sbc(n, seed=(20_000 if hoop else 10_000) + (50_000 if source == "records" else 0), hoop=hoop,
                    source=source)
     ck, cf = coverage(reps)
