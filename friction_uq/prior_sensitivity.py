@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .models.parameters import effective_sample_size
 from .priors import Priors
 from .sampler import PosteriorSamples, sample_posterior
 from .window import StationaryData
@@ -104,7 +105,7 @@ def reweight(samples: PosteriorSamples, used: Priors, other: Priors, *, label: s
     n = min(len(f), 4000)
     pick = np.searchsorted(np.cumsum(w), (rng.random() + np.arange(n)) / n)  # systematic resampling
     return FUnderPrior(label, other.subset(samples.names).describe(), mean, sd, float(q[0]), float(q[1]),
-                       float(q[2]), f[np.minimum(pick, len(f) - 1)], "reweighted", float(k), float(1.0 / np.sum(w**2)))
+                       float(q[2]), f[np.minimum(pick, len(f) - 1)], "reweighted", float(k), effective_sample_size(w))
 
 
 def nu_sensitivity(

@@ -18,8 +18,9 @@ from friction_uq.discrepancy.mechanisms import MECHANISMS, Mechanism, register
 from friction_uq.models.parameters import F, HOOP_GAIN, NU
 from friction_uq.priors import default_prior_path, load_priors
 from friction_uq.record import read_record
-from friction_uq.simulate import SimulationConfig, simulate_to_file
+from friction_uq.simulate import simulate_to_file
 from friction_uq.simulate.config import ChannelSpec
+from simulated import noisy_config
 
 REQUIRED = ("velocity_friction", "pressure_friction", "slip_friction", "clearance", "plug_friction", "gauge_gain",
             "dispersion", "end_friction")
@@ -68,7 +69,7 @@ def test_extended_models_fitted_on_two_processes_are_the_same_bits(tmp_path):
     from friction_uq.discrepancy.extended import Diagnoser, Variant
 
     path = tmp_path / "r.h5"
-    simulate_to_file(_config(friction_params=MappingProxyType({"f": 0.06})), path, seed=31)
+    simulate_to_file(noisy_config(friction_params=MappingProxyType({"f": 0.06})), path, seed=31)
     prep = prepare(read_record(path))
     priors = load_priors(default_prior_path("I1"))
 
@@ -85,17 +86,6 @@ def test_extended_models_fitted_on_two_processes_are_the_same_bits(tmp_path):
             np.testing.assert_array_equal(a.fit.draws[name], b.fit.draws[name])
         assert a.elpd.total == b.elpd.total
         assert b.lik is not None and b.lik.model.parameters.names == a.lik.model.parameters.names
-
-
-def _config(**kw) -> SimulationConfig:
-    ch = {
-        "input_bar": ChannelSpec(white=3e-6, ar1=2e-6, ar1_coef=0.5, offset=1e-5),
-        "internal_output_bar": ChannelSpec(white=2e-6, ar1=2e-6, ar1_coef=0.4, offset=-5e-6),
-        "external_output_bar": ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, offset=1e-6),
-        "tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3),
-    }
-    ch.update(kw.pop("channels", {}))
-    return SimulationConfig(channels=MappingProxyType(ch), **kw)
 
 
 def _diagnose(tmp_path, cfg, seed):
@@ -115,7 +105,7 @@ def _diagnose(tmp_path, cfg, seed):
 
 
 def test_clean_record_names_no_cause(tmp_path):
-    prep, dg = _diagnose(tmp_path, _config(striker_velocity=9.0, poisson_ratio=0.39,
+    prep, dg = _diagnose(tmp_path, noisy_config(striker_velocity=9.0, poisson_ratio=0.39,
                                            friction_params=MappingProxyType({"f": 0.06})), seed=21)
     assert dg.cause is None, [(r.fit.label, r.delpd, r.se) for r in dg.ranking]
     fx = dg.final.f_summary()
@@ -128,7 +118,7 @@ def test_clean_record_names_no_cause(tmp_path):
 def test_a_hoop_gauge_calibration_error_is_said_not_named(tmp_path):
     """The hoop gauge's gain is profiled in every model: a 5 % calibration error is no mechanism, but the
     sentence says it (data/B hides one)."""
-    prep, dg = _diagnose(tmp_path, _config(striker_velocity=10.0, friction_params=MappingProxyType({"f": 0.06}),
+    prep, dg = _diagnose(tmp_path, noisy_config(striker_velocity=10.0, friction_params=MappingProxyType({"f": 0.06}),
                                            channels={"tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3,
                                                                               gain=0.95)}), seed=24)
     assert dg.cause is None, [(r.fit.label, r.delpd, r.se) for r in dg.ranking]
@@ -139,7 +129,7 @@ def test_a_hoop_gauge_calibration_error_is_said_not_named(tmp_path):
 
 
 def test_plug_friction_is_named_and_f_recovered(tmp_path):
-    prep, dg = _diagnose(tmp_path, _config(striker_velocity=11.0, plug_friction_force=300.0,
+    prep, dg = _diagnose(tmp_path, noisy_config(striker_velocity=11.0, plug_friction_force=300.0,
                                            plug_friction_coefficient=0.015,
                                            friction_params=MappingProxyType({"f": 0.05})), seed=22)
     assert dg.cause is not None and dg.cause.mechanism.name == "plug_friction"
@@ -154,7 +144,7 @@ def test_plug_friction_is_named_and_f_recovered(tmp_path):
 
 
 def test_external_gauge_gain_is_named_with_its_channel(tmp_path):
-    prep, dg = _diagnose(tmp_path, _config(channels={"external_output_bar": ChannelSpec(
+    prep, dg = _diagnose(tmp_path, noisy_config(channels={"external_output_bar": ChannelSpec(
         white=1e-6, ar1=1e-6, ar1_coef=0.6, gain=1.12)}), seed=23)
     assert dg.cause is not None
     assert (dg.cause.mechanism.name, dg.cause.channel) == ("gauge_gain", "external_output_bar")
@@ -163,7 +153,7 @@ def test_external_gauge_gain_is_named_with_its_channel(tmp_path):
 
 
 def test_clearance_is_named_and_the_gap_measured(tmp_path):
-    prep, dg = _diagnose(tmp_path, _config(gap=8e-6, tube_compliance=True), seed=24)
+    prep, dg = _diagnose(tmp_path, noisy_config(gap=8e-6, tube_compliance=True), seed=24)
     assert dg.cause is not None and dg.cause.mechanism.name == "clearance"
     gap = dg.final.fit.draws["gap"]
     assert np.quantile(gap, 0.005) <= 8e-6 <= np.quantile(gap, 0.995)

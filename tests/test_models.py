@@ -16,8 +16,8 @@ from friction_uq.models import SimulatorModel, measured_loading
 from friction_uq.models.parameters import F, HOOP_GAIN, NU, Parameter, ParameterSet
 from friction_uq.record import read_record
 from friction_uq.simulate import SimulationConfig, simulate_to_file
-from friction_uq.simulate.config import ChannelSpec
 from friction_uq.simulate.model import run_model
+from simulated import noisy_config
 
 
 ODDS = dataclasses.replace(NU, transform="logodds")
@@ -71,19 +71,9 @@ def test_parameters_are_addressed_by_name():
         ParameterSet((F, F))
 
 
-def _noisy_config(**kw) -> SimulationConfig:
-    ch = {
-        "input_bar": ChannelSpec(white=3e-6, ar1=2e-6, ar1_coef=0.5, offset=1e-5),
-        "internal_output_bar": ChannelSpec(white=2e-6, ar1=2e-6, ar1_coef=0.4, offset=-5e-6),
-        "external_output_bar": ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, offset=1e-6),
-        "tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3),
-    }
-    return SimulationConfig(channels=MappingProxyType(ch), **kw)
-
-
 @pytest.fixture(scope="module")
 def trapezoid_record(tmp_path_factory):
-    cfg = _noisy_config(striker_velocity=11.0, poisson_ratio=0.38,
+    cfg = noisy_config(striker_velocity=11.0, poisson_ratio=0.38,
                         friction_params=MappingProxyType({"f": 0.07}))
     path = tmp_path_factory.mktemp("sim") / "trap.h5"
     simulate_to_file(cfg, path, seed=11)

@@ -17,8 +17,8 @@ from friction_uq.discrepancy.whole_record import longest_sign_run, whiten
 from friction_uq.likelihood import ar1_noise
 from friction_uq.priors import default_prior_path, load_priors
 from friction_uq.record import read_record
-from friction_uq.simulate import SimulationConfig, simulate_to_file
-from friction_uq.simulate.config import ChannelSpec
+from friction_uq.simulate import simulate_to_file
+from simulated import noisy_config
 
 
 @settings(max_examples=25, deadline=None)
@@ -55,16 +55,6 @@ def test_tolerance_forgives_only_what_lies_inside_it():
     np.testing.assert_allclose(tolerated(r, np.ones(4)), [0.0, 0.0, 1.0, -2.0])
 
 
-def _config(**kw) -> SimulationConfig:
-    ch = {
-        "input_bar": ChannelSpec(white=3e-6, ar1=2e-6, ar1_coef=0.5, offset=1e-5),
-        "internal_output_bar": ChannelSpec(white=2e-6, ar1=2e-6, ar1_coef=0.4, offset=-5e-6),
-        "external_output_bar": ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, offset=1e-6),
-        "tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3),
-    }
-    return SimulationConfig(channels=MappingProxyType(ch), **kw)
-
-
 def _check(path):
     rec = read_record(path)
     prep = prepare(rec)
@@ -79,7 +69,7 @@ def _check(path):
 @pytest.mark.parametrize("seed", [1, 2])
 def test_clean_record_has_no_misfit(tmp_path, seed):
     path = tmp_path / "clean.h5"
-    simulate_to_file(_config(striker_velocity=8.0 + seed, poisson_ratio=0.41,
+    simulate_to_file(noisy_config(striker_velocity=8.0 + seed, poisson_ratio=0.41,
                              friction_params=MappingProxyType({"f": 0.06})), path, seed=seed)
     chk = _check(path)
     assert not chk.decision.detected, chk.decision.sentence()
@@ -89,7 +79,7 @@ def test_clean_record_has_no_misfit(tmp_path, seed):
 
 def test_plug_friction_is_a_misfit(tmp_path):
     path = tmp_path / "plug.h5"
-    simulate_to_file(_config(plug_friction_force=400.0, plug_friction_coefficient=0.02), path, seed=4)
+    simulate_to_file(noisy_config(plug_friction_force=400.0, plug_friction_coefficient=0.02), path, seed=4)
     chk = _check(path)
     assert chk.decision.detected
     assert chk.decision.statistic > THRESHOLD
@@ -100,7 +90,7 @@ def test_plug_friction_is_a_misfit(tmp_path):
 def test_clearance_is_a_misfit_on_the_hoop_gauge(tmp_path):
     """A 10 um clearance delays and lowers the wall pressure: the hoop gauge reads well below the model."""
     path = tmp_path / "gap.h5"
-    simulate_to_file(_config(gap=10e-6, tube_compliance=True), path, seed=5)
+    simulate_to_file(noisy_config(gap=10e-6, tube_compliance=True), path, seed=5)
     chk = _check(path)
     assert chk.decision.detected
     assert any(c.channel == "tube_hoop" for c in chk.decision.flagged())

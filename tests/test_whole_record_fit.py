@@ -13,19 +13,17 @@ from friction_uq.analysis import prepare
 from friction_uq.discrepancy.fit import GAIN_SD, WholeRecordLikelihood, robust_covariance
 from friction_uq.models import SimulatorModel, measured_loading
 from friction_uq.record import read_record
-from friction_uq.simulate import SimulationConfig, simulate_to_file
+from friction_uq.simulate import simulate_to_file
 from friction_uq.simulate.config import ChannelSpec
+from simulated import noisy_config
 
 
 @pytest.fixture(scope="module")
 def lik(tmp_path_factory):
-    ch = {"input_bar": ChannelSpec(white=3e-6, ar1=2e-6, ar1_coef=0.5, offset=1e-5),
-          "internal_output_bar": ChannelSpec(white=2e-6, ar1=2e-6, ar1_coef=0.4, offset=-5e-6),
-          "external_output_bar": ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, offset=1e-6, gain=1.02),
-          "tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3)}
+    gain = {"external_output_bar": ChannelSpec(white=1e-6, ar1=1e-6, ar1_coef=0.6, offset=1e-6, gain=1.02)}
     path = tmp_path_factory.mktemp("wr") / "r.h5"
-    simulate_to_file(SimulationConfig(channels=MappingProxyType(ch), friction_params=MappingProxyType({"f": 0.06}),
-                                      poisson_ratio=0.4), path, seed=3)
+    simulate_to_file(noisy_config(channels=gain, friction_params=MappingProxyType({"f": 0.06}), poisson_ratio=0.4),
+                     path, seed=3)
     rec = read_record(path)
     prep = prepare(rec)
     return WholeRecordLikelihood(prep, SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), hoop=True))

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import logsumexp
 
+from ..models.parameters import effective_sample_size
 from ..priors import Priors
 
 MAX_MC_VARIANCE = 1.0
@@ -125,7 +126,7 @@ def pool(tests: Sequence[StoredDraws], variable: str, *, n_mu: int = 81, n_sigma
     for t in tests:
         log_w = -0.5 * ((t.draws - mu[i_m]) / sigma[i_s]) ** 2 - t.log_prior
         w = np.exp(log_w - log_w.max())
-        ess[t.label] = float(w.sum() ** 2 / np.sum(w**2))
+        ess[t.label] = effective_sample_size(w)
     mu_q = _quantiles(mu, p.sum(axis=0))
     sigma_q = _quantiles(sigma, p.sum(axis=1))
     refused = None

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..models.parameters import summarize_draws
+from ..models.parameters import effective_sample_size, summarize_draws
 from .diagnose import Diagnosis, ModelFit, Ranked
 from .whole_record import CHANNEL_LABELS
 
@@ -12,11 +12,11 @@ from .whole_record import CHANNEL_LABELS
 HOOP_GAIN_FINDING = 0.03
 
 
-def effective_sample_size(log_weights: np.ndarray) -> float:
-    """Kish's effective sample size of weighted draws, 1 / sum(w^2) (the draws are independent: normal draws
-    around the mode, equally weighted unless importance-corrected)."""
-    w = np.exp(np.asarray(log_weights, float) - np.logaddexp.reduce(log_weights))
-    return float(1.0 / np.sum(w * w))
+def _ess(log_weights: np.ndarray) -> float:
+    """Effective sample size of a fit's draws (independent normal draws, equally weighted unless
+    importance-corrected)."""
+    lw = np.asarray(log_weights, float)
+    return effective_sample_size(np.exp(lw - np.max(lw)))
 
 
 def _entry(r: Ranked) -> dict[str, object]:
@@ -24,7 +24,7 @@ def _entry(r: Ranked) -> dict[str, object]:
     params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
     return {"name": v.mechanism.name, "channel": v.channel, "model": r.fit.label, "delpd": r.delpd, "se": r.se,
             "decisive": r.decisive, "parameters": params, "f_effective": summarize_draws(r.fit.f_effective),
-            "draws": int(len(r.fit.f_effective)), "ess": effective_sample_size(r.fit.fit.log_weights)}
+            "draws": int(len(r.fit.f_effective)), "ess": _ess(r.fit.fit.log_weights)}
 
 
 def _describe(dg: Diagnosis) -> str:
@@ -58,11 +58,15 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
             f"{_hoop_finding(dg)}.")
 
 
+def hoop_gain_off(dg: Diagnosis) -> bool:
+    """The final model's profiled hoop calibration factor is more than HOOP_GAIN_FINDING from 1."""
+    return "tube_hoop" in dg.final.predicted and abs(dg.final.hoop_gain - 1.0) > HOOP_GAIN_FINDING
+
+
 def _hoop_finding(dg: Diagnosis) -> str:
-    g = dg.final.hoop_gain
-    if "tube_hoop" not in dg.final.predicted or abs(g - 1.0) <= HOOP_GAIN_FINDING:
+    if not hoop_gain_off(dg):
         return ""
-    return f"; the tube hoop gauge reads {g:.2f} times the model's strain (its calibration factor, profiled)"
+    return f"; the tube hoop gauge reads {dg.final.hoop_gain:.2f} times the model's strain (its calibration factor, profiled)"
 
 
 def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
@@ -82,7 +86,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
         "f_baseline_stationary": f_without,
         "f_baseline_whole_record": dg.baseline.f_summary(),
         "nu_extended": summarize_draws(dg.final.fit.draws["nu"]),
-        "hoop_gain": {"value": hoop, "finding": abs(hoop - 1.0) > HOOP_GAIN_FINDING,
+        "hoop_gain": {"value": hoop, "finding": hoop_gain_off(dg),
                       "meaning": "calibration factor of the tube hoop gauge (recorded / true), profiled in the "
                                  "whole-record fit of the final model"},
         "residual_rms": {ch: {ph: {"before": b, "after": a} for ph, (b, a) in phases.items()}

@@ -117,6 +117,12 @@ def summarize_draws(v: np.ndarray) -> dict[str, float]:
             "q95": float(q[2])}
 
 
+def effective_sample_size(weights: np.ndarray) -> float:
+    """Kish's effective sample size of weighted draws, (sum w)^2 / sum w^2 (weights need not be normalised)."""
+    w = np.asarray(weights, float)
+    return float(w.sum() ** 2 / np.sum(w * w))
+
+
 class ParameterSet:
     """An ordered set of :class:`Parameter` with lookup by name."""
 
