@@ -66,7 +66,8 @@ def hoop_gain_off(dg: Diagnosis) -> bool:
 def _hoop_finding(dg: Diagnosis) -> str:
     if not hoop_gain_off(dg):
         return ""
-    return f"; the tube hoop gauge reads {dg.final.hoop_gain:.2f} times the model's strain (its calibration factor, profiled)"
+    g = dg.final.hoop_gain
+    return f"; the tube hoop gauge reads {g:.2f} times the model's strain (its calibration factor, profiled)"
 
 
 def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
