@@ -36,6 +36,9 @@ class RecordPosterior:
     p_mean: np.ndarray
     V: dict[str, float]
     prior_file: str
+    #: f under the model the record's diagnosis chose (its headline f): the extended model's f_effective
+    #: when a cause was named, the stationary posterior's f when none was; None without a diagnosis
+    f_model: np.ndarray | None = None
 
 
 @dataclass
@@ -62,7 +65,7 @@ class CampaignAnalysis:
         y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref)
         if fit.model.offset_setup == setup:
             y = y * (1.0 + th["delta"])
-        return y * fit.kbar * (1.0 - self.nu[0]) / self.nu[0]
+        return y * fit.kbar * fit.data.to_f(self.nu[0])
 
 
 def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
@@ -74,11 +77,15 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
         dt = xr.open_datatree(nc, engine="h5netcdf")
         post = dt["posterior"]
         draws = {k: thin(post[k].values) for k in ("f", "kappa", "nu", "p_mean")}
+        f_model = None
+        if "discrepancy_baseline" in dt.children:  # diagnosed
+            final = str(dt.attrs.get("discrepancy_final_group", ""))
+            f_model = thin(dt[f"{final}/posterior"]["f_effective"].values) if final else draws["f"]
         dt.close()
     except (OSError, KeyError, ValueError) as exc:
         raise FrictionUQError(f"{nc}: cannot read the posterior draws of {r.label} ({exc})") from None
     return RecordPosterior(r.label, str(r.campaign), draws["f"], draws["kappa"], draws["nu"], draws["p_mean"],
-                         r.summary["V"], str(r.prior_file))
+                           r.summary["V"], str(r.prior_file), f_model)
 
 
 def campaign_nu(tests: Sequence[RecordPosterior], prior_mean: float, prior_sd: float) -> tuple[float, float]:
@@ -91,10 +98,16 @@ def campaign_nu(tests: Sequence[RecordPosterior], prior_mean: float, prior_sd: f
 
 
 def _law_data(tests: Sequence[RecordPosterior]) -> LawData:
+    """The laws' data: f under each test's diagnosed model when every test was diagnosed (a cause such as
+    a clearance or a plug friction biases the stationary kappa by a load-dependent amount that a law
+    in (p, V) would otherwise absorb), else the stationary kappa."""
+    diagnosed = all(t.f_model is not None for t in tests)
+    y = [t.f_model if diagnosed else t.kappa for t in tests]
     return LawData([t.label for t in tests], [t.setup for t in tests],
-                   np.array([np.mean(t.kappa) for t in tests]), np.array([np.std(t.kappa) for t in tests]),
+                   np.array([np.mean(v) for v in y]), np.array([np.std(v) for v in y]),
                    np.array([t.V["mean"] for t in tests]), np.array([t.V["sd"] for t in tests]),
-                   np.array([np.mean(t.p_mean) for t in tests]), np.array([np.std(t.p_mean) for t in tests]))
+                   np.array([np.mean(t.p_mean) for t in tests]), np.array([np.std(t.p_mean) for t in tests]),
+                   basis="f" if diagnosed else "kappa")
 
 
 def _nested(a: Model, b: Model) -> bool:
@@ -119,11 +132,12 @@ def _summ(x: np.ndarray) -> dict[str, float]:
 
 
 def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np.ndarray]:
-    """The law's parameters in f units: kappa-law draws times (1-nu)/nu with the campaign's nu."""
+    """The law's parameters in f units: kappa-law draws times (1-nu)/nu with the campaign's nu (a law
+    fitted to f directly: times its scale only)."""
     rng = np.random.default_rng(seed)
     x = fit.draws
     nu_d = np.clip(rng.normal(nu[0], nu[1], len(x)), 1e-3, 0.499)
-    g = fit.kbar * (1.0 - nu_d) / nu_d
+    g = fit.kbar * fit.data.to_f(nu_d)
     col = {p: x[:, k] for k, p in enumerate(fit.model.params)}
     out: dict[str, np.ndarray] = {}
     if "a" in col:

@@ -3,7 +3,10 @@
 Each test gives kappa = f nu/(1-nu) (what its forces fix, to < 1 %: a normal approximation of its
 draws), its sliding velocity V and mean wall pressure p (measured, with their sd). The sample is
 one material, so nu is shared: a law for f is a law for kappa up to the factor nu/(1-nu), and the
-laws are fitted to kappa (in units of the campaign's mean kappa, y = kappa / kappa_bar):
+laws are fitted to kappa (in units of the campaign's mean kappa, y = kappa / kappa_bar). When
+every test was diagnosed, the laws are fitted to f under each test's diagnosed model instead
+(``LawData.basis = "f"``; y = f / f_bar), which the mechanism found (a clearance, a plug
+friction) no longer biases:
 
 * ``constant``:           y = a
 * ``velocity``:           y = d + (s - d) exp(-V / v_c)   (the mechanism catalogue's form)
@@ -53,15 +56,23 @@ class LawData:
     V_sd: np.ndarray
     p: np.ndarray
     p_sd: np.ndarray
+    #: what ``kappa`` holds: "kappa" (f nu/(1-nu) of the stationary phase) or "f" (f itself, under
+    #: each test's diagnosed model)
+    basis: str = "kappa"
 
     @property
     def n(self) -> int:
         return len(self.labels)
 
+    def to_f(self, nu: float | np.ndarray) -> float | np.ndarray:
+        """Factor from the data's unit to f: (1-nu)/nu for kappa, 1 for f."""
+        return (1.0 - nu) / nu if self.basis == "kappa" else 1.0 + 0.0 * nu
+
     def drop(self, i: int) -> LawData:
         keep = np.arange(self.n) != i
         return LawData([x for k, x in enumerate(self.labels) if k != i], [x for k, x in enumerate(self.setups) if k != i],
-                       *(getattr(self, f)[keep] for f in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")))
+                       *(getattr(self, f)[keep] for f in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")),
+                       basis=self.basis)
 
 
 @dataclass(frozen=True)

@@ -45,13 +45,15 @@ def statements(ca: CampaignAnalysis) -> list[str]:
     if ca.best:
         post = ca.law_posterior
         parts = [f"{k} {v['q50']:.3g} [{v['q05']:.3g}, {v['q95']:.3g}]" for k, v in post.items()]
-        out.append(f"friction law: {ca.best} (model {ca.chosen}); " + ", ".join(parts))
+        basis = "" if ca.law_data is None or ca.law_data.basis == "kappa" else ", fitted to f under each test's diagnosed model"
+        out.append(f"friction law: {ca.best} (model {ca.chosen}{basis}); " + ", ".join(parts))
     out.extend(ca.sentences)
     for f in ca.flagged:
         if "setup" in f:
             off = f["offset"]
             rel = f" relative to {f['relative_to']}" if "relative_to" in f else ""
-            out.append(f"flagged: set-up {f['setup']} does not follow the shared law{rel}: kappa offset "
+            unit = "kappa" if ca.law_data is None or ca.law_data.basis == "kappa" else "f"
+            out.append(f"flagged: set-up {f['setup']} does not follow the shared law{rel}: {unit} offset "
                        f"{off['q50'] * 100:+.0f} % [{off['q05'] * 100:+.0f}, {off['q95'] * 100:+.0f}], dELPD "
                        f"{f['d_elpd']:.1f} (SE {f['d_se']:.1f})")
             if "note" in f:
@@ -86,7 +88,10 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
         "pooled": {k: p.to_json() for k, p in ca.pooled.items()},
         "friction_law": {"best": ca.best, "chosen_model": ca.chosen, "ranking": ca.ranking,
                          "posterior": ca.law_posterior, "models": models,
-                         "nu": {"mean": ca.nu[0], "sd": ca.nu[1]}},
+                         "nu": {"mean": ca.nu[0], "sd": ca.nu[1]},
+                         "fitted_to": None if ca.law_data is None else
+                         ("f under each test's diagnosed model" if ca.law_data.basis == "f" else
+                          "kappa = f nu/(1-nu) of the stationary phase, converted with the campaign's nu")},
         "flagged": ca.flagged,
         "causes": ca.tallies,
         "statements": statements(ca),
@@ -117,12 +122,14 @@ def write_netcdf(ca: CampaignAnalysis, path: Path) -> Path:
         d = ca.law_data
         groups["tests"] = xr.Dataset(
             {k: ("test", getattr(d, k)) for k in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")}
-            | {"setup": ("test", np.array(d.setups, dtype=str))}, coords={"test": np.array(d.labels, dtype=str)})
+            | {"setup": ("test", np.array(d.setups, dtype=str))}, coords={"test": np.array(d.labels, dtype=str)},
+            attrs={"kappa_holds": d.basis})
         for name, fit in ca.fits.items():
             groups[f"law_{_group(name)}"] = xr.Dataset(
                 {"draws": (("draw", "parameter"), fit.draws)},
                 coords={"parameter": list(fit.model.params)},
-                attrs={"model": name, "kappa_bar": fit.kbar, "p_ref": fit.p_ref, "units": "kappa / kappa_bar"})
+                attrs={"model": name, "kappa_bar": fit.kbar, "p_ref": fit.p_ref,
+                       "units": "kappa / kappa_bar" if fit.data.basis == "kappa" else "f / f_bar"})
     dt = xr.DataTree.from_dict({"/": xr.Dataset(attrs={"friction_uq_version": __version__,
                                                        "best_law": ca.best or "none"})}
                                | {f"/{k}": v for k, v in groups.items()})

@@ -104,14 +104,21 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
     }
 
 
+def group_key(label: str) -> str:
+    """The DataTree group name part of a fitted model's label (``discrepancy_<key>``)."""
+    return label.replace("[", "_").replace("]", "").replace("+", "__")
+
+
 def add_to_datatree(dt, dg: Diagnosis) -> None:
     """One group per fitted model under ``discrepancy``: the Laplace draws (posterior) and the pointwise
     block elpd (log_likelihood)."""
     import xarray as xr
 
     fits: list[ModelFit] = [dg.baseline] + [r.fit for rnd in dg.rounds for r in rnd]
+    # the group of the model the headline f comes from (empty: no cause named, the stationary posterior's f)
+    dt.attrs["discrepancy_final_group"] = f"discrepancy_{group_key(dg.final.label)}" if dg.causes else ""
     for mf in fits:
-        key = mf.label.replace("[", "_").replace("]", "").replace("+", "__")
+        key = group_key(mf.label)
         post = {n: (("chain", "draw"), v[None]) for n, v in mf.fit.draws.items()}
         post["f_effective"] = (("chain", "draw"), mf.f_effective[None])
         ll = {"block_elpd": (("block",), mf.elpd.pointwise)}

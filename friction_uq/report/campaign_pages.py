@@ -57,12 +57,13 @@ def _law_page(ca: CampaignAnalysis):
     d = ca.law_data
     name = ca.chosen or str(ca.ranking[0]["model"])
     nu = ca.nu[0]
-    fig, axes = figure(f"f at the campaign's nu = {nu:.3f} against V and p; band: {name} (90 %)", nrows=1, ncols=2)
+    head = f"f at the campaign's nu = {nu:.3f}" if d.basis == "kappa" else "f under each test's diagnosed model"
+    fig, axes = figure(f"{head} against V and p; band: {name} (90 %)", nrows=1, ncols=2)
     setups = sorted(set(d.setups))
     for k, s in enumerate(setups):
         on = np.array([x == s for x in d.setups])
-        f = d.kappa[on] * (1 - nu) / nu
-        fsd = d.kappa_sd[on] * (1 - nu) / nu
+        f = d.kappa[on] * d.to_f(nu)
+        fsd = d.kappa_sd[on] * d.to_f(nu)
         # the set-up's (V, p) line: p rises with V through the striker speed
         coef = np.polyfit(d.V[on], d.p[on], 1) if on.sum() > 1 else np.array([0.0, d.p[on][0]])
         vv = np.linspace(d.V[on].min() * 0.9, d.V[on].max() * 1.1, 60)
@@ -75,7 +76,7 @@ def _law_page(ca: CampaignAnalysis):
     axes[0].set_xlabel("sliding velocity V (m/s)")
     axes[1].set_xlabel("mean wall pressure p_mean (MPa)")
     for ax in axes:
-        ax.set_ylabel("f = kappa (1-nu)/nu")
+        ax.set_ylabel("f = kappa (1-nu)/nu" if d.basis == "kappa" else "f under each test's diagnosed model")
         ax.legend(fontsize=8)
     return fig
 
