@@ -114,6 +114,34 @@ def test_diagnosed_tests_fit_the_law_to_f_under_their_models_not_to_a_biased_kap
     assert analyse_tests(tests, tally_causes([]), seed=3).law_data.basis == "kappa"
 
 
+@pytest.mark.parametrize("final", [None, "", "discrepancy_clearance"])
+def test_f_under_the_diagnosed_model_is_read_from_the_group_the_record_names(tmp_path, final):
+    """The .nc names the group of its headline f: a cause's group, empty (no cause: the stationary f) or
+    nothing (no diagnosis, or a version before the attribute: the law falls back to kappa)."""
+    import xarray as xr
+
+    from friction_uq.campaign.analysis import read_test_posterior
+
+    rng = np.random.default_rng(0)
+    post = {k: (("chain", "draw"), rng.normal(m, 0.01 * m, (2, 500)))
+            for k, m in (("f", 0.05), ("kappa", 0.033), ("nu", 0.4), ("p_mean", 1e8))}
+    groups = {"/posterior": xr.Dataset(post),
+              "/discrepancy_clearance/posterior": xr.Dataset({"f_effective": (("chain", "draw"),
+                                                                             rng.normal(0.06, 0.002, (1, 800)))})}
+    dt = xr.DataTree.from_dict(groups)
+    if final is not None:
+        dt.attrs["discrepancy_final_group"] = final
+    dt.to_netcdf(tmp_path / "A_A-01.nc", engine="h5netcdf")
+    r = RecordResult(path="A-01.h5", status="done", campaign="A", test_id="A-01", prior_file=PRIOR,
+                     outputs={"netcdf": "A_A-01.nc"}, summary={"V": {"mean": 9.0, "sd": 0.1}})
+    t = read_test_posterior(r, tmp_path)
+    if final is None:
+        assert t.f_model is None
+    else:
+        assert t.f_model is not None
+        assert np.mean(t.f_model) == pytest.approx(0.06 if final else 0.05, rel=0.02)
+
+
 def test_a_constant_friction_campaign_names_constant_and_flags_nothing():
     rng = np.random.default_rng(7)
     tests = [_test(rng, f"A-0{k}", "A", V, 9e6 * V, 0.05) for k, V in enumerate(np.linspace(5, 13, 6))]

@@ -78,8 +78,8 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
         post = dt["posterior"]
         draws = {k: thin(post[k].values) for k in ("f", "kappa", "nu", "p_mean")}
         f_model = None
-        if "discrepancy_baseline" in dt.children:  # diagnosed
-            final = str(dt.attrs.get("discrepancy_final_group", ""))
+        final = dt.attrs.get("discrepancy_final_group")  # diagnosed (absent: no diagnosis, or an older version)
+        if final is not None:
             f_model = thin(dt[f"{final}/posterior"]["f_effective"].values) if final else draws["f"]
         dt.close()
     except (OSError, KeyError, ValueError) as exc:
