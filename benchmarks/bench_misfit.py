@@ -28,6 +28,7 @@ from scipy import stats
 
 from friction_uq.analysis import prepare
 from friction_uq.discrepancy.check import check_whole_record
+from friction_uq.discrepancy.outcome import HOOP_GAIN_FINDING
 from friction_uq.errors import FrictionUQError
 from friction_uq.likelihood import Likelihood
 from friction_uq.priors import default_prior_path, load_priors
@@ -102,6 +103,7 @@ def main() -> None:
     rng = np.random.default_rng(args.seed)
     tmp = tempfile.mkdtemp()
     rows, secs, worst_clean = [], [], []
+    hoop: dict[str, list[float]] = {}
     header = (f"{'records':<36} {'n':>5} {'flag':>5} {'refused':>7} {'rate':>7}  95 % interval "
               "(flag: misfit detected, or refused: no stationary phase)")
     jobs = [("clean (false alarms)", None)] * 0
@@ -116,6 +118,7 @@ def main() -> None:
         secs.append(time.perf_counter() - t)
         hits += chk.decision.detected
         worst_clean.append(chk.decision.statistic)
+        hoop.setdefault("A" if i % 2 == 0 else "B", []).append(chk.hoop_gain)
         os.remove(p)
     rows.append(rate_line("clean (false alarms)", hits, args.clean))
     print(rows[-1], file=sys.stderr, flush=True)
@@ -137,6 +140,12 @@ def main() -> None:
     print(header)
     print("\n".join(rows))
     print(f"clean statistic quantiles 50/90/95/99 %: {q[0]:.2f} {q[1]:.2f} {q[2]:.2f} {q[3]:.2f} (threshold 5)")
+    for setup, g in sorted(hoop.items()):
+        g = np.array(g)
+        q = np.quantile(g, [0.05, 0.5, 0.95])
+        print(f"hoop gauge factor, clean set-up {setup} (true {SETUPS[setup].channels['tube_hoop'].gain:.2f}): "
+              f"5/50/95 % {q[0]:.3f} {q[1]:.3f} {q[2]:.3f}; |g - 1| > {HOOP_GAIN_FINDING:.0%} (reported) in "
+              f"{np.mean(np.abs(g - 1.0) > HOOP_GAIN_FINDING):.0%} of {len(g)}")
     if secs:
         print(f"whole-record check per record: median {np.median(secs):.2f} s, max {np.max(secs):.2f} s")
 

@@ -116,13 +116,14 @@ def test_clean_record_names_no_cause(tmp_path):
 
 
 def test_a_hoop_gauge_calibration_error_is_said_not_named(tmp_path):
-    """The hoop gauge's gain is profiled in every model: a 5 % calibration error is no mechanism, but the
-    sentence says it (data/B hides one)."""
+    """The hoop gauge's factor is marginalised in every model under its 5 % prior: a 5 % calibration error is
+    no mechanism, but its most probable value (shrunk toward 1, where nu could also explain the hoop's
+    level) moves past the reporting threshold and the sentence says it (data/B hides one)."""
     prep, dg = _diagnose(tmp_path, noisy_config(striker_velocity=10.0, friction_params=MappingProxyType({"f": 0.06}),
                                            channels={"tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3,
                                                                               gain=0.95)}), seed=24)
     assert dg.cause is None, [(r.fit.label, r.delpd, r.se) for r in dg.ranking]
-    assert dg.final.hoop_gain == pytest.approx(0.95, abs=0.015)
+    assert 0.95 - 0.015 <= dg.final.hoop_gain < 1.0 - outcome.HOOP_GAIN_FINDING
     doc = outcome.to_json(dg, {"mean": 0.06, "sd": 0.003, "q05": 0.055, "q50": 0.06, "q95": 0.065})
     assert doc["hoop_gain"]["finding"]
     assert f"the tube hoop gauge reads {dg.final.hoop_gain:.2f} times the model" in doc["sentence"]

@@ -11,6 +11,7 @@ from scipy import stats
 
 from friction_uq.analysis import prepare
 from friction_uq.discrepancy.fit import GAIN_SD, WholeRecordLikelihood, robust_covariance
+from friction_uq.discrepancy.record_likelihood import HOOP_GAIN_SD
 from friction_uq.models import SimulatorModel, measured_loading
 from friction_uq.record import read_record
 from friction_uq.simulate import simulate_to_file
@@ -36,9 +37,10 @@ def _ar1_cov(n: int, sd: float, rho: float) -> np.ndarray:
 
 def test_loglike_is_the_marginal_gaussian_over_offset_and_gain(lik):
     """Offset and gain errors marginalised: the likelihood equals the dense Gaussian with covariance
-    S + sd_off^2 w w^T + sd_g^2 p p^T per channel (w the tolerance weight, p the scaled prediction)."""
+    S + sd_off^2 w w^T + sd_g^2 p p^T per channel (w the tolerance weight, p the scaled prediction at
+    the hoop gauge's factor 1; sd_g 1 % on the output bars, 5 % on the hoop)."""
     values = {"f": 0.058, "nu": 0.41}
-    pred, _ = lik.strains(values)
+    pred = lik.unit_strains(values)
     dense = 0.0
     for c in lik.channels:
         nz = lik.noise[c]
@@ -47,18 +49,18 @@ def test_loglike_is_the_marginal_gaussian_over_offset_and_gain(lik):
         u = (lik.measured[c][i0:i3] - pred[c][i0:i3]) * w
         C = _ar1_cov(len(u), nz.sd, nz.rho_long_run)
         C += nz.offset_sd**2 * np.outer(w, w)
-        if c in GAIN_SD:
+        if c in lik.gain_sd:
             p = pred[c][i0:i3] * w
-            C += GAIN_SD[c] ** 2 * np.outer(p, p)
+            C += lik.gain_sd[c] ** 2 * np.outer(p, p)
         dense += stats.multivariate_normal(np.zeros(len(u)), C, allow_singular=False).logpdf(u) + np.sum(np.log(w))
-    assert set(GAIN_SD) <= set(lik.channels)
+    assert set(lik.gain_sd) == set(GAIN_SD) | {"tube_hoop"} and lik.gain_sd["tube_hoop"] == HOOP_GAIN_SD
     assert lik.loglike(values) == pytest.approx(dense, abs=1e-6 * abs(dense))
 
 
 def test_whitened_residuals_end_with_one_pseudo_residual_per_nuisance(lik):
     w = lik.whitened({"f": 0.06, "nu": 0.4})
     assert len(w) == lik.n_samples + lik.n_pseudo
-    assert lik.n_pseudo == sum(lik.noise[c].offset_sd > 0 for c in lik.channels) + len(GAIN_SD)
+    assert lik.n_pseudo == sum(lik.noise[c].offset_sd > 0 for c in lik.channels) + len(GAIN_SD) + 1
 
 
 def _regression(rng, n, misspecified):
@@ -91,3 +93,20 @@ def test_pressure_friction_states_the_coefficient_at_the_window_shear_stress():
     tau = f0 * p / (1 + p / p0)
     got = MECHANISMS["pressure_friction"].f_effective({"f": f0, "p0": p0}, Context(V=5.0, tau_mean=tau, slip=1e-3))
     assert got == pytest.approx(tau / p, rel=1e-12)
+
+
+def test_the_hoop_gauge_factor_is_its_most_probable_value_under_its_prior(lik):
+    """The reported hoop factor: generalised least squares shrunk toward 1 by the 5 % prior (jointly with
+    the offset); with an uninformative prior it would be the least-squares factor of the prediction."""
+    values = {"f": 0.058, "nu": 0.41}
+    unit = lik.unit_strains(values)["tube_hoop"]
+    g = lik.hoop_gain(unit)
+    pred, g2 = lik.strains(values)
+    assert g2 == g and np.allclose(pred["tube_hoop"], g * unit)
+    wide = WholeRecordLikelihood.__new__(WholeRecordLikelihood)
+    wide.__dict__.update(lik.__dict__)
+    wide.gain_sd = dict(lik.gain_sd, tube_hoop=10.0)
+    g_free = wide.hoop_gain(unit)
+    # shrinkage toward 1: between 1 and the free factor, and close to it (the hoop's level is well measured)
+    assert min(1.0, g_free) - 1e-9 <= g <= max(1.0, g_free) + 1e-9
+    assert abs(g - g_free) < 0.3 * abs(g_free - 1.0) + 1e-3

@@ -201,7 +201,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     pm, psd = float(prior0.ppf(0.5)), float(np.std(prior0.rvs(np.random.default_rng(seed), 20000)))
     with_offset = {s: (elpds[Model(law_for_flags, s).name],
                        _summ(ca.fits[Model(law_for_flags, s).name].draws[:, -2])) for s in offsets}
-    ca.flagged = setup_flags(elpds[law_for_flags], with_offset, setups, tallies)
+    ca.flagged = setup_flags(elpds[law_for_flags], with_offset, setups, tallies, quantity=data.basis)
     flagged_setups = {str(f["setup"]) for f in ca.flagged}
     if len(setups) == 2 and flagged_setups:
         flagged_setups = set(setups)

@@ -54,8 +54,9 @@ def causes_sentence(setup: str, tally: dict[str, object]) -> str:
 
 
 def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]], setups: Sequence[str],
-                tallies: dict[str, dict[str, object]]) -> list[dict[str, object]]:
-    """One entry per set-up whose offset model beats the shared law decisively."""
+                tallies: dict[str, dict[str, object]], *, quantity: str = "kappa") -> list[dict[str, object]]:
+    """One entry per set-up whose offset model beats the shared law decisively (``quantity``: what the law
+    was fitted to, kappa or f)."""
     flags = []
     pair = len(setups) == 2
     for s, (e, delta) in with_offset.items():
@@ -70,7 +71,7 @@ def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]
         if pair:
             entry["relative_to"] = other[0]
             entry["note"] = (f"with two set-ups an offset on {s} is an offset on {other[0]}: they disagree by "
-                             f"{delta['q50'] * 100:+.0f} % on kappa; which one is off needs a third set-up or "
+                             f"{delta['q50'] * 100:+.0f} % on {quantity}; which one is off needs a third set-up or "
                              "the per-record causes")
             named = {x: sum((tallies.get(x, {}).get("causes") or {}).values()) for x in setups}
             if named[s] > 0 and named[other[0]] == 0:

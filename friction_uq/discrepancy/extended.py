@@ -4,7 +4,7 @@ fitted to the whole record and scored by its expected log predictive density.
 For each mechanism (:mod:`.mechanisms`; ``gauge_gain`` once per bar gauge) the simulator driven by
 the measured incident wave, extended by the mechanism, is fitted to the whole record (:mod:`.fit`:
 posterior by a Laplace approximation; f, nu and the sample's modulus stay free, a nuisance with a
-10 % lognormal prior, the hoop gauge's gain is profiled) and scored by its expected log predictive
+10 % lognormal prior, the hoop gauge's calibration factor marginalised under its 5 % prior) and scored by its expected log predictive
 density over blocks of 10 us of every gauge (:mod:`.elpd`: exact leave-one-block-out for AR(1)
 noise). The baseline is the same simulator without extension. What is named from these scores is
 :mod:`.diagnose`'s rule.
@@ -125,13 +125,14 @@ class Diagnoser:
         block_of = self._blocks(lik)
         fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False,
                                prior_scale=scales, extra_starts=extra, score_blocks=block_of)
+        unit = lik.unit_strains(fit.mode)
         pred, gain = lik.strains(fit.mode)
         dens = []
         for c in lik.channels:
             i0, _, _, i3 = lik.bounds[c]
             nz = lik.noise[c]
             logw = np.add.reduceat(np.log(lik.weight[c]), np.arange(0, i3 - i0, self.block))
-            dens.append(ar1_block_loo(lik.scaled_residual(c, pred[c])[None], sd=nz.sd, rho=nz.rho_long_run,
+            dens.append(ar1_block_loo(lik.scaled_residual(c, unit[c])[None], sd=nz.sd, rho=nz.rho_long_run,
                                       block=self.block)[0] + logw)
         elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z, block_of)
         names = list(fit.draws)
@@ -175,8 +176,8 @@ class Diagnoser:
         return np.concatenate(blocks + [np.zeros(lik.n_pseudo, int)])
 
     def predictive(self, mf: ModelFit, n: int = 30) -> dict[str, np.ndarray]:
-        """Simulated gauges for the first ``n`` draws of a fitted model (channel -> (n, samples)), hoop gain
-        profiled."""
+        """Simulated gauges for the first ``n`` draws of a fitted model (channel -> (n, samples)), the hoop
+        gauge's most probable calibration factor applied."""
         draws = mf.fit.laplace_draws or mf.fit.draws  # the likelihood's posterior: the misfit decision's footing
         rows: dict[str, list[np.ndarray]] = {}
         for s in range(min(n, len(draws["f"]))):

@@ -84,7 +84,7 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
                      score_blocks: np.ndarray | None = None) -> WholeRecordFit:
     """Posterior mode, Laplace approximation and importance-weighted draws (module docstring).
 
-    ``start`` gives a value for every free parameter (``hoop_gain``, profiled, is not one).
+    ``start`` gives a value for every free parameter (``hoop_gain``, marginalised by the likelihood, is not one).
     ``prior_scale`` (name -> (centre, sd) in the parameter's unbounded coordinate) gives the
     Gaussian stand-ins of the priors used while searching the mode (Levenberg-Marquardt on the
     whitened residuals); the exact ``log_prior`` weights the draws. Without ``importance`` the

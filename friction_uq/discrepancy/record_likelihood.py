@@ -11,12 +11,14 @@ tolerated model error (:func:`~.whole_record.tolerance_sd`: 1-2 % of the signal 
 3 % on the hoop gauge, and a timing tolerance of 0.2 us times the local slope), and the residual
 scaled by sd / s_t is AR(1) with the gauge's coefficient. Without it the 0.1 %-level differences
 between any two simulators of the test (time step, mesh, a rounded constant) would read as physics
-on the high-signal channels. The hoop gauge's calibration factor enters linearly and is profiled
-out (its generalised least-squares value for each parameter vector). Each channel's offset error
-(the pre-pulse mean is uncertain) and each output bar gauge's gain error (its calibration, 1 %:
-an error correlated over the whole record, which the per-sample tolerance alone would treat as
-averaging out) enter linearly with Gaussian priors and are marginalised: least squares on the
-whitened residuals with one pseudo-residual per nuisance gives the marginal quadratic form exactly.
+on the high-signal channels. Each channel's offset error (the pre-pulse mean is uncertain), each
+output bar gauge's gain error (its calibration, 1 %: an error correlated over the whole record,
+which the per-sample tolerance alone would treat as averaging out) and the hoop gauge's calibration
+factor (5 %, the stationary analysis's prior ``hoop_gain``) enter linearly with Gaussian priors and
+are marginalised: least squares on the whitened residuals with one pseudo-residual per nuisance
+gives the marginal quadratic form exactly. The hoop's level, known to its calibration, is what
+fixes nu: a hoop factor left free (profiled) lets a low nu with a stiff sample match the record
+about as well as the right nu, and f = kappa (1-nu)/nu then follows nu off.
 """
 
 from __future__ import annotations
@@ -34,15 +36,20 @@ from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, toleranc
 #: a bar gauge's calibration and the bar's E and c are known to about 1 % (the level part of
 #: :data:`~.whole_record.TOLERANCE`, correlated over the record as a calibration error is).
 GAIN_SD = {"internal_output_bar": 0.01, "external_output_bar": 0.01}
+#: The hoop gauge's calibration factor (relative sd), marginalised like the bar gauges' (the default prior
+#: file's ``hoop_gain``: gauge factor, bonding, kernel fit).
+HOOP_GAIN_SD = 0.05
 
 
 class WholeRecordLikelihood:
     """log p(record | parameters) over every gauge's span (module docstring)."""
 
-    def __init__(self, prep: Prepared, model: SimulatorModel) -> None:
+    def __init__(self, prep: Prepared, model: SimulatorModel, *, hoop_gain_sd: float = HOOP_GAIN_SD) -> None:
         rec = prep.record
         self.model = model
         self.channels = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or model.hoop))
+        #: relative sd of each marginalised gain error, by channel
+        self.gain_sd = {c: sd for c, sd in (GAIN_SD | {"tube_hoop": hoop_gain_sd}).items() if c in self.channels}
         self.bounds = channel_spans(prep, self.channels)
         self.noise = {c: channel_noise(prep, c) for c in self.channels}
         self.measured = {c: rec.strain(c) - prep.forces.channels[c].noise.offset for c in self.channels}
@@ -66,15 +73,16 @@ class WholeRecordLikelihood:
         """The channel's calibration nuisances: raw (scaled) directions, their whitened columns and prior sds.
 
         A constant offset error (the pre-pulse mean is uncertain: sd ``offset_sd``) and, on the output bar
-        gauges, a gain error (their calibration: sd :data:`GAIN_SD`), whose direction is the prediction."""
+        gauges and the hoop gauge, a gain error (their calibration: sd ``gain_sd``), whose direction is the
+        prediction."""
         nz, sl, w = self.noise[c], self._span(c), self.weight[c]
         raw, sds = [], []
         if nz.offset_sd > 0.0:
             raw.append(w)
             sds.append(nz.offset_sd)
-        if c in GAIN_SD:
+        if c in self.gain_sd:
             raw.append(pred[sl] * w)
-            sds.append(GAIN_SD[c])
+            sds.append(self.gain_sd[c])
         if not raw:
             return np.zeros((len(w), 0)), np.zeros((len(w), 0)), np.zeros(0)
         R = np.stack(raw, axis=1)
@@ -97,7 +105,7 @@ class WholeRecordLikelihood:
     def scaled_residual(self, c: str, pred: np.ndarray) -> np.ndarray:
         """(measured - predicted - nuisances) sd / s_t over the channel's span: AR(1) with the gauge's sd
         and effective coefficient. The offset error (the pre-pulse mean is uncertain) and an output bar
-        gauge's gain error are profiled."""
+        gauge's or the hoop gauge's gain error are profiled."""
         nz = self.noise[c]
         u = self._raw_scaled(c, pred)
         d, R, _, _, _ = self._nuisances(c, pred, whiten(u, sd=nz.sd, rho=nz.rho_long_run))
@@ -108,18 +116,22 @@ class WholeRecordLikelihood:
         return slice(i0, i3)
 
     def hoop_gain(self, predicted_unit: np.ndarray) -> float:
-        """Generalised least-squares gain of the hoop gauge for a prediction at gain 1."""
-        s, nz, w = self._span("tube_hoop"), self.noise["tube_hoop"], self.weight["tube_hoop"]
-        wp = whiten(predicted_unit[s] * w, sd=nz.sd, rho=nz.rho_long_run)
-        wm = whiten(self.measured["tube_hoop"][s] * w, sd=nz.sd, rho=nz.rho_long_run)
-        den = float(wp @ wp)
-        return float(wm @ wp) / den if den > 0 else 1.0
+        """The hoop gauge's calibration factor given a prediction at factor 1: its most probable value under
+        its prior (jointly with the channel's offset error)."""
+        c = "tube_hoop"
+        nz = self.noise[c]
+        d, *_ = self._nuisances(c, predicted_unit, whiten(self._raw_scaled(c, predicted_unit), sd=nz.sd,
+                                                          rho=nz.rho_long_run))
+        return 1.0 + float(d[-1])
+
+    def unit_strains(self, values: Mapping[str, float]) -> dict[str, np.ndarray]:
+        """Predicted strains with the hoop gauge's factor 1: what the likelihood conditions on (the gauges'
+        calibration errors are its nuisances)."""
+        return self.model.predict(dict(values) | {"hoop_gain": 1.0}).strains
 
     def strains(self, values: Mapping[str, float]) -> tuple[dict[str, np.ndarray], float]:
-        """Predicted strains with the hoop gain profiled; returns (strains, hoop gain)."""
-        vals = dict(values)
-        vals["hoop_gain"] = 1.0
-        pred = self.model.predict(vals).strains
+        """Predicted strains with the hoop gauge's most probable factor applied; returns (strains, factor)."""
+        pred = self.unit_strains(values)
         g = 1.0
         if "tube_hoop" in self.channels:
             g = self.hoop_gain(pred["tube_hoop"])
@@ -128,10 +140,10 @@ class WholeRecordLikelihood:
         return pred, g
 
     def whitened(self, values: Mapping[str, float]) -> np.ndarray:
-        """AR(1)-whitened residuals of every channel with its profiled offset error, concatenated, then one
-        pseudo-residual per channel (offset / its sd): log-likelihood = const - |w|^2 / 2."""
-        pred, _ = self.strains(values)
-        return self.whitened_from(pred)
+        """AR(1)-whitened residuals of every channel with its nuisances removed, concatenated, then one
+        pseudo-residual per nuisance (value / its sd): log-likelihood = const - |w|^2 / 2 (up to the
+        nuisances' log determinant)."""
+        return self.whitened_from(self.unit_strains(values))
 
     @property
     def n_samples(self) -> int:
@@ -139,7 +151,7 @@ class WholeRecordLikelihood:
 
     def loglike(self, values: Mapping[str, float]) -> float:
         try:
-            pred, _ = self.strains(values)
+            pred = self.unit_strains(values)
         except ValueError:
             return -np.inf
         w, logdet = self._whitened_logdet(pred)
@@ -148,7 +160,7 @@ class WholeRecordLikelihood:
     @property
     def n_pseudo(self) -> int:
         """Pseudo-residuals (nuisance / its prior sd) at the end of :meth:`whitened`: one per nuisance."""
-        return sum(int(self.noise[c].offset_sd > 0.0) + int(c in GAIN_SD) for c in self.channels)
+        return sum(int(self.noise[c].offset_sd > 0.0) + int(c in self.gain_sd) for c in self.channels)
 
     def whitened_from(self, pred: Mapping[str, np.ndarray]) -> np.ndarray:
         return self._whitened_logdet(pred)[0]
