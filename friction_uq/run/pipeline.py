@@ -24,6 +24,7 @@ import numpy as np
 
 from .. import __version__
 from .._atomic import output_lock, remove_orphans, write_together
+from .._parallel import Background
 from ..analysis import Identification, Prepared, identify, prepare
 from ..discrepancy.check import WholeRecordCheck
 from ..diagnostics import (
@@ -66,6 +67,13 @@ class RunResult:
     sensitivity: dict[str, FUnderPrior] = dataclasses.field(default_factory=dict)
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
+
+
+def _whole_record_start(lab: Identification, priors) -> dict[str, float]:
+    """Where the whole-record fit starts its mode search (it also starts from nu either side of the prior):
+    the lab's eq. 17 estimate at the nominal nu, or the f prior's median where eq. 17 gives no f."""
+    f = lab.f if np.isfinite(lab.f) and lab.f > 0 else float(priors["f"].ppf(0.5))
+    return {"f": float(f), "nu": float(lab.nu)}
 
 
 def run_file(
@@ -145,11 +153,26 @@ def run_file(
         if left_out:
             note(f"the hoop gauge is left out of the likelihood: {left_out}")
 
-        t = time.perf_counter()
-        samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
-                                   progress=stderr_progress if progress else None, notify=note,
-                                   likelihood=likelihood)
-        stages["sampling"] = time.perf_counter() - t
+        # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
+        lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
+        wr_job = None
+        if whole_record or diagnose:
+            # the whole-record check needs no posterior draw: it runs on the other core while this one samples
+            from ..discrepancy import pipeline
+
+            say("the whole test simulated and fitted to every gauge (alongside the sampling)")
+            wr_job = Background(pipeline.whole_record_check, prep, priors, _whole_record_start(lab, priors),
+                                hoop=use_hoop, seed=seed)
+        try:
+            t = time.perf_counter()
+            samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
+                                       progress=stderr_progress if progress else None, notify=note,
+                                       likelihood=likelihood)
+            stages["sampling"] = time.perf_counter() - t
+        except BaseException:
+            if wr_job is not None:
+                wr_job.close()
+            raise
         t = time.perf_counter()
         dt = build_datatree(samples, prep.data, priors, seed=seed, likelihood=likelihood)
         dt.attrs["analysis_settings"] = settings.to_attr()  # provenance: how the likelihood was built
@@ -170,23 +193,18 @@ def run_file(
         band = f_given_nu(samples, np.linspace(0.15, 0.49, 69))
         share = nu_variance_share(samples)
         ppc = ratio_ppc(samples, prep.data, seed=seed, likelihood=likelihood)
-        # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
-        lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
         V = sliding_velocity_summary(prep)
         stages["analysis"] = time.perf_counter() - t
         t = time.perf_counter()
         wrc = diag = None
-        if whole_record or diagnose:
-            from ..discrepancy import pipeline
-
-            start = {"f": summary["f"].q50, "nu": summary["nu"].q50}
-            say("the whole test simulated with the posterior, against every gauge")
-            wrc = pipeline.whole_record_check(prep, priors, start, hoop=use_hoop, seed=seed)
+        if wr_job is not None:
+            wrc = wr_job.result()
             pipeline.add_whole_record(dt, wrc)
             if diagnose:
                 from ..discrepancy import outcome
 
                 say("diagnose: fitting each mechanism of the catalogue to the whole record")
+                start = {"f": summary["f"].q50, "nu": summary["nu"].q50}
                 diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say)
                 outcome.add_to_datatree(dt, diag)
         stages["whole_record"] = time.perf_counter() - t
