@@ -18,7 +18,7 @@ from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, 
 from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
-from .style import figure
+from .style import CORE_FONTS, figure
 
 UNITS = {"f": ("-", 1.0), "nu": ("-", 1.0), "kappa": ("-", 1.0), "hoop_gain": ("-", 1.0), "ratio": ("-", 1.0),
          "p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
@@ -124,7 +124,7 @@ def render_report(r: ReportInputs) -> bytes:
     p = r.prepared
     meta = {"Title": f"friction-uq {p.record.campaign} {p.record.test_id}", "Creator": f"friction-uq {r.version}"}
     buf = io.BytesIO()
-    with PdfPages(buf, metadata=meta) as pdf:
+    with plt.rc_context(CORE_FONTS), PdfPages(buf, metadata=meta) as pdf:
         builders = [
             lambda: page_summary(r),
             lambda: page_raw(p.record),
