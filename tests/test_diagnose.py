@@ -158,3 +158,15 @@ def test_clearance_is_named_and_the_gap_measured(tmp_path):
     assert dg.cause is not None and dg.cause.mechanism.name == "clearance"
     gap = dg.final.fit.draws["gap"]
     assert np.quantile(gap, 0.005) <= 8e-6 <= np.quantile(gap, 0.995)
+
+
+@pytest.mark.parametrize("base, final, found", [(0.91, 0.92, True), (0.965, 1.07, False), (0.99, 0.91, False),
+                                                (1.05, 1.04, True), (0.97, 0.97, True)])
+def test_a_hoop_calibration_finding_needs_the_baseline_and_the_final_model_to_agree(base, final, found):
+    """A clearance changes the hoop's level and moves the factor with it (bundled A: 0.965 without the cause,
+    1.07 with it): only a reading both models agree on is said."""
+    from types import SimpleNamespace
+
+    dg = SimpleNamespace(baseline=SimpleNamespace(hoop_gain=base),
+                         final=SimpleNamespace(hoop_gain=final, predicted={"tube_hoop": None}))
+    assert outcome.hoop_gain_off(dg) is found
