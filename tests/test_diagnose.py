@@ -167,6 +167,8 @@ def test_a_hoop_calibration_finding_needs_the_baseline_and_the_final_model_to_ag
     1.07 with it): only a reading both models agree on is said."""
     from types import SimpleNamespace
 
-    dg = SimpleNamespace(baseline=SimpleNamespace(hoop_gain=base),
+    dg = SimpleNamespace(baseline=SimpleNamespace(hoop_gain=1.0), check_hoop_gain=base,
                          final=SimpleNamespace(hoop_gain=final, predicted={"tube_hoop": None}))
+    assert outcome.hoop_gain_off(dg) is found
+    dg.baseline.hoop_gain, dg.check_hoop_gain = base, None  # diagnose alone: its own baseline
     assert outcome.hoop_gain_off(dg) is found

@@ -89,6 +89,9 @@ class Diagnosis:
     seconds: float = 0.0
     baseline_comparison: WholeRecord | None = None
     final_comparison: WholeRecord | None = None
+    #: the hoop gauge's calibration factor as the whole-record check reads it (f and nu free only: the model
+    #: the misfit decision judges), when ``run`` made the check
+    check_hoop_gain: float | None = None
 
     @property
     def cause(self) -> Variant | None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 
 import numpy as np
 
@@ -31,12 +32,14 @@ def whole_record_check(prep: Prepared, priors: Priors, start: Mapping[str, float
 
 
 def run_diagnose(prep: Prepared, priors: Priors, start: Mapping[str, float], *, hoop: bool, seed: int,
-                 say: Callable[[str], None] = lambda msg: None) -> Diagnosis:
+                 say: Callable[[str], None] = lambda msg: None, check: WholeRecordCheck | None = None) -> Diagnosis:
     """:func:`.diagnose.diagnose` with the run's f and nu priors (and their Gaussian stand-ins for the
-    mode search), started from the stationary posterior's medians."""
+    mode search), started from the stationary posterior's medians; ``check``: the run's whole-record
+    check, whose hoop reading the calibration finding compares with the final model's."""
     scales = {par.name: par.gaussian_stand_in(priors[par.name]) for par in (F, NU)}
-    return diagnose(prep, f_nu_log_prior(priors), start, hoop=hoop or prep.record.has_hoop, seed=seed,
-                    progress=lambda m: say(f"diagnose: {m}"), base_scales=scales)
+    dg = diagnose(prep, f_nu_log_prior(priors), start, hoop=hoop or prep.record.has_hoop, seed=seed,
+                  progress=lambda m: say(f"diagnose: {m}"), base_scales=scales)
+    return dg if check is None else replace(dg, check_hoop_gain=check.hoop_gain)
 
 
 def add_whole_record(dt, wrc: WholeRecordCheck) -> None:

@@ -205,7 +205,7 @@ def run_file(
 
                 say("diagnose: fitting each mechanism of the catalogue to the whole record")
                 start = {"f": summary["f"].q50, "nu": summary["nu"].q50}
-                diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say)
+                diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say, check=wrc)
                 outcome.add_to_datatree(dt, diag)
         stages["whole_record"] = time.perf_counter() - t
         t = time.perf_counter()
