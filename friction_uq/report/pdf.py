@@ -46,6 +46,10 @@ class ReportInputs:
     likelihood: object | None = None  # friction_uq.likelihood.Likelihood, built once by run
 
 
+#: Top of the summary page's table (axes fraction) for up to ten rows: the sentences above stay clear of it.
+SUMMARY_TABLE_TOP = 0.37
+
+
 def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
@@ -83,13 +87,16 @@ def page_summary(r: ReportInputs) -> Figure:
         from ..discrepancy.outcome import sentence
 
         lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, s["f"].to_json()))
+    # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
+    # together where they would run into the table below them
+    texts = ["\n".join(textwrap.wrap(line, 110)) for line in lines]
+    need = sum(0.034 * (t.count("\n") + 1) + 0.016 for t in texts)
+    k = min(1.0, (0.97 - SUMMARY_TABLE_TOP) / need)
     y = 0.97
-    for line in lines:
+    for line, text in zip(lines, texts):
         color = "firebrick" if line.startswith("WARNING") else "black"
-        # wrapped here, not by matplotlib (whose wrap=True measures the text word by word)
-        text = "\n".join(textwrap.wrap(line, 100))
-        ax.text(0.0, y, text, fontsize=10, va="top", transform=ax.transAxes, color=color)
-        y -= 0.034 * (text.count("\n") + 1) + 0.016
+        ax.text(0.0, y, text, fontsize=10 * k, va="top", transform=ax.transAxes, color=color)
+        y -= k * (0.034 * (text.count("\n") + 1) + 0.016)
     rows = []
     for name, v in list(s.items()) + [("V", r.V)]:
         unit, scale = UNITS.get(name, ("", 1.0))
