@@ -203,3 +203,24 @@ def test_run_file_can_run_silently(paper_run, tmp_path, capsys):
     assert captured.out == "" and captured.err == ""
     assert set(res.outputs) == {"netcdf", "json"} and res.convergence.ok
     assert {"signals", "sampling", "datatree", "sensitivity", "outputs", "pdf"} <= set(res.stages)
+
+
+def test_the_report_has_no_character_its_fonts_cannot_show(paper_run):
+    """The PDF's standard fonts (Helvetica, Courier) encode Latin-1 only: a Unicode minus in a tick label
+    shows as '?'. Every text drawn through them is checked for characters outside Latin-1."""
+    import re
+    import zlib
+
+    _, out, _ = paper_run
+    pdf = next(out.glob("*.pdf")).read_bytes()
+    shown = b""
+    for m in re.finditer(rb"stream\r?\n(.*?)\r?\nendstream", pdf, re.S):
+        try:
+            shown += zlib.decompress(m.group(1))
+        except zlib.error:
+            continue
+    # text shown with the standard fonts is written as (string) Tj; a character it lacks is written as '?'
+    strings = re.findall(rb"\(((?:[^()\\]|\\.)*)\)\s*Tj", shown)
+    assert strings, "no text drawn with the standard fonts"
+    assert any(re.fullmatch(rb"-\d[\d.]*", s) for s in strings), "no negative tick label to check"
+    assert not [s for s in strings if re.fullmatch(rb"\?\d.*", s)], "a tick label lost its minus sign"

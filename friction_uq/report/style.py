@@ -28,8 +28,9 @@ RC = {
 }
 A4_LANDSCAPE = (11.69, 8.27)
 #: The PDF's text in the PDF standard's own fonts (Helvetica, Courier: every reader has them, nothing is
-#: embedded): a third less time per page than embedding a TrueType subset.
-CORE_FONTS = {"pdf.use14corefonts": True}
+#: embedded): a third less time per page than embedding a TrueType subset. Their encoding has no
+#: Unicode minus sign: tick labels use the ASCII hyphen-minus (else they read "?20").
+CORE_FONTS = {"pdf.use14corefonts": True, "axes.unicode_minus": False}
 
 
 class _SameFontOtherWeight(logging.Filter):
