@@ -11,7 +11,6 @@ from __future__ import annotations
 import multiprocessing
 import threading
 from collections.abc import Callable
-from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
 
@@ -21,49 +20,83 @@ def can_fork() -> bool:
             and threading.active_count() == 1)
 
 
-_CALLS: dict[int, tuple[Callable[..., Any], tuple[Any, ...], dict[str, Any]]] = {}
-
-
-def _run_inherited(key: int) -> Any:
-    """In the forked worker: the call :class:`Background` left in this module (inherited, not pickled)."""
-    fn, args, kwargs = _CALLS[key]
-    return fn(*args, **kwargs)
+def _child(fn: Callable[..., Any], args: tuple, kwargs: dict, send: Any, recv: Any) -> None:
+    """In the forked process: run the call, send (ok, value or exception) once, exit. A parent gone
+    meanwhile closes the pipe's other end: the send fails and the child ends all the same."""
+    recv.close()
+    try:
+        out: tuple[bool, Any] = (True, fn(*args, **kwargs))
+    except BaseException as exc:  # noqa: BLE001 - carried back to the parent, raised there
+        out = (False, exc)
+    try:
+        send.send(out)
+    except Exception:  # noqa: BLE001 - the parent has gone (or the value does not pickle): nothing to tell
+        pass
+    finally:
+        send.close()
 
 
 class Background:
     """``fn(*args, **kwargs)`` started now in a forked process (where :func:`can_fork`), its value taken
-    with :meth:`result`; in line, at :meth:`result`, where not. The worker inherits the call from the
-    fork (the arguments need not pickle); the value comes back pickled; an exception raised by ``fn``
-    is raised again by :meth:`result`."""
+    with :meth:`result`; in line, at :meth:`result`, where not. The child inherits the call from the
+    fork (the arguments need not pickle); the value or the exception comes back pickled, once, and
+    the child ends. A daemon child: it is stopped when this process exits, and :meth:`close` (or
+    leaving the ``with`` block) stops it when its value is no longer wanted. ``fn`` None: nothing
+    to do, :meth:`result` is None."""
 
-    def __init__(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
+    def __init__(self, fn: Callable[..., Any] | None, *args: Any, **kwargs: Any) -> None:
         self._call = (fn, args, kwargs)
-        self._pool: ProcessPoolExecutor | None = None
-        self._future: Future | None = None
-        if can_fork():
-            key = id(self)
-            _CALLS[key] = self._call
-            try:
-                self._pool = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork"))
-                self._future = self._pool.submit(_run_inherited, key)  # the worker is forked here
-            finally:
-                del _CALLS[key]
+        self._proc: Any = None
+        self._recv: Any = None
+        self._taken: tuple[bool, Any] | None = None
+        if fn is not None and can_fork():
+            ctx = multiprocessing.get_context("fork")
+            recv, send = ctx.Pipe(duplex=False)
+            self._proc = ctx.Process(target=_child, args=(fn, args, kwargs, send, recv), daemon=True)
+            self._proc.start()
+            send.close()
+            self._recv = recv
 
     @property
     def forked(self) -> bool:
-        return self._future is not None
+        return self._proc is not None
 
     def result(self) -> Any:
+        """The value (computed once); the exception ``fn`` raised is raised again."""
         fn, args, kwargs = self._call
-        if self._future is None:
-            return fn(*args, **kwargs)
-        try:
-            return self._future.result()
-        finally:
-            self.close()
+        if self._taken is None:
+            if fn is None:
+                self._taken = (True, None)
+            elif self._recv is None:  # in line (or the child was stopped before its value was taken)
+                try:
+                    self._taken = (True, fn(*args, **kwargs))
+                except Exception as exc:
+                    self._taken = (False, exc)
+            else:
+                try:
+                    self._taken = self._recv.recv()
+                except EOFError:
+                    raise RuntimeError(f"the background process running {fn.__name__} ended without a result") from None
+                finally:
+                    self.close()
+        ok, value = self._taken
+        if not ok:
+            raise value
+        return value
 
     def close(self) -> None:
-        """Stop the worker (a run interrupted before it asked for the value)."""
-        if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
-            self._pool = None
+        """Stop the child if it still runs (its value was not taken) and release the pipe."""
+        if self._proc is not None:
+            if self._proc.is_alive():
+                self._proc.terminate()
+            self._proc.join()
+            self._proc = None
+        if self._recv is not None:
+            self._recv.close()
+            self._recv = None
+
+    def __enter__(self) -> Background:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -48,3 +48,54 @@ def test_no_fork_while_other_threads_run():
     finally:
         stop.set()
         t.join()
+
+
+def _slow(seconds):
+    import time
+
+    time.sleep(seconds)
+    return seconds
+
+
+def test_result_is_computed_once_and_close_before_result_runs_it_in_line():
+    job = Background(_draws, {"mean": 1.0}, seed=3)
+    job.close()  # the child stopped before its value was taken
+    assert not job.forked
+    first = job.result()
+    assert np.array_equal(first, _draws({"mean": 1.0}, seed=3)) and job.result() is first
+    assert Background(None).result() is None
+
+
+def test_the_child_ends_when_its_parent_is_killed(tmp_path):
+    """A killed run must not leave its child behind (it would keep what the run had open)."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "parent.py"
+    script.write_text(
+        "import os, sys, time\n"
+        "from tests.test_parallel import _slow\n"
+        "from friction_uq._parallel import Background\n"
+        "job = Background(_slow, 1.0)\n"
+        "print(job._proc.pid if job.forked else -1, flush=True)\n"
+        "os._exit(0)  # as if killed: no clean-up runs\n")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, cwd=root, timeout=60,
+                         env=os.environ | {"PYTHONPATH": root})
+    pid = int(out.stdout.split()[0])
+    if pid < 0:
+        pytest.skip("the parent could not fork")
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return
+        try:  # reap it if it became ours (it does not: it is reparented), else wait
+            os.waitpid(pid, os.WNOHANG)
+        except ChildProcessError:
+            pass
+        time.sleep(0.2)
+    pytest.fail(f"the child {pid} still runs 20 s after its parent was killed")

@@ -2,8 +2,9 @@
 
 Reads each analysed record's stored draws (the ``.nc`` beside its result), pools f and kappa
 (:mod:`.pooling`), fits the candidate friction laws with and without a set-up offset
-(:mod:`.laws`), chooses the best-supported law by leave-one-test-out ELPD, converts its
-parameters from kappa to f with the campaign's nu, and flags set-ups and tests (:mod:`.flags`).
+(:mod:`.laws`: to kappa, or, when every test was diagnosed, to f under each test's diagnosed
+model), chooses the best-supported law by leave-one-test-out ELPD, gives its parameters in f
+(from kappa with the campaign's nu), and flags set-ups and tests (:mod:`.flags`).
 """
 
 from __future__ import annotations

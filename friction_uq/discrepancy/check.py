@@ -1,8 +1,9 @@
 """The whole-record check of one analysis: fit the simulator to the whole record, compare, decide.
 
-:func:`check_whole_record` is what ``friction-uq run`` calls after sampling the stationary-phase
-posterior: the simulator driven by the measured incident wave is fitted to every gauge
-(:mod:`.fit`, started from the stationary posterior's median), the posterior draws are simulated
+:func:`check_whole_record` is what ``friction-uq run`` runs beside the sampling of the
+stationary-phase posterior (it needs none of its draws): the simulator driven by the measured
+incident wave is fitted to every gauge (:mod:`.fit`, started from the lab's eq. 17 estimate and
+from nu either side of the prior), the posterior draws are simulated
 (:mod:`.whole_record`) and the misfit decision is taken (:mod:`.misfit`).
 """
 
@@ -46,7 +47,7 @@ def check_whole_record(prep: Prepared, log_prior: Callable[[Mapping[str, float]]
                        *, hoop: bool, seed: int, n_draws: int = 30) -> WholeRecordCheck:
     """Fit, simulate the posterior draws, compare and decide (module docstring).
 
-    ``log_prior`` takes ``{"f": ..., "nu": ...}``; ``start`` the stationary posterior's medians.
+    ``log_prior`` takes ``{"f": ..., "nu": ...}``; ``start`` where the mode search starts (f, nu).
     """
     t0 = time.perf_counter()
     rec = prep.record

@@ -26,8 +26,8 @@ def f_nu_log_prior(priors: Priors) -> Callable[[Mapping[str, float]], float]:
 
 def whole_record_check(prep: Prepared, priors: Priors, start: Mapping[str, float], *, hoop: bool,
                        seed: int) -> WholeRecordCheck:
-    """:func:`.check.check_whole_record` with the run's f and nu priors, started from ``start`` (the
-    stationary posterior's medians)."""
+    """:func:`.check.check_whole_record` with the run's f and nu priors, started from ``start`` (run: the
+    lab's eq. 17 estimate)."""
     return check_whole_record(prep, f_nu_log_prior(priors), start, hoop=hoop or prep.record.has_hoop, seed=seed)
 
 

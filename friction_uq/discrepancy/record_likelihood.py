@@ -14,7 +14,7 @@ between any two simulators of the test (time step, mesh, a rounded constant) wou
 on the high-signal channels. Each channel's offset error (the pre-pulse mean is uncertain), each
 output bar gauge's gain error (its calibration, 1 %: an error correlated over the whole record,
 which the per-sample tolerance alone would treat as averaging out) and the hoop gauge's calibration
-factor (5 %, the stationary analysis's prior ``hoop_gain``) enter linearly with Gaussian priors and
+factor (5 %, as the default prior file's ``hoop_gain``) enter linearly with Gaussian priors and
 are marginalised: least squares on the whitened residuals with one pseudo-residual per nuisance
 gives the marginal quadratic form exactly. The hoop's level, known to its calibration, is what
 fixes nu: a hoop factor left free (profiled) lets a low nu with a stiff sample match the record
@@ -49,7 +49,8 @@ class WholeRecordLikelihood:
         self.model = model
         self.channels = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or model.hoop))
         #: relative sd of each marginalised gain error, by channel
-        self.gain_sd = {c: sd for c, sd in (GAIN_SD | {"tube_hoop": hoop_gain_sd}).items() if c in self.channels}
+        self.gain_sd = {c: sd for c, sd in (GAIN_SD | {"tube_hoop": hoop_gain_sd}).items()
+                        if c in self.channels and sd > 0.0}
         self.bounds = channel_spans(prep, self.channels)
         self.noise = {c: channel_noise(prep, c) for c in self.channels}
         self.measured = {c: rec.strain(c) - prep.forces.channels[c].noise.offset for c in self.channels}
@@ -105,7 +106,7 @@ class WholeRecordLikelihood:
     def scaled_residual(self, c: str, pred: np.ndarray) -> np.ndarray:
         """(measured - predicted - nuisances) sd / s_t over the channel's span: AR(1) with the gauge's sd
         and effective coefficient. The offset error (the pre-pulse mean is uncertain) and an output bar
-        gauge's or the hoop gauge's gain error are profiled."""
+        gauge's or the hoop gauge's gain error are set to their most probable values."""
         nz = self.noise[c]
         u = self._raw_scaled(c, pred)
         d, R, _, _, _ = self._nuisances(c, pred, whiten(u, sd=nz.sd, rho=nz.rho_long_run))
@@ -119,10 +120,12 @@ class WholeRecordLikelihood:
         """The hoop gauge's calibration factor given a prediction at factor 1: its most probable value under
         its prior (jointly with the channel's offset error)."""
         c = "tube_hoop"
+        if c not in self.gain_sd:
+            return 1.0
         nz = self.noise[c]
         d, *_ = self._nuisances(c, predicted_unit, whiten(self._raw_scaled(c, predicted_unit), sd=nz.sd,
                                                           rho=nz.rho_long_run))
-        return 1.0 + float(d[-1])
+        return 1.0 + float(d[int(nz.offset_sd > 0.0)])  # the columns: [offset], gain
 
     def unit_strains(self, values: Mapping[str, float]) -> dict[str, np.ndarray]:
         """Predicted strains with the hoop gauge's factor 1: what the likelihood conditions on (the gauges'

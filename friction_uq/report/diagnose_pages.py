@@ -51,7 +51,7 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
              f"(nu {np.median(dg.baseline.fit.draws['nu']):.3f})",
              f"f, model '{dg.final.label}': {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] "
              f"(nu {np.median(dg.final.fit.draws['nu']):.3f})",
-             f"hoop gauge gain (profiled, final model): {dg.final.hoop_gain:.3f}", ""]
+             f"hoop gauge gain (final model, most probable under its 5 % prior): {dg.final.hoop_gain:.3f}", ""]
     for v in dg.causes:
         lines.append(f"{v.mechanism.name}{' (' + v.channel + ')' if v.channel else ''}: {v.mechanism.meaning}")
         for p in v.mechanism.parameters:

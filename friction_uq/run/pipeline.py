@@ -71,9 +71,11 @@ class RunResult:
 
 def _whole_record_start(lab: Identification, priors) -> dict[str, float]:
     """Where the whole-record fit starts its mode search (it also starts from nu either side of the prior):
-    the lab's eq. 17 estimate at the nominal nu, or the f prior's median where eq. 17 gives no f."""
-    f = lab.f if np.isfinite(lab.f) and lab.f > 0 else float(priors["f"].ppf(0.5))
-    return {"f": float(f), "nu": float(lab.nu)}
+    the lab's eq. 17 estimate at the nominal nu, kept within the f prior's 1-99 % range (its median where
+    eq. 17 gives no f)."""
+    lo, hi = (float(priors["f"].ppf(q)) for q in (0.01, 0.99))
+    f = float(np.clip(lab.f, lo, hi)) if np.isfinite(lab.f) else float(priors["f"].ppf(0.5))
+    return {"f": f, "nu": float(lab.nu)}
 
 
 def run_file(
@@ -141,8 +143,18 @@ def run_file(
         if p.is_dir():
             raise OutputError(f"{p}: cannot write the output, a directory has that name")
     stages["signals"] = time.perf_counter() - t_start
+    # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
+    lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
+    # the whole-record check needs no posterior draw: it runs on the other core while this one samples,
+    # forked before the output lock is taken (the child holds no lock), stopped on the way out
+    wr_call = None
+    if whole_record or diagnose:
+        from ..discrepancy import pipeline
 
-    with output_lock(out, stem):
+        wr_call = pipeline.whole_record_check
+
+    with (Background(wr_call, prep, priors, _whole_record_start(lab, priors), hoop=use_hoop, seed=seed) as wr_job,
+          output_lock(out, stem)):
         backend = out / f".{stem}.checkpoint.npz"
         remove_orphans(out, [p.name for p in names.values()] + [backend.name])
         old_backend = out / f".{stem}.chains.h5"  # an earlier version's emcee backend
@@ -152,27 +164,15 @@ def run_file(
             f"{prep.window.t1 * 1e6:.1f} us, hoop term {'on' if use_hoop else 'off'}, priors {p_path}")
         if left_out:
             note(f"the hoop gauge is left out of the likelihood: {left_out}")
+        if wr_call is not None:
+            say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if wr_job.forked
+                                                                         else "(after the sampling)"))
 
-        # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
-        lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
-        wr_job = None
-        if whole_record or diagnose:
-            # the whole-record check needs no posterior draw: it runs on the other core while this one samples
-            from ..discrepancy import pipeline
-
-            say("the whole test simulated and fitted to every gauge (alongside the sampling)")
-            wr_job = Background(pipeline.whole_record_check, prep, priors, _whole_record_start(lab, priors),
-                                hoop=use_hoop, seed=seed)
-        try:
-            t = time.perf_counter()
-            samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
-                                       progress=stderr_progress if progress else None, notify=note,
-                                       likelihood=likelihood)
-            stages["sampling"] = time.perf_counter() - t
-        except BaseException:
-            if wr_job is not None:
-                wr_job.close()
-            raise
+        t = time.perf_counter()
+        samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
+                                   progress=stderr_progress if progress else None, notify=note,
+                                   likelihood=likelihood)
+        stages["sampling"] = time.perf_counter() - t
         t = time.perf_counter()
         dt = build_datatree(samples, prep.data, priors, seed=seed, likelihood=likelihood)
         dt.attrs["analysis_settings"] = settings.to_attr()  # provenance: how the likelihood was built
@@ -197,7 +197,7 @@ def run_file(
         stages["analysis"] = time.perf_counter() - t
         t = time.perf_counter()
         wrc = diag = None
-        if wr_job is not None:
+        if wr_call is not None:
             wrc = wr_job.result()
             pipeline.add_whole_record(dt, wrc)
             if diagnose:
