@@ -178,6 +178,10 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
         return ca
     data = _law_data(tests)
     ca.law_data = data
+    n_diag = sum(t.f_model is not None for t in tests)
+    if 0 < n_diag < len(tests):
+        ca.sentences.append(f"friction law: fitted to the stationary kappa, since only {n_diag} of {len(tests)} tests "
+                            "were diagnosed (f under the diagnosed models needs every test diagnosed)")
     kbar, p_ref = float(np.mean(data.kappa)), float(np.mean(data.p))
     setups = sorted(set(data.setups))
     offsets = [setups[-1]] if len(setups) == 2 else (setups if len(setups) > 2 else [])
