@@ -131,6 +131,9 @@ def test_a_dead_hoop_gauge_is_left_out_with_a_note(tmp_path, capsys):
     doc = json.loads((out / "dead_D-01.json").read_text())
     assert doc["hoop_term"] is False and doc["hoop_left_out"]
     assert doc["f"]["q05"] <= 0.05 <= doc["f"]["q95"]
+    # nor the whole-record check, where its calibration prior would make a flat gauge pull nu
+    channels = {fig["channel"] for fig in doc["misfit"]["figures"]}
+    assert "tube_hoop" not in channels and "external_output_bar" in channels
 
 
 def test_out_that_is_a_file_is_refused(paper_run, tmp_path, capsys):

@@ -28,7 +28,7 @@ def whole_record_check(prep: Prepared, priors: Priors, start: Mapping[str, float
                        seed: int) -> WholeRecordCheck:
     """:func:`.check.check_whole_record` with the run's f and nu priors, started from ``start`` (run: the
     lab's eq. 17 estimate)."""
-    return check_whole_record(prep, f_nu_log_prior(priors), start, hoop=hoop or prep.record.has_hoop, seed=seed)
+    return check_whole_record(prep, f_nu_log_prior(priors), start, hoop=hoop and prep.record.has_hoop, seed=seed)
 
 
 def run_diagnose(prep: Prepared, priors: Priors, start: Mapping[str, float], *, hoop: bool, seed: int,
@@ -37,7 +37,7 @@ def run_diagnose(prep: Prepared, priors: Priors, start: Mapping[str, float], *, 
     mode search), started from the stationary posterior's medians; ``check``: the run's whole-record
     check, whose hoop reading the calibration finding compares with the final model's."""
     scales = {par.name: par.gaussian_stand_in(priors[par.name]) for par in (F, NU)}
-    dg = diagnose(prep, f_nu_log_prior(priors), start, hoop=hoop or prep.record.has_hoop, seed=seed,
+    dg = diagnose(prep, f_nu_log_prior(priors), start, hoop=hoop and prep.record.has_hoop, seed=seed,
                   progress=lambda m: say(f"diagnose: {m}"), base_scales=scales)
     return dg if check is None else replace(dg, check_hoop_gain=check.hoop_gain)
 
