@@ -35,6 +35,9 @@ from scipy.special import logsumexp
 from scipy.stats import t as student_t
 
 LAWS = ("constant", "velocity", "pressure", "pressure+velocity")
+#: What the laws are fitted to, in words (``LawData.basis``).
+BASES = {"kappa": "kappa = f nu/(1-nu) of the stationary phase, converted with the campaign's nu",
+         "f": "f under each test's diagnosed model"}
 #: law -> the laws it contains as a special case (constant is in all)
 NESTS = {"constant": set(LAWS), "velocity": {"velocity", "pressure+velocity"},
          "pressure": {"pressure", "pressure+velocity"}, "pressure+velocity": {"pressure+velocity"}}
@@ -57,12 +60,17 @@ class LawData:
     p: np.ndarray
     p_sd: np.ndarray
     #: what ``kappa`` holds: "kappa" (f nu/(1-nu) of the stationary phase) or "f" (f itself, under
-    #: each test's diagnosed model)
+    #: each test's diagnosed model); :data:`BASES` says it in words
     basis: str = "kappa"
 
     @property
     def n(self) -> int:
         return len(self.labels)
+
+    @property
+    def meaning(self) -> str:
+        """What the laws were fitted to, in words."""
+        return BASES[self.basis]
 
     def to_f(self, nu: float | np.ndarray) -> float | np.ndarray:
         """Factor from the data's unit to f: (1-nu)/nu for kappa, 1 for f."""

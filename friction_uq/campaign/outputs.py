@@ -45,15 +45,14 @@ def statements(ca: CampaignAnalysis) -> list[str]:
     if ca.best:
         post = ca.law_posterior
         parts = [f"{k} {v['q50']:.3g} [{v['q05']:.3g}, {v['q95']:.3g}]" for k, v in post.items()]
-        basis = "" if ca.law_data is None or ca.law_data.basis == "kappa" else ", fitted to f under each test's diagnosed model"
+        basis = "" if ca.law_data.basis == "kappa" else f", fitted to {ca.law_data.meaning}"
         out.append(f"friction law: {ca.best} (model {ca.chosen}{basis}); " + ", ".join(parts))
     out.extend(ca.sentences)
     for f in ca.flagged:
         if "setup" in f:
             off = f["offset"]
             rel = f" relative to {f['relative_to']}" if "relative_to" in f else ""
-            unit = "kappa" if ca.law_data is None or ca.law_data.basis == "kappa" else "f"
-            out.append(f"flagged: set-up {f['setup']} does not follow the shared law{rel}: {unit} offset "
+            out.append(f"flagged: set-up {f['setup']} does not follow the shared law{rel}: {ca.law_data.basis} offset "
                        f"{off['q50'] * 100:+.0f} % [{off['q05'] * 100:+.0f}, {off['q95'] * 100:+.0f}], dELPD "
                        f"{f['d_elpd']:.1f} (SE {f['d_se']:.1f})")
             if "note" in f:
@@ -89,9 +88,7 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
         "friction_law": {"best": ca.best, "chosen_model": ca.chosen, "ranking": ca.ranking,
                          "posterior": ca.law_posterior, "models": models,
                          "nu": {"mean": ca.nu[0], "sd": ca.nu[1]},
-                         "fitted_to": None if ca.law_data is None else
-                         ("f under each test's diagnosed model" if ca.law_data.basis == "f" else
-                          "kappa = f nu/(1-nu) of the stationary phase, converted with the campaign's nu")},
+                         "fitted_to": None if ca.law_data is None else ca.law_data.meaning},
         "flagged": ca.flagged,
         "causes": ca.tallies,
         "statements": statements(ca),

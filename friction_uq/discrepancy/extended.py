@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import multiprocessing
-import threading
 import zlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
@@ -26,6 +25,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
+from .._parallel import can_fork
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
@@ -126,7 +126,7 @@ class Diagnoser:
         fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False,
                                prior_scale=scales, extra_starts=extra, score_blocks=block_of)
         unit = lik.unit_strains(fit.mode)
-        pred, gain = lik.strains(fit.mode)
+        pred, gain = lik.scaled(unit)
         dens = []
         for c in lik.channels:
             i0, _, _, i3 = lik.bounds[c]
@@ -147,8 +147,7 @@ class Diagnoser:
         this object). A daemon process or one running other threads (a campaign's Dask worker: forking
         a threaded process can deadlock) fits them in turn. Same results as one by one."""
         workers = min(workers, len(jobs))
-        if (workers <= 1 or multiprocessing.current_process().daemon or threading.active_count() > 1
-                or "fork" not in multiprocessing.get_all_start_methods()):
+        if workers <= 1 or not can_fork():
             return [self.fit(*job) for job in jobs]
         global _ACTIVE
         _ACTIVE = (self, jobs)

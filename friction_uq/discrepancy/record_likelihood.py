@@ -134,11 +134,14 @@ class WholeRecordLikelihood:
 
     def strains(self, values: Mapping[str, float]) -> tuple[dict[str, np.ndarray], float]:
         """Predicted strains with the hoop gauge's most probable factor applied; returns (strains, factor)."""
-        pred = self.unit_strains(values)
+        return self.scaled(self.unit_strains(values))
+
+    def scaled(self, pred: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray], float]:
+        """:meth:`unit_strains`' prediction with the hoop gauge's most probable factor applied."""
+        pred = dict(pred)
         g = 1.0
         if "tube_hoop" in self.channels:
             g = self.hoop_gain(pred["tube_hoop"])
-            pred = dict(pred)
             pred["tube_hoop"] = g * pred["tube_hoop"]
         return pred, g
 

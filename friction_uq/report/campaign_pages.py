@@ -57,7 +57,7 @@ def _law_page(ca: CampaignAnalysis):
     d = ca.law_data
     name = ca.chosen or str(ca.ranking[0]["model"])
     nu = ca.nu[0]
-    head = f"f at the campaign's nu = {nu:.3f}" if d.basis == "kappa" else "f under each test's diagnosed model"
+    head = f"f at the campaign's nu = {nu:.3f}" if d.basis == "kappa" else d.meaning
     fig, axes = figure(f"{head} against V and p; band: {name} (90 %)", nrows=1, ncols=2)
     setups = sorted(set(d.setups))
     for k, s in enumerate(setups):
@@ -76,7 +76,7 @@ def _law_page(ca: CampaignAnalysis):
     axes[0].set_xlabel("sliding velocity V (m/s)")
     axes[1].set_xlabel("mean wall pressure p_mean (MPa)")
     for ax in axes:
-        ax.set_ylabel("f = kappa (1-nu)/nu" if d.basis == "kappa" else "f under each test's diagnosed model")
+        ax.set_ylabel("f = kappa (1-nu)/nu" if d.basis == "kappa" else d.meaning)
         ax.legend(fontsize=8)
     return fig
 
