@@ -48,7 +48,7 @@ class SamplerSettings:
     check_every: int = 100
     checkpoint_seconds: float = 2.0
     tau_factor: float = 50.0
-    tau_rtol: float = 0.01
+    tau_rtol: float = 0.05
     burn_factor: float = 3.0
     thin_factor: float = 0.5
     max_draws: int = 4000
