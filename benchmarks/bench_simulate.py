@@ -18,7 +18,7 @@ from dataclasses import replace
 from types import MappingProxyType
 
 from friction_uq.simulate import SimulationConfig, run_model, simulate
-from friction_uq.simulate._jit import HAVE_NUMBA
+from friction_uq._jit import HAVE_NUMBA
 
 BASE = SimulationConfig(duration=1.2e-3, pretrigger=80e-6, sample_rate=5e6)
 CASES = {

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from .._jit import njit
 from ..signals import ar1_mean_sd
 
 _LOG_2PI = math.log(2.0 * math.pi)
@@ -39,9 +40,8 @@ def ar1_pointwise(
     rho = np.asarray(rho, float)
     offset = np.asarray(offset, float)
     if np.any(offset > 0.0):
-        shape = resid.shape[:-1]
-        return _offset_pointwise_shift(resid, np.broadcast_to(sd, shape), np.broadcast_to(rho, shape),
-                                       np.broadcast_to(np.maximum(offset, 1e-150), shape))
+        return _offset_pointwise_shift(resid, np.asarray(sd, float), np.asarray(rho, float),
+                                       np.maximum(offset, 1e-150))
     var = sd**2
     var_c = var * (1.0 - rho**2)  # conditional variance of e_t given e_{t-1}
     out = np.empty(np.broadcast_shapes(resid.shape, sd.shape + (1,), rho.shape + (1,)))
@@ -105,21 +105,41 @@ def _offset_pointwise_shift(resid: np.ndarray, sd: np.ndarray, rho: np.ndarray, 
     """Per-sample conditional log densities of u = delta + AR(1), delta ~ N(0, offset^2) (recursive form).
 
     Innovations eta_1 = u_1 = delta + e_1 (variance sd^2), eta_t = u_t - rho u_{t-1} = (1-rho) delta + w_t
-    (variance sd^2 (1-rho^2)): a regression on delta, whose predictive densities follow from
-    cumulative sums.
+    (variance sd^2 (1-rho^2)): a regression on delta, whose predictive densities follow from running sums
+    (:func:`_offset_pointwise_rows`). ``sd``, ``rho`` and ``offset`` broadcast to ``resid.shape[:-1]``.
     """
-    n = resid.shape[-1]
-    var = sd[..., None] ** 2
-    var_t = np.concatenate([np.broadcast_to(var, var.shape), np.broadcast_to(var * (1.0 - rho[..., None] ** 2), var.shape[:-1] + (n - 1,))], axis=-1)
-    x = np.concatenate([np.ones(var.shape), np.broadcast_to((1.0 - rho[..., None]), var.shape[:-1] + (n - 1,))], axis=-1)
-    eta = np.concatenate([resid[..., :1], resid[..., 1:] - rho[..., None] * resid[..., :-1]], axis=-1)
-    a = np.cumsum(x * eta / var_t, axis=-1)
-    b = 1.0 / offset[..., None] ** 2 + np.cumsum(x * x / var_t, axis=-1)
-    a_prev = np.concatenate([np.zeros(var.shape), a[..., :-1]], axis=-1)
-    b_prev = np.concatenate([np.broadcast_to(1.0 / offset[..., None] ** 2, var.shape), b[..., :-1]], axis=-1)
-    mean = x * a_prev / b_prev
-    v = var_t + x * x / b_prev
-    return -0.5 * (_LOG_2PI + np.log(v) + (eta - mean) ** 2 / v)
+    shape = resid.shape
+    rows = int(np.prod(shape[:-1], dtype=np.int64))
+    flat = [np.ascontiguousarray(np.broadcast_to(a, shape[:-1]), dtype=float).reshape(rows)
+            for a in (sd, rho, offset)]
+    out = np.empty((rows, shape[-1]))
+    _offset_pointwise_rows(np.ascontiguousarray(resid, dtype=float).reshape(rows, shape[-1]), *flat, out)
+    return out.reshape(shape)
+
+
+@njit
+def _offset_pointwise_rows(u, sd, rho, offset, out):  # pragma: no cover - compiled
+    """Row by row: with delta's posterior after t-1 samples (precision b, b * mean = a), sample t's
+    predictive is N(x_t a / b, var_t + x_t^2 / b), x_1 = 1, var_1 = sd^2, x_t = 1 - rho, var_t = sd^2 (1 - rho^2)."""
+    n = u.shape[1]
+    for i in range(u.shape[0]):
+        var = sd[i] * sd[i]
+        r = rho[i]
+        var1 = var * (1.0 - r * r)
+        c1 = 1.0 - r
+        b = 1.0 / (offset[i] * offset[i])
+        v = var + 1.0 / b
+        eta = u[i, 0]
+        out[i, 0] = -0.5 * (_LOG_2PI + math.log(v) + eta * eta / v)
+        a = eta / var
+        b += 1.0 / var
+        for t in range(1, n):
+            eta = u[i, t] - r * u[i, t - 1]
+            m = c1 * a / b
+            v = var1 + c1 * c1 / b
+            out[i, t] = -0.5 * (_LOG_2PI + math.log(v) + (eta - m) * (eta - m) / v)
+            a += c1 * eta / var1
+            b += c1 * c1 / var1
 
 
 def _innovations(x: np.ndarray, rho: float) -> np.ndarray:

@@ -51,7 +51,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit
+from .._jit import njit
 from .friction import shear_strength
 
 # indices of the parameter vector ``par``

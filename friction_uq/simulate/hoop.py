@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..record import Tube
-from ._jit import njit
+from .._jit import njit
 
 #: Table half-width in units of 1/beta (K < 1e-12 of its peak beyond) and table step.
 _HALF_WIDTH = 30.0
