@@ -201,7 +201,8 @@ def sample_posterior(
         tau_max = float(np.max(tau))
         acc = float(np.mean(backend.accepted) / max(n, 1))
         if progress is not None:
-            progress(Progress(n, max_steps, tau_max, change, n / tau_max, acc, time.perf_counter() - t_start))
+            progress(Progress(n, max_steps, tau_max, change, n / tau_max, acc, time.perf_counter() - t_start,
+                              settings.tau_factor, settings.tau_rtol))
         if n > settings.tau_factor * tau_max and change < settings.tau_rtol:
             converged = True
             break

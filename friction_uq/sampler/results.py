@@ -23,12 +23,15 @@ class Progress:
     steps_over_tau: float
     acceptance: float
     seconds: float
+    tau_factor: float  # the stopping rule's steps/tau and relative tau change (SamplerSettings)
+    tau_rtol: float
 
     def line(self) -> str:
         """A short line for a terminal."""
         return (
             f"sampling: step {self.steps}/{self.max_steps}, tau {self.tau_max:.1f} "
-            f"(steps/tau {self.steps_over_tau:.0f}, needs 50; change {100 * self.tau_change:.1f} %, needs < 1 %), "
+            f"(steps/tau {self.steps_over_tau:.0f}, needs {self.tau_factor:g}; change {100 * self.tau_change:.1f} %, "
+            f"needs < {100 * self.tau_rtol:g} %), "
             f"acceptance {self.acceptance:.2f}, {self.seconds:.1f} s"
         )
 
