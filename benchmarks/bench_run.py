@@ -5,11 +5,12 @@ command as a user starts it (a new process each time, imports included). Prints
 
 1. the command's wall and CPU time (user + sys of the process) for each of the ``--repeat`` runs
    and their median;
-2. the breakdown of one in-process run: imports, signals (read, forces, window), sampling, the
-   DataTree (pointwise log-likelihood, ESS, R-hat), sensitivity (nu priors by PSIS reweighting,
-   prior-data conflict), analysis (the lab's identification), whole_record (the simulator fitted
-   to every gauge and the misfit decision: issue target <= 2 s), outputs (netCDF, JSON, renames),
-   PDF;
+2. the breakdown of one in-process run, in this process's order: imports, signals (read, forces,
+   window), sampling, the DataTree (pointwise log-likelihood, ESS, R-hat), sensitivity (nu priors by
+   PSIS reweighting, prior-data conflict), analysis (the lab's identification), pdf (the posterior's
+   pages, then the summary page and the merge), whole_record (what is left to wait of the other
+   core's work: the simulator fitted to every gauge, the misfit decision, the record's and the
+   check's pages), outputs (netCDF, JSON, renames);
 3. ESS of f (bulk and tail; must be >= 2000), ESS per second of sampling, steps, R-hat max.
 
 On a shared machine wall times are noisy: quote CPU time beside them.
@@ -20,6 +21,7 @@ On a shared machine wall times are noisy: quote CPU time beside them.
 from __future__ import annotations
 
 import argparse
+import os
 import resource
 import statistics
 import subprocess
@@ -82,7 +84,11 @@ print(f"steps {{s.n_steps}} x {{s.nwalkers}} walkers x {{s.n_chains}} ensembles,
       f"{{bulk / s.seconds:.0f}} ESS/s of sampling; R-hat max {{res.convergence.r_hat_max:.4f}}")
 print("nu priors: " + ", ".join(f"{{k}} {{v.method}} (k {{v.pareto_k:.2f}})" for k, v in res.sensitivity.items()))
 """
-    subprocess.run([sys.executable, "-c", code], check=True)
+    # as the command runs: one BLAS thread per process (friction_uq.cli.console)
+    from friction_uq.cli import BLAS_THREADS
+
+    env = {**os.environ, **{v: os.environ.get(v, "1") for v in BLAS_THREADS}}
+    subprocess.run([sys.executable, "-c", code], check=True, env=env)
 
 
 def main(argv: list[str]) -> int:

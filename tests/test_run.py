@@ -86,6 +86,24 @@ def test_pdf_is_a_multipage_report(paper_run):
     assert pages == 11
 
 
+def test_pdf_pages_in_order_though_made_on_two_cores(paper_run):
+    """The record's and the check's pages are made on the other core, the posterior's here: merged, every
+    page stands where the summary's table of pages says."""
+    from pypdf import PdfReader
+
+    _, out, _ = paper_run
+    reader = PdfReader(out / "paper_P-01.pdf")
+    texts = [page.extract_text() for page in reader.pages]
+    titles = ["friction-uq report", "1. Record", "2. Waves", "3. Stationary window", "4. Joint posterior",
+              "5. How the uncertainty of nu", "6. Convergence", "7. Posterior predictive", "8. Tube hoop gauge",
+              "the whole test simulated with the posterior", "the whole test simulated with the posterior"]
+    assert len(texts) == len(titles)
+    for k, (text, title) in enumerate(zip(texts, titles)):
+        assert title in text, (k, title)
+    assert "(1/2)" in texts[9] and "(2/2)" in texts[10]
+    assert reader.metadata["/Title"] == "friction-uq paper P-01"
+
+
 def test_a_prior_file_with_a_typo_is_refused_and_nothing_is_written(paper_run, tmp_path, capsys):
     _, _, rec = paper_run
     bad = tmp_path / "bad.toml"
@@ -178,9 +196,9 @@ def test_a_prior_that_overwhelms_the_data_is_said_everywhere(paper_run, tmp_path
     seen = {}
     render = report.render_report
 
-    def keep(inputs):
+    def keep(inputs, **parts):
         seen["inputs"] = inputs
-        return render(inputs)
+        return render(inputs, **parts)
 
     monkeypatch.setattr(report, "render_report", keep)
     out = tmp_path / "out"

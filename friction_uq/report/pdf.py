@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import io
 import os
 import textwrap
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -121,37 +123,74 @@ def page_summary(r: ReportInputs) -> Figure:
     return fig
 
 
-def render_report(r: ReportInputs) -> bytes:
-    """The PDF (summary page, pages 1-7, and page 8 when the hoop term was used), in memory."""
-    import io
-
+def _render(builders: list[Callable[[], Figure]]) -> bytes:
+    """One PDF of the figures the builders make, one page each, in memory."""
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
-    p = r.prepared
-    meta = {"Title": f"friction-uq {p.record.campaign} {p.record.test_id}", "Creator": f"friction-uq {r.version}"}
     buf = io.BytesIO()
-    with plt.rc_context(CORE_FONTS), PdfPages(buf, metadata=meta) as pdf:
-        builders = [
-            lambda: page_summary(r),
-            lambda: page_raw(p.record),
-            lambda: page_forces(p.record, p.forces, p.window),
-            lambda: page_window(p.record, p.forces, p.window),
-            lambda: page_corner(r.samples, r.datatree),
-            lambda: page_propagation(r.samples, r.band, r.sensitivity, r.nu_share, nu_assumed=r.lab.nu),
-            lambda: page_convergence(r.samples, r.convergence),
-            lambda: page_ppc(r.ppc),
-        ]
-        if r.samples.hoop:
-            builders.append(lambda: page_hoop(r.samples, p.data, p.forces, seed=r.samples.seed,
-                                              likelihood=r.likelihood))
+    with plt.rc_context(CORE_FONTS), PdfPages(buf) as pdf:
         for build in builders:
             fig = build()
             pdf.savefig(fig)
             plt.close(fig)
-        for fig in discrepancy_pages(r):
-            pdf.savefig(fig)
-            plt.close(fig)
+    return buf.getvalue()
+
+
+def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None) -> bytes:
+    """The pages that need no posterior draw: the record's (pages 1-3) and the whole-record check's. A run
+    renders them on its other core, after the check, while it samples (:func:`render_report` merges them)."""
+    from .whole_record_pages import pages_whole_record
+
+    p = prepared
+    builders: list[Callable[[], Figure]] = [
+        lambda: page_raw(p.record),
+        lambda: page_forces(p.record, p.forces, p.window),
+        lambda: page_window(p.record, p.forces, p.window),
+    ]
+    if whole_record is not None:
+        builders += [lambda fig=fig: fig for fig in pages_whole_record(
+            whole_record, test=f"{p.record.campaign} {p.record.test_id}")]
+    return _render(builders)
+
+
+def render_posterior_part(r: ReportInputs) -> bytes:
+    """Pages 4-7 (and 8, the hoop gauge's, when its term was used): the posterior draws', which need
+    neither the whole-record check nor the diagnosis (a run renders them while it waits for those)."""
+    p = r.prepared
+    builders: list[Callable[[], Figure]] = [
+        lambda: page_corner(r.samples, r.datatree),
+        lambda: page_propagation(r.samples, r.band, r.sensitivity, r.nu_share, nu_assumed=r.lab.nu),
+        lambda: page_convergence(r.samples, r.convergence),
+        lambda: page_ppc(r.ppc),
+    ]
+    if r.samples.hoop:
+        builders.append(lambda: page_hoop(r.samples, p.data, p.forces, seed=r.samples.seed, likelihood=r.likelihood))
+    return _render(builders)
+
+
+def render_report(r: ReportInputs, record_part: bytes | None = None, posterior_part: bytes | None = None) -> bytes:
+    """The PDF, in memory: summary page, pages 1-7, page 8 when the hoop term was used, the
+    whole-record pages and, with a diagnosis, its two pages. ``record_part`` and ``posterior_part``: the
+    pages of :func:`render_record_part` and :func:`render_posterior_part` for ``r``, rendered already
+    (None: rendered here); the summary and the diagnosis pages are rendered here, and all are merged."""
+    from pypdf import PdfReader, PdfWriter
+
+    p = r.prepared
+    if record_part is None:
+        record_part = render_record_part(p, r.whole_record)
+    if posterior_part is None:
+        posterior_part = render_posterior_part(r)
+    own = [lambda: page_summary(r)] + [lambda fig=fig: fig for fig in diagnosis_pages(r)]
+    summary, *diagnosis = PdfReader(io.BytesIO(_render(own))).pages
+    record = PdfReader(io.BytesIO(record_part)).pages
+    out = PdfWriter()
+    for page in [summary, *record[:3], *PdfReader(io.BytesIO(posterior_part)).pages, *record[3:], *diagnosis]:
+        out.add_page(page)
+    out.add_metadata({"/Title": f"friction-uq {p.record.campaign} {p.record.test_id}",
+                      "/Creator": f"friction-uq {r.version}"})
+    buf = io.BytesIO()
+    out.write(buf)
     return buf.getvalue()
 
 
@@ -160,23 +199,17 @@ def whole_record_page(r: ReportInputs) -> int:
     return 9 if r.samples.hoop else 8
 
 
-def discrepancy_pages(r: ReportInputs) -> list[Figure]:
-    """The whole-record pages and, with a diagnosis, the ranking and the extended fit."""
-    p = r.prepared
-    test = f"{p.record.campaign} {p.record.test_id}"
-    figs: list[Figure] = []
-    if r.whole_record is not None:
-        from .whole_record_pages import pages_whole_record
+def diagnosis_pages(r: ReportInputs) -> list[Figure]:
+    """With a diagnosis, its two pages: the ranking and the extended fit."""
+    if r.diagnosis is None:
+        return []
+    from ..discrepancy.outcome import sentence
+    from .diagnose_pages import page_extended_fit, page_ranking
 
-        figs += pages_whole_record(r.whole_record, test=test)
-    if r.diagnosis is not None:
-        from ..discrepancy.outcome import sentence
-        from .diagnose_pages import page_extended_fit, page_ranking
-
-        fw = r.summary["f"].to_json()
-        figs += [page_ranking(r.diagnosis, f_without=fw, sentence=sentence(r.diagnosis, fw), test=test),
-                 page_extended_fit(r.diagnosis, test=test)]
-    return figs
+    test = f"{r.prepared.record.campaign} {r.prepared.record.test_id}"
+    fw = r.summary["f"].to_json()
+    return [page_ranking(r.diagnosis, f_without=fw, sentence=sentence(r.diagnosis, fw), test=test),
+            page_extended_fit(r.diagnosis, test=test)]
 
 
 def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:

@@ -7,6 +7,8 @@ deviation with the +-2 band; the stationary window (carried to the gauge) is sha
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -60,7 +62,8 @@ def pages_whole_record(chk: WholeRecordCheck, *, test: str) -> list[Figure]:
                 axes[0, j].axis("off")
                 axes[1, j].axis("off")
         axes[0, 0].legend(loc="best")
-        fig.text(0.01, 0.01, chk.decision.sentence(), fontsize=9, wrap=True)
-        fig.tight_layout(rect=(0, 0.04, 1, 0.95))
+        fig.text(0.01, 0.01, textwrap.fill(chk.decision.sentence(), 170), fontsize=9)
+        # fixed margins: tight_layout draws the page once more to measure it (half the page's time)
+        fig.subplots_adjust(left=0.08, right=0.98, bottom=0.1, top=0.9, wspace=0.22, hspace=0.3)
         out.append(fig)
     return out

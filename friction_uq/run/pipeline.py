@@ -13,9 +13,11 @@ The checkpoint is removed once the outputs are written.
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import json
 import os
 import sys
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,7 +42,7 @@ from ..diagnostics import (
     summarize,
 )
 from ..errors import OutputError, check_seed, os_error_text
-from ..likelihood import Likelihood
+from ..likelihood import Likelihood, ar1_pointwise
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import default_prior_path, load_priors
 from ..record import read_record
@@ -76,6 +78,41 @@ def _whole_record_start(lab: Identification, priors) -> dict[str, float]:
     lo, hi = (float(priors["f"].ppf(q)) for q in (0.01, 0.99))
     f = float(np.clip(lab.f, lo, hi)) if np.isfinite(lab.f) else float(priors["f"].ppf(0.5))
     return {"f": f, "nu": float(lab.nu)}
+
+
+def _alongside(prep: Prepared, priors, start: dict[str, float], *, hoop: bool, seed: int, check: bool,
+               pages: bool) -> tuple[WholeRecordCheck | None, bytes | None]:
+    """What a run computes on its other core while it samples: the whole-record check (``check``; it
+    needs no posterior draw) and the report's pages that need none either (``pages``: the record's and
+    the check's)."""
+    wrc = None
+    if check:
+        from ..discrepancy import pipeline
+
+        wrc = pipeline.whole_record_check(prep, priors, start, hoop=hoop, seed=seed)
+    part = None
+    if pages:
+        from ..report.pdf import render_record_part
+
+        part = render_record_part(prep, wrc)
+    return wrc, part
+
+
+def _prepare_soon() -> threading.Thread:
+    """On a thread, while this one samples, what the stages after the sampling would otherwise wait for:
+    dask.array, which xarray imports (a good half second) at the first DataArray it makes where dask is
+    installed (it is, for campaigns), and the compiled AR(1) densities of the pointwise log-likelihood,
+    loaded from numba's cache (a quarter of a second, the first time in a process)."""
+    def load() -> None:
+        try:
+            importlib.import_module("dask.array")
+        except ImportError:
+            pass
+        ar1_pointwise(np.zeros((1, 3)), 1.0, 0.5, 1.0)
+
+    thread = threading.Thread(target=load, name="prepare", daemon=True)
+    thread.start()
+    return thread
 
 
 def run_file(
@@ -145,15 +182,13 @@ def run_file(
     stages["signals"] = time.perf_counter() - t_start
     # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
     lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
-    # the whole-record check needs no posterior draw: it runs on the other core while this one samples,
-    # forked before the output lock is taken (the child holds no lock), stopped on the way out
-    wr_call = None
-    if whole_record or diagnose:
-        from ..discrepancy import pipeline
-
-        wr_call = pipeline.whole_record_check
-
-    with (Background(wr_call, prep, priors, _whole_record_start(lab, priors), hoop=use_hoop, seed=seed) as wr_job,
+    check = bool(whole_record or diagnose)
+    if pdf:  # imported once, before the fork, for both processes
+        import matplotlib.figure  # noqa: F401
+    # on the other core while this one samples: forked before the output lock is taken (the child holds
+    # no lock), stopped on the way out
+    with (Background(_alongside if check or pdf else None, prep, priors, _whole_record_start(lab, priors),
+                     hoop=use_hoop, seed=seed, check=check, pages=pdf) as side_job,
           output_lock(out, stem)):
         backend = out / f".{stem}.checkpoint.npz"
         remove_orphans(out, [p.name for p in names.values()] + [backend.name])
@@ -164,15 +199,17 @@ def run_file(
             f"{prep.window.t1 * 1e6:.1f} us, hoop term {'on' if use_hoop else 'off'}, priors {p_path}")
         if left_out:
             note(f"the hoop gauge is left out of the likelihood: {left_out}")
-        if wr_call is not None:
-            say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if wr_job.forked
+        if check:
+            say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if side_job.forked
                                                                          else "(after the sampling)"))
+        loader = _prepare_soon()
 
         t = time.perf_counter()
         samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
                                    progress=stderr_progress if progress else None, notify=note,
                                    likelihood=likelihood)
         stages["sampling"] = time.perf_counter() - t
+        loader.join()  # no thread left running: later stages fork only where this process has one thread
         t = time.perf_counter()
         dt = build_datatree(samples, prep.data, priors, seed=seed, likelihood=likelihood)
         dt.attrs["analysis_settings"] = settings.to_attr()  # provenance: how the likelihood was built
@@ -196,9 +233,20 @@ def run_file(
         V = sliding_velocity_summary(prep)
         stages["analysis"] = time.perf_counter() - t
         t = time.perf_counter()
-        wrc = diag = None
-        if wr_call is not None:
-            wrc = wr_job.result()
+        posterior_part = None
+        if pdf:  # the posterior's pages, while the other core finishes
+            from ..report.pdf import ReportInputs, render_posterior_part, render_report
+
+            inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
+                                  conflict, likelihood=likelihood)
+            posterior_part = render_posterior_part(inputs)
+        stages["pdf"] = time.perf_counter() - t
+        t = time.perf_counter()  # whole_record: what is left of the check when this process gets to it, and diagnose
+        wrc, record_part = side_job.result() if check or pdf else (None, None)
+        diag = None
+        if wrc is not None:
+            from ..discrepancy import pipeline
+
             pipeline.add_whole_record(dt, wrc)
             if diagnose:
                 from ..discrepancy import outcome
@@ -222,12 +270,10 @@ def run_file(
         t = time.perf_counter()
         pdf_bytes = None
         if pdf:
-            from ..report.pdf import ReportInputs, render_report
-
-            inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
-                                  conflict, whole_record=wrc, diagnosis=diag, likelihood=likelihood)
-            pdf_bytes = render_report(inputs)
-        stages["pdf"] = time.perf_counter() - t
+            inputs = dataclasses.replace(inputs, whole_record=wrc, diagnosis=diag)
+            pdf_bytes = render_report(inputs, record_part=record_part, posterior_part=posterior_part)
+        stages["pdf"] += time.perf_counter() - t
+        t = time.perf_counter()
 
         seconds = time.perf_counter() - t_start
         doc: dict[str, object] = {}
@@ -275,7 +321,7 @@ def run_file(
         write_together({names["netcdf"]: nc_bytes, names["pdf"]: pdf_bytes, names["json"]: js_bytes},
                        last=names["json"])
         backend.unlink(missing_ok=True)
-        stages["outputs"] += time.perf_counter() - t - stages["pdf"]
+        stages["outputs"] += time.perf_counter() - t
     outputs = {k: p for k, p in names.items() if k != "pdf" or pdf_bytes is not None}
     if table:
         lines = []
