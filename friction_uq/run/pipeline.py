@@ -98,16 +98,22 @@ def _alongside(prep: Prepared, priors, start: dict[str, float], *, hoop: bool, s
     return wrc, part
 
 
+#: What later stages import on first use: xarray imports dask.array at its first array and dask.distributed
+#: when it writes a netCDF file (where dask is installed, as it is for campaigns); pypdf merges the report.
+LATER_IMPORTS = ("dask.array", "dask.distributed", "pypdf")
+
+
 def _prepare_soon() -> threading.Thread:
     """On a thread, while this one samples, what the stages after the sampling would otherwise wait for:
-    dask.array, which xarray imports (a good half second) at the first DataArray it makes where dask is
-    installed (it is, for campaigns), and the compiled AR(1) densities of the pointwise log-likelihood,
-    loaded from numba's cache (a quarter of a second, the first time in a process)."""
+    the :data:`LATER_IMPORTS` (three quarters of a second) and the compiled AR(1) densities of the
+    pointwise log-likelihood, loaded from numba's cache (a quarter of a second, the first time in a
+    process)."""
     def load() -> None:
-        try:
-            importlib.import_module("dask.array")
-        except ImportError:
-            pass
+        for module in LATER_IMPORTS:
+            try:
+                importlib.import_module(module)
+            except ImportError:
+                pass
         ar1_pointwise(np.zeros((1, 3)), 1.0, 0.5, 1.0)
 
     thread = threading.Thread(target=load, name="prepare", daemon=True)
@@ -184,6 +190,7 @@ def run_file(
     lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
     check = bool(whole_record or diagnose)
     if pdf:  # imported once, before the fork, for both processes
+        import matplotlib.backends.backend_pdf  # noqa: F401
         import matplotlib.figure  # noqa: F401
     # on the other core while this one samples: forked before the output lock is taken (the child holds
     # no lock), stopped on the way out
