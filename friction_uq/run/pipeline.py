@@ -13,11 +13,9 @@ The checkpoint is removed once the outputs are written.
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import json
 import os
 import sys
-import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,12 +40,13 @@ from ..diagnostics import (
     summarize,
 )
 from ..errors import OutputError, check_seed, os_error_text
-from ..likelihood import Likelihood, ar1_pointwise
+from ..likelihood import Likelihood
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import default_prior_path, load_priors
 from ..record import read_record
 from ..sampler import PosteriorSamples, sample_posterior, stderr_progress
 from ..settings import AnalysisSettings
+from .alongside import alongside, prepare_soon, whole_record_start
 from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
 from .outputs import netcdf_bytes, safe_stem, sha256_hex, summary_table
 
@@ -69,56 +68,6 @@ class RunResult:
     sensitivity: dict[str, FUnderPrior] = dataclasses.field(default_factory=dict)
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
-
-
-def _whole_record_start(lab: Identification, priors) -> dict[str, float]:
-    """Where the whole-record fit starts its mode search (it also starts from nu either side of the prior):
-    the lab's eq. 17 estimate at the nominal nu, kept within the f prior's 1-99 % range (its median where
-    eq. 17 gives no f)."""
-    lo, hi = (float(priors["f"].ppf(q)) for q in (0.01, 0.99))
-    f = float(np.clip(lab.f, lo, hi)) if np.isfinite(lab.f) else float(priors["f"].ppf(0.5))
-    return {"f": f, "nu": float(lab.nu)}
-
-
-def _alongside(prep: Prepared, priors, start: dict[str, float], *, hoop: bool, seed: int, check: bool,
-               pages: bool) -> tuple[WholeRecordCheck | None, bytes | None]:
-    """What a run computes on its other core while it samples: the whole-record check (``check``; it
-    needs no posterior draw) and the report's pages that need none either (``pages``: the record's and
-    the check's)."""
-    wrc = None
-    if check:
-        from ..discrepancy import pipeline
-
-        wrc = pipeline.whole_record_check(prep, priors, start, hoop=hoop, seed=seed)
-    part = None
-    if pages:
-        from ..report.pdf import render_record_part
-
-        part = render_record_part(prep, wrc)
-    return wrc, part
-
-
-#: What later stages import on first use: xarray imports dask.array at its first array and dask.distributed
-#: when it writes a netCDF file (where dask is installed, as it is for campaigns); pypdf merges the report.
-LATER_IMPORTS = ("dask.array", "dask.distributed", "pypdf")
-
-
-def _prepare_soon() -> threading.Thread:
-    """On a thread, while this one samples, what the stages after the sampling would otherwise wait for:
-    the :data:`LATER_IMPORTS` (three quarters of a second) and the compiled AR(1) densities of the
-    pointwise log-likelihood, loaded from numba's cache (a quarter of a second, the first time in a
-    process)."""
-    def load() -> None:
-        for module in LATER_IMPORTS:
-            try:
-                importlib.import_module(module)
-            except ImportError:
-                pass
-        ar1_pointwise(np.zeros((1, 3)), 1.0, 0.5, 1.0)
-
-    thread = threading.Thread(target=load, name="prepare", daemon=True)
-    thread.start()
-    return thread
 
 
 def run_file(
@@ -194,7 +143,7 @@ def run_file(
         import matplotlib.figure  # noqa: F401
     # on the other core while this one samples: forked before the output lock is taken (the child holds
     # no lock), stopped on the way out
-    with (Background(_alongside if check or pdf else None, prep, priors, _whole_record_start(lab, priors),
+    with (Background(alongside if check or pdf else None, prep, priors, whole_record_start(lab, priors),
                      hoop=use_hoop, seed=seed, check=check, pages=pdf) as side_job,
           output_lock(out, stem)):
         backend = out / f".{stem}.checkpoint.npz"
@@ -209,7 +158,7 @@ def run_file(
         if check:
             say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if side_job.forked
                                                                          else "(after the sampling)"))
-        loader = _prepare_soon()
+        loader = prepare_soon()
 
         t = time.perf_counter()
         samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
