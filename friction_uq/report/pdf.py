@@ -137,6 +137,10 @@ def _render(builders: list[Callable[[], Figure]]) -> bytes:
     return buf.getvalue()
 
 
+#: Pages 1-3, the record's, open :func:`render_record_part`'s part; the check's pages follow them there.
+RECORD_PAGES = 3
+
+
 def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None) -> bytes:
     """The pages that need no posterior draw: the record's (pages 1-3) and the whole-record check's. A run
     renders them on its other core, after the check, while it samples (:func:`render_report` merges them)."""
@@ -148,6 +152,7 @@ def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None
         lambda: page_forces(p.record, p.forces, p.window),
         lambda: page_window(p.record, p.forces, p.window),
     ]
+    assert len(builders) == RECORD_PAGES
     if whole_record is not None:
         builders += [lambda fig=fig: fig for fig in pages_whole_record(
             whole_record, test=f"{p.record.campaign} {p.record.test_id}")]
@@ -185,7 +190,8 @@ def render_report(r: ReportInputs, record_part: bytes | None = None, posterior_p
     summary, *diagnosis = PdfReader(io.BytesIO(_render(own))).pages
     record = PdfReader(io.BytesIO(record_part)).pages
     out = PdfWriter()
-    for page in [summary, *record[:3], *PdfReader(io.BytesIO(posterior_part)).pages, *record[3:], *diagnosis]:
+    posterior = PdfReader(io.BytesIO(posterior_part)).pages
+    for page in [summary, *record[:RECORD_PAGES], *posterior, *record[RECORD_PAGES:], *diagnosis]:
         out.add_page(page)
     out.add_metadata({"/Title": f"friction-uq {p.record.campaign} {p.record.test_id}",
                       "/Creator": f"friction-uq {r.version}"})
