@@ -13,6 +13,8 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+from .errors import BackgroundError
+
 
 def can_fork() -> bool:
     """Whether this process may fork workers safely (module docstring)."""
@@ -62,7 +64,8 @@ class Background:
         return self._proc is not None
 
     def result(self) -> Any:
-        """The value (computed once); the exception ``fn`` raised is raised again."""
+        """The value (computed once); the exception ``fn`` raised is raised again, and
+        :class:`~friction_uq.errors.BackgroundError` where the child ended without a value."""
         fn, args, kwargs = self._call
         if self._taken is None:
             if fn is None:
@@ -76,7 +79,8 @@ class Background:
                 try:
                     self._taken = self._recv.recv()
                 except EOFError:
-                    raise RuntimeError(f"the background process running {fn.__name__} ended without a result") from None
+                    raise BackgroundError(f"the process working beside this one ({fn.__name__}) ended without handing "
+                                          "back its result: it was killed, or ran out of memory") from None
                 finally:
                     self.close()
         ok, value = self._taken

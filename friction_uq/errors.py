@@ -22,6 +22,10 @@ class RecordError(FrictionUQError):
         super().__init__(f"{self.file}: {where}: {problem}")
 
 
+class BackgroundError(FrictionUQError):
+    """A forked process ended without handing back its value (killed, or out of memory)."""
+
+
 class SignalError(FrictionUQError):
     """The signals of a record cannot be analysed (no pulse, no stationary phase, ...)."""
 

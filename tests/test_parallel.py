@@ -66,6 +66,24 @@ def test_result_is_computed_once_and_close_before_result_runs_it_in_line():
     assert Background(None).result() is None
 
 
+def _dies(code: int) -> None:
+    import os
+
+    os._exit(code)  # as if killed: no value is sent back
+
+
+def test_a_child_that_dies_is_one_sentence_not_a_traceback():
+    """A child killed (or out of memory) before its value: a FrictionUQError, which the CLI says in one line."""
+    from friction_uq.errors import BackgroundError, FrictionUQError
+
+    job = Background(_dies, 3)
+    if not job.forked:
+        pytest.skip("this process cannot fork (threads running)")
+    with pytest.raises(BackgroundError, match=r"\(_dies\) ended without handing back its result") as err:
+        job.result()
+    assert isinstance(err.value, FrictionUQError) and "\n" not in str(err.value)
+
+
 def test_the_child_ends_when_its_parent_is_killed(tmp_path):
     """A killed run must not leave its child behind (it would keep what the run had open)."""
     import os
