@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import threading
 from types import MappingProxyType
 
@@ -66,15 +69,21 @@ def test_result_is_computed_once_and_close_before_result_runs_it_in_line():
     assert Background(None).result() is None
 
 
+def _in_fresh_interpreter(tmp_path, source: str) -> subprocess.CompletedProcess:
+    """Run ``source`` as a script in a new Python process with the project on its path (a fresh interpreter
+    runs no threads, so it may fork where this one, deep in the suite, may not)."""
+    script = tmp_path / "script.py"
+    script.write_text(source)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    return subprocess.run([sys.executable, str(script)], capture_output=True, text=True, cwd=root, timeout=60,
+                          env=os.environ | {"PYTHONPATH": root})
+
+
 def test_a_child_that_dies_is_one_sentence_not_a_traceback(tmp_path):
     """A child killed (or out of memory) before its value: a FrictionUQError, which the CLI says in one line.
     In a fresh interpreter: this one may run threads by now, and then it does not fork."""
-    import os
-    import subprocess
-    import sys
-
-    script = tmp_path / "dies.py"
-    script.write_text(
+    out = _in_fresh_interpreter(
+        tmp_path,
         "import os\n"
         "from friction_uq._parallel import Background\n"
         "from friction_uq.errors import FrictionUQError\n"
@@ -86,9 +95,6 @@ def test_a_child_that_dies_is_one_sentence_not_a_traceback(tmp_path):
         "    job.result()\n"
         "except FrictionUQError as exc:\n"
         "    print(type(exc).__name__, '|', exc)\n")
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, cwd=root, timeout=60,
-                         env=os.environ | {"PYTHONPATH": root})
     forked, said = out.stdout.strip().split("\n")
     if forked != "True":
         pytest.skip("a fresh interpreter could not fork here")
@@ -99,22 +105,16 @@ def test_a_child_that_dies_is_one_sentence_not_a_traceback(tmp_path):
 
 def test_the_child_ends_when_its_parent_is_killed(tmp_path):
     """A killed run must not leave its child behind (it would keep what the run had open)."""
-    import os
-    import subprocess
-    import sys
     import time
 
-    script = tmp_path / "parent.py"
-    script.write_text(
+    out = _in_fresh_interpreter(
+        tmp_path,
         "import os, sys, time\n"
         "from tests.test_parallel import _slow\n"
         "from friction_uq._parallel import Background\n"
         "job = Background(_slow, 1.0)\n"
         "print(job._proc.pid if job.forked else -1, flush=True)\n"
         "os._exit(0)  # as if killed: no clean-up runs\n")
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, cwd=root, timeout=60,
-                         env=os.environ | {"PYTHONPATH": root})
     pid = int(out.stdout.split()[0])
     if pid < 0:
         pytest.skip("the parent could not fork")
