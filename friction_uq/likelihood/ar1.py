@@ -40,8 +40,7 @@ def ar1_pointwise(
     rho = np.asarray(rho, float)
     offset = np.asarray(offset, float)
     if np.any(offset > 0.0):
-        return _offset_pointwise_shift(resid, np.asarray(sd, float), np.asarray(rho, float),
-                                       np.maximum(offset, 1e-150))
+        return _offset_pointwise_shift(resid, sd, rho, np.maximum(offset, 1e-150))
     var = sd**2
     var_c = var * (1.0 - rho**2)  # conditional variance of e_t given e_{t-1}
     out = np.empty(np.broadcast_shapes(resid.shape, sd.shape + (1,), rho.shape + (1,)))
