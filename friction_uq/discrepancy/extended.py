@@ -77,6 +77,7 @@ class Diagnoser:
         self.prep = prep
         rec = prep.record
         self.loading = measured_loading(rec, prep.forces)
+        self.dispersive_loading = measured_loading(rec, prep.forces, dispersion=True)  # for ``dispersion``
         self.hoop = hoop and rec.has_hoop
         self.log_prior_f_nu = log_prior_f_nu
         self.seed = seed
@@ -99,7 +100,8 @@ class Diagnoser:
             for v in variants:
                 v.mechanism.apply(values, settings, gains, v.channel)
 
-        return SimulatorModel(self.prep.record.apparatus, self.loading, hoop=self.hoop, extra=tuple(extra), apply=apply)
+        return SimulatorModel(self.prep.record.apparatus, self.loading, hoop=self.hoop, extra=tuple(extra), apply=apply,
+                              dispersive_loading=self.dispersive_loading)
 
     def fit(self, variants: tuple[Variant, ...], start: Mapping[str, float], label: str) -> ModelFit:
         model = self._model(variants)

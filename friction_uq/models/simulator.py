@@ -65,6 +65,10 @@ class SimulatorModel:
         The record's apparatus (a plug of 10 mm of steel is assumed when the record has none).
     loading : Loading
         The incident wave driving the test.
+    dispersive_loading : Loading, optional
+        The same wave carried to the cell with Pochhammer-Chree dispersion (a measured wave: read at the
+        gauge, it disperses on its way to the cell as every other leg does): it drives the configurations
+        whose bars disperse (``dispersion``, here or set by ``apply``). Without it, ``loading`` drives them.
     hoop : bool
         Predict the tube hoop gauge.
     dispersion : bool
@@ -82,8 +86,10 @@ class SimulatorModel:
     name = "simulator"
 
     def __init__(self, apparatus: Apparatus, loading: Loading, *, hoop: bool = True, dispersion: bool = False,
-                 elements: int = 20, extra: tuple[Parameter, ...] = (), apply: Apply | None = None) -> None:
+                 elements: int = 20, extra: tuple[Parameter, ...] = (), apply: Apply | None = None,
+                 dispersive_loading: Loading | None = None) -> None:
         self.loading = loading
+        self.dispersive_loading = dispersive_loading
         self.hoop = hoop
         self.parameters = ParameterSet((F, NU, HOOP_GAIN, *extra))
         self._apply = apply
@@ -111,7 +117,7 @@ class SimulatorModel:
     def predict(self, values: Mapping[str, float]) -> Prediction:
         """Gauge strains over the whole record for one set of parameter values."""
         cfg, gains = self.config(values)
-        loading = self.loading
+        loading = self.dispersive_loading if cfg.dispersion and self.dispersive_loading is not None else self.loading
         g_in = gains["input_bar"]
         if g_in != 1.0:  # the measured incident wave is g_in times the true one
             loading = Loading(loading.time, loading.at_gauge / g_in, loading.at_cell / g_in, loading.source)
