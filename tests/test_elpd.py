@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from friction_uq.discrepancy.elpd import Elpd, ar1_block_loo, elpd_difference, psis_loo
+from friction_uq.discrepancy.elpd import (CALIBRATION_FLOOR, Elpd, ar1_block_loo, calibration_loo, elpd_difference,
+                                         psis_loo, with_calibration)
 
 
 @pytest.mark.parametrize("n,block", [(23, 5), (20, 5), (7, 7), (9, 4)])
@@ -45,3 +46,38 @@ def test_difference_and_its_standard_error():
     d, se = elpd_difference(a, b)
     assert d == 10.0
     assert se == pytest.approx(math.sqrt(4) * np.std([1, 2, 3, 4], ddof=1))
+
+
+@pytest.mark.parametrize("mu_d,v_d,c,s", [(1.2, 0.01, 1.0, 0.05), (0.7, 0.002, 1.0, 0.05), (3.1, 0.04, 3.0, 0.1)])
+def test_calibration_left_out_is_the_record_alone_predictive(mu_d, v_d, c, s):
+    """The record alone says N(mu_d, v_d) of the quantity; with the datum c +- s the posterior is N(m, v). Left
+    out, the datum's predictive is N(c | mu_d, v_d + s^2): the closed form must give it from (m, v) alone."""
+    v = 1.0 / (1.0 / v_d + 1.0 / s**2)
+    m = v * (mu_d / v_d + c / s**2)
+    logp, mean, var = calibration_loo(m, v, c, s)
+    assert logp == pytest.approx(stats.norm(mu_d, math.sqrt(v_d + s**2)).logpdf(c), rel=1e-9)
+    assert mean == pytest.approx(mu_d - c, rel=1e-9) and var == pytest.approx(v_d + s**2, rel=1e-9)
+
+
+def test_a_record_silent_on_the_quantity_gives_the_floored_equal_density():
+    a = calibration_loo(1.0, 0.05**2, 1.0, 0.05)
+    b = calibration_loo(1.0, 0.05**2 * 0.999, 1.0, 0.05)
+    assert a == b and math.isfinite(a[0])
+    assert a[2] == pytest.approx(0.05**2 / CALIBRATION_FLOOR)
+
+
+def test_calibration_terms_enter_the_difference_with_their_spread():
+    blocks = np.array([1.0, 2.0, 3.0, 4.0])
+    a = with_calibration(Elpd(blocks, 0.1), [calibration_loo(1.0, 0.001, 1.0, 0.05)])
+    b = with_calibration(Elpd(np.zeros(4), 0.1), [calibration_loo(0.8, 0.001, 1.0, 0.05)])
+    d, se = elpd_difference(a, b)
+    assert d == pytest.approx(10.0 + a.calibration[0] - b.calibration[0])
+    assert a.total == pytest.approx(10.0 + a.calibration[0])
+    # the spread of a log-density difference of one datum drawn from a's predictive, by simulation
+    y = 1.0 + a.calibration_mean[0] + math.sqrt(a.calibration_var[0]) * np.random.default_rng(0).standard_normal(200_000)
+    diff = (stats.norm(1.0 + a.calibration_mean[0], math.sqrt(a.calibration_var[0])).logpdf(y)
+            - stats.norm(1.0 + b.calibration_mean[0], math.sqrt(b.calibration_var[0])).logpdf(y))
+    block_var = 4 * np.var(blocks, ddof=1)
+    assert se**2 - block_var == pytest.approx(np.var(diff), rel=0.05)
+    # a model without the calibration data (another likelihood) is compared on the blocks alone
+    assert elpd_difference(a, Elpd(np.zeros(4), 0.1)) == (10.0, pytest.approx(math.sqrt(block_var)))

@@ -28,15 +28,29 @@ whitened residuals that the fit already has: g_b = -J_b^T w_b) and Sigma the pos
 are affordable; with tens of draws of a posterior this narrow its Pareto k exceeded 0.7 on most
 blocks, which is why the first-order form is the default.
 
-dELPD between two models is the sum over blocks of the difference of their pointwise elpd, its
-standard error sqrt(B) times the standard deviation of the differences (Vehtari, Gelman and Gabry
-2017).
+Calibration data. Some of what is known about a test is not in its gauges: the hoop gauge's
+calibration (1 +- 5 %) and the sample's modulus (the header's, +- 10 %) are separate measurements,
+which enter the fit as priors. A model that reads the record well only with a hoop factor of 0.75
+or a sample 50 % stiffer than measured predicts those measurements badly, yet block LOO cannot see
+it: the blocks left in pin the factor whatever the calibration said. So each calibration is one
+more datum left out in turn: its predictive density given the record,
+:func:`calibration_loo`. It has a closed form, since the datum is Gaussian: with the posterior
+N(m, v) of the calibrated quantity (the datum included) and the datum c +- s,
+
+    p(c | record) = N(c | m', V),  V = s^4 / (s^2 - v),  m' - c = (m - c) s^2 / (s^2 - v).
+
+dELPD between two models is the sum over blocks of the difference of their pointwise elpd plus the
+difference of their calibration terms. Its standard error: sqrt(B) times the standard deviation
+of the blocks' differences (Vehtari, Gelman and Gabry 2017), combined with each calibration
+datum's own spread: one datum gives no standard deviation of its own, but under Gaussian
+predictives the difference of two log densities of a datum that scatters as predicted has
+variance (m'_a - m'_b)^2 / V (V the two models' mean predictive variance).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -93,16 +107,47 @@ def ar1_block_loo(resid: np.ndarray, *, sd: float, rho: float, block: int) -> np
     return out
 
 
+#: The smallest share of a calibration datum's variance s^2 taken as not yet told by the record (s^2 - v >=
+#: this s^2): where the record says nothing of the quantity, its posterior is the datum and the left-out
+#: predictive is flat; the floor keeps it a finite, equal-for-all-models density.
+CALIBRATION_FLOOR = 0.1
+
+
+def calibration_loo(m: float, v: float, c: float, s: float) -> tuple[float, float, float]:
+    """Leave-the-datum-out predictive of a Gaussian calibration datum c +- s (module docstring).
+
+    Parameters
+    ----------
+    m, v : float
+        Posterior mean and variance of the calibrated quantity, the datum included.
+    c, s : float
+        The calibration's value and standard deviation.
+
+    Returns
+    -------
+    (log density, predictive mean minus c, predictive variance)
+    """
+    r = max(s * s - v, CALIBRATION_FLOOR * s * s)
+    var = s**4 / r
+    mean = (m - c) * s * s / r
+    return -0.5 * (_LOG_2PI + math.log(var)) - 0.5 * mean * mean / var, mean, var
+
+
 @dataclass(frozen=True)
 class Elpd:
-    """Pointwise elpd of a model (one value per channel block) and its diagnostics."""
+    """Pointwise elpd of a model (one value per channel block), its calibration data's left-out densities
+    (with their predictive means, relative to the datum, and variances: :func:`calibration_loo`) and
+    its diagnostics."""
 
     pointwise: np.ndarray
     pareto_k_max: float
+    calibration: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    calibration_mean: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    calibration_var: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def total(self) -> float:
-        return float(np.sum(self.pointwise))
+        return float(np.sum(self.pointwise) + np.sum(self.calibration))
 
     @property
     def se(self) -> float:
@@ -147,7 +192,19 @@ def takeuchi_block_loo(log_density_mode: np.ndarray, jacobian: np.ndarray, white
     return Elpd(pointwise=np.asarray(log_density_mode, float) - penalty, pareto_k_max=float("nan"))
 
 
+def with_calibration(e: Elpd, terms: list[tuple[float, float, float]]) -> Elpd:
+    """``e`` with calibration data's terms (:func:`calibration_loo`'s triples) attached."""
+    t = np.array(terms, float).reshape(-1, 3)
+    return replace(e, calibration=t[:, 0], calibration_mean=t[:, 1], calibration_var=t[:, 2])
+
+
 def elpd_difference(a: Elpd, b: Elpd) -> tuple[float, float]:
-    """elpd(a) - elpd(b) and its standard error (same pointwise layout)."""
+    """elpd(a) - elpd(b) and its standard error (same pointwise layout; module docstring). Calibration data
+    count when both models have the same ones."""
     d = a.pointwise - b.pointwise
-    return float(np.sum(d)), float(math.sqrt(len(d)) * np.std(d, ddof=1))
+    total, var = float(np.sum(d)), len(d) * float(np.var(d, ddof=1))
+    if len(a.calibration) and len(a.calibration) == len(b.calibration):
+        total += float(np.sum(a.calibration - b.calibration))
+        spread = 0.5 * (a.calibration_var + b.calibration_var)
+        var += float(np.sum((a.calibration_mean - b.calibration_mean) ** 2 / spread))
+    return total, math.sqrt(var)

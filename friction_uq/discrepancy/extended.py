@@ -6,7 +6,8 @@ the measured incident wave, extended by the mechanism, is fitted to the whole re
 posterior by a Laplace approximation; f, nu and the sample's modulus stay free, a nuisance with a
 10 % lognormal prior, the hoop gauge's calibration factor marginalised under its 5 % prior) and scored by its expected log predictive
 density over blocks of 10 us of every gauge (:mod:`.elpd`: exact leave-one-block-out for AR(1)
-noise). The baseline is the same simulator without extension. What is named from these scores is
+noise) and over the calibration data the fit takes as priors (the hoop gauge's factor, the sample's
+modulus), each left out in turn. The baseline is the same simulator without extension. What is named from these scores is
 :mod:`.diagnose`'s rule.
 
 The headline f under an extended model is the wall's coefficient at the stationary window's mean
@@ -29,7 +30,7 @@ from .._parallel import can_fork
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
-from .elpd import Elpd, ar1_block_loo, takeuchi_block_loo
+from .elpd import Elpd, ar1_block_loo, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
 
@@ -137,11 +138,26 @@ class Diagnoser:
             dens.append(ar1_block_loo(lik.scaled_residual(c, unit[c])[None], sd=nz.sd, rho=nz.rho_long_run,
                                       block=self.block)[0] + logw)
         elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z, block_of)
+        elpd = with_calibration(elpd, self._calibration(lik, fit, unit, scales["sample_modulus"]))
         names = list(fit.draws)
         S = len(fit.draws["f"])
         f_eff = np.array([self._f_effective(variants, {n: float(fit.draws[n][s]) for n in names}) for s in range(S)])
         return ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd, f_effective=f_eff,
                         predicted={c: v[None] for c, v in pred.items()}, lik=lik)
+
+    def _calibration(self, lik: WholeRecordLikelihood, fit: WholeRecordFit, unit: Mapping[str, np.ndarray],
+                     modulus_scale: tuple[float, float]) -> list[tuple[float, float, float]]:
+        """The calibration data left out in turn (:func:`~.elpd.calibration_loo`): the hoop gauge's factor
+        (1 +- its prior sd) and the sample's modulus (the header's, its prior's Gaussian stand-in in the
+        unbounded coordinate), each from the fit's posterior at the mode."""
+        out = []
+        if "tube_hoop" in lik.gain_sd:
+            m, v = lik.gain_posterior("tube_hoop", unit["tube_hoop"])
+            out.append(calibration_loo(m, v, 0.0, lik.gain_sd["tube_hoop"]))
+        i = fit.names.index("sample_modulus")
+        v = float(fit.cov_z[i, i]) if fit.cov_z is not None else 0.0
+        out.append(calibration_loo(float(self.modulus.to_unbounded(fit.mode["sample_modulus"])), v, *modulus_scale))
+        return out
 
     def fit_many(self, jobs: list[tuple[tuple[Variant, ...], Mapping[str, float], str]], *,
                  workers: int = 1) -> list[ModelFit]:

@@ -127,6 +127,16 @@ class WholeRecordLikelihood:
                                                           rho=nz.rho_long_run))
         return 1.0 + float(d[int(nz.offset_sd > 0.0)])  # the columns: [offset], gain
 
+    def gain_posterior(self, c: str, predicted_unit: np.ndarray) -> tuple[float, float]:
+        """Posterior mean and variance of channel ``c``'s gain error (its calibration included, jointly with
+        the channel's offset error) given a prediction at factor 1."""
+        nz = self.noise[c]
+        w = whiten(self._raw_scaled(c, predicted_unit), sd=nz.sd, rho=nz.rho_long_run)
+        _, V, sds = self._nuisance_basis(c, predicted_unit)
+        A = V.T @ V + np.diag(1.0 / sds**2)
+        k = int(nz.offset_sd > 0.0)  # the columns: [offset], gain
+        return float(np.linalg.solve(A, V.T @ w)[k]), float(np.linalg.inv(A)[k, k])
+
     def unit_strains(self, values: Mapping[str, float]) -> dict[str, np.ndarray]:
         """Predicted strains with the hoop gauge's factor 1: what the likelihood conditions on (the gauges'
         calibration errors are its nuisances)."""
