@@ -172,3 +172,17 @@ def test_a_hoop_calibration_finding_needs_the_baseline_and_the_final_model_to_ag
     assert outcome.hoop_gain_off(dg) is found
     dg.baseline.hoop_gain, dg.check_hoop_gain = base, None  # diagnose alone: its own baseline
     assert outcome.hoop_gain_off(dg) is found
+
+
+def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
+    """Friction on bare end faces (no PTFE sheet) lowers the wall pressure near the faces: the baseline then
+    reads the record only with a hoop factor and a sample modulus far from their calibrations, which the
+    block LOO alone cannot see and the calibration data's left-out densities do."""
+    prep, dg = _diagnose(tmp_path, noisy_config(end_friction=0.4, friction_params=MappingProxyType({"f": 0.05})),
+                         seed=25)
+    assert dg.cause is not None and dg.cause.mechanism.name == "end_friction", \
+        [(r.fit.label, r.delpd, r.se) for r in dg.ranking]
+    fx = dg.final.f_summary()
+    assert fx["q05"] <= 0.05 <= fx["q95"], fx
+    fe = dg.final.fit.draws["f_e"]
+    assert np.quantile(fe, 0.005) <= 0.4 <= np.quantile(fe, 0.995)

@@ -121,7 +121,8 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     if workers is None:
         workers = min(MAX_WORKERS, os.cpu_count() or 1)
     say = progress or (lambda msg: None)
-    dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales)
+    dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales,
+                   nominal=start)
     say("baseline")
     base = dg.fit((), start, "baseline")
     reference = base

@@ -24,7 +24,8 @@ Priors (why these ranges):
 * ``plug_friction``: force ~ half-normal(500 N), coefficient ~ half-normal(0.03) of F_i.
 * ``gauge_gain``: gain ~ lognormal(0, 0.1): a bar gauge's calibration is rarely 10 % off.
 * ``dispersion``: no parameter (the bars' geometry gives it).
-* ``end_friction``: f_e ~ half-normal(0.1): PTFE on steel is 0.02-0.1.
+* ``end_friction``: f_e ~ half-normal(0.25): PTFE on steel is 0.02-0.1, bare faces (a sheet torn or
+  missing: explosive on steel) 0.3-0.5.
 """
 
 from __future__ import annotations
@@ -211,7 +212,7 @@ register(Mechanism(
     signature="a lower F_eo/F_io than eq. 13 gives for the same f (eq. 17 reads f low) and a smaller hoop "
               "signal; the cell's equilibrium unchanged",
     parameters=(Parameter("f_e", "-", 0.0, 1.0, "friction coefficient of the end faces"),),
-    priors={"f_e": stats.halfnorm(scale=0.1)},
+    priors={"f_e": stats.halfnorm(scale=0.25)},
     start={"f_e": 0.01},
     apply=lambda v, s, g, ch: s.__setitem__("end_friction", float(v["f_e"])),
 ))
