@@ -186,3 +186,15 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
     assert fx["q05"] <= 0.05 <= fx["q95"], fx
     fe = dg.final.fit.draws["f_e"]
     assert np.quantile(fe, 0.005) <= 0.4 <= np.quantile(fe, 0.995)
+    # the calibration data's terms, in the JSON and in the DataTree as written and read back
+    top = outcome.to_json(dg, {"mean": 0.05, "sd": 0.003, "q05": 0.045, "q50": 0.05, "q95": 0.055})["ranking"][0]
+    assert set(top["calibration_elpd"]) == {"hoop_gain", "sample_modulus"}
+    import xarray as xr
+
+    dt = xr.DataTree()
+    outcome.add_to_datatree(dt, dg)
+    dt.to_netcdf(tmp_path / "d.nc")
+    with xr.open_datatree(tmp_path / "d.nc") as back:
+        ll = back["discrepancy_end_friction/log_likelihood"]
+        assert list(ll["calibration"].values) == ["hoop_gain", "sample_modulus"]
+        assert ll.attrs["elpd"] == pytest.approx(float(ll["block_elpd"].sum() + ll["calibration_elpd"].sum()))

@@ -68,8 +68,8 @@ def test_a_record_silent_on_the_quantity_gives_the_floored_equal_density():
 
 def test_calibration_terms_enter_the_difference_with_their_spread():
     blocks = np.array([1.0, 2.0, 3.0, 4.0])
-    a = with_calibration(Elpd(blocks, 0.1), [calibration_loo(1.0, 0.001, 1.0, 0.05)])
-    b = with_calibration(Elpd(np.zeros(4), 0.1), [calibration_loo(0.8, 0.001, 1.0, 0.05)])
+    a = with_calibration(Elpd(blocks, 0.1), {"hoop_gain": calibration_loo(1.0, 0.001, 1.0, 0.05)})
+    b = with_calibration(Elpd(np.zeros(4), 0.1), {"hoop_gain": calibration_loo(0.8, 0.001, 1.0, 0.05)})
     d, se = elpd_difference(a, b)
     assert d == pytest.approx(10.0 + a.calibration[0] - b.calibration[0])
     assert a.total == pytest.approx(10.0 + a.calibration[0])

@@ -144,6 +144,7 @@ class Elpd:
     calibration: np.ndarray = field(default_factory=lambda: np.zeros(0))
     calibration_mean: np.ndarray = field(default_factory=lambda: np.zeros(0))
     calibration_var: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    calibration_names: tuple[str, ...] = ()
 
     @property
     def total(self) -> float:
@@ -192,10 +193,11 @@ def takeuchi_block_loo(log_density_mode: np.ndarray, jacobian: np.ndarray, white
     return Elpd(pointwise=np.asarray(log_density_mode, float) - penalty, pareto_k_max=float("nan"))
 
 
-def with_calibration(e: Elpd, terms: list[tuple[float, float, float]]) -> Elpd:
-    """``e`` with calibration data's terms (:func:`calibration_loo`'s triples) attached."""
-    t = np.array(terms, float).reshape(-1, 3)
-    return replace(e, calibration=t[:, 0], calibration_mean=t[:, 1], calibration_var=t[:, 2])
+def with_calibration(e: Elpd, terms: dict[str, tuple[float, float, float]]) -> Elpd:
+    """``e`` with calibration data's terms attached (name -> :func:`calibration_loo`'s triple)."""
+    t = np.array(list(terms.values()), float).reshape(-1, 3)
+    return replace(e, calibration=t[:, 0], calibration_mean=t[:, 1], calibration_var=t[:, 2],
+                   calibration_names=tuple(terms))
 
 
 def elpd_difference(a: Elpd, b: Elpd) -> tuple[float, float]:
@@ -203,7 +205,7 @@ def elpd_difference(a: Elpd, b: Elpd) -> tuple[float, float]:
     count when both models have the same ones."""
     d = a.pointwise - b.pointwise
     total, var = float(np.sum(d)), len(d) * float(np.var(d, ddof=1))
-    if len(a.calibration) and len(a.calibration) == len(b.calibration):
+    if len(a.calibration) and a.calibration_names == b.calibration_names:
         total += float(np.sum(a.calibration - b.calibration))
         spread = 0.5 * (a.calibration_var + b.calibration_var)
         var += float(np.sum((a.calibration_mean - b.calibration_mean) ** 2 / spread))

@@ -158,17 +158,18 @@ class Diagnoser:
                         predicted={c: v[None] for c, v in pred.items()}, lik=lik)
 
     def _calibration(self, lik: WholeRecordLikelihood, fit: WholeRecordFit, unit: Mapping[str, np.ndarray],
-                     modulus_scale: tuple[float, float]) -> list[tuple[float, float, float]]:
+                     modulus_scale: tuple[float, float]) -> dict[str, tuple[float, float, float]]:
         """The calibration data left out in turn (:func:`~.elpd.calibration_loo`): the hoop gauge's factor
         (1 +- its prior sd) and the sample's modulus (the header's, its prior's Gaussian stand-in in the
         unbounded coordinate), each from the fit's posterior at the mode."""
-        out = []
+        out = {}
         if "tube_hoop" in lik.gain_sd:
             m, v = lik.gain_posterior("tube_hoop", unit["tube_hoop"])
-            out.append(calibration_loo(m, v, 0.0, lik.gain_sd["tube_hoop"]))
+            out["hoop_gain"] = calibration_loo(m, v, 0.0, lik.gain_sd["tube_hoop"])
         i = fit.names.index("sample_modulus")
         v = float(fit.cov_z[i, i]) if fit.cov_z is not None else 0.0
-        out.append(calibration_loo(float(self.modulus.to_unbounded(fit.mode["sample_modulus"])), v, *modulus_scale))
+        out["sample_modulus"] = calibration_loo(float(self.modulus.to_unbounded(fit.mode["sample_modulus"])), v,
+                                                *modulus_scale)
         return out
 
     def fit_many(self, jobs: list[tuple[tuple[Variant, ...], Mapping[str, float], str]], *,
