@@ -65,6 +65,31 @@ def test_decisive_rule():
     assert beyond(500.0, 200.0, None)
 
 
+def _ranked(name, channel, blocks):
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.diagnose import Ranked
+    from friction_uq.discrepancy.elpd import Elpd
+    from friction_uq.discrepancy.extended import Variant
+
+    fit = SimpleNamespace(elpd=Elpd(np.asarray(blocks, float), float("nan")),
+                          variants=(Variant(MECHANISMS[name], channel),))
+    return Ranked(fit, float(np.sum(blocks)), 1.0)
+
+
+def test_the_same_mechanism_on_another_gauge_is_a_gauge_not_a_mechanism_not_separable():
+    from friction_uq.discrepancy.diagnose import separability
+
+    best = _ranked("gauge_gain", "external_output_bar", [3.0, 3.0, 3.0, 3.0])
+    same = _ranked("gauge_gain", "input_bar", [3.0, 2.9, 3.1, 3.0])
+    other = _ranked("plug_friction", None, [3.0, 3.1, 2.9, 3.0])
+    far = _ranked("clearance", None, [0.5, 0.4, 0.6, 0.5])
+    assert separability([best, same, far]) == ((), ("input_bar",), None)
+    names, channels, how = separability([best, same, other, far])
+    assert names == ("gauge_gain", "plug_friction") and channels == ("input_bar",) and how
+    assert separability([best, far]) == ((), (), None)
+
+
 def test_extended_models_fitted_on_two_processes_are_the_same_bits(tmp_path):
     from friction_uq.discrepancy.extended import Diagnoser, Variant
 

@@ -85,6 +85,8 @@ class Diagnosis:
     not_separable: tuple[str, ...]
     separate_by: str | None
     final: ModelFit
+    #: other gauges on which the first cause (a gauge_gain) explains the record about as well
+    channels_not_separable: tuple[str, ...] = ()
     rms: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict)
     seconds: float = 0.0
     baseline_comparison: WholeRecord | None = None
@@ -105,6 +107,26 @@ class Diagnosis:
 def rank(reference: ModelFit, fits: list[ModelFit], *, misfit: bool = False) -> tuple[Ranked, ...]:
     out = [Ranked(f, *elpd_difference(f.elpd, reference.elpd), misfit=misfit) for f in fits]
     return tuple(sorted(out, key=lambda r: -r.delpd))
+
+
+def separability(decisive: list[Ranked]) -> tuple[tuple[str, ...], tuple[str, ...], str | None]:
+    """Who explains the record about as well as the best of the ``decisive`` (module docstring): the
+    mechanisms not separable from it (with it first; empty when none), the other gauges on which the same
+    mechanism does (a gauge_gain: the mechanism is named, its gauge is not certain), and what would
+    separate the mechanisms."""
+    best = decisive[0]
+    named = best.fit.variants[-1]
+    close = []
+    for r in decisive[1:]:
+        d, se = elpd_difference(best.fit.elpd, r.fit.elpd)
+        if not beyond(d, se, max(STRONG_ELPD, 0.1 * best.delpd) if best.misfit else None):
+            close.append(r.fit.variants[-1])
+    channels = tuple(v.channel for v in close if v.mechanism is named.mechanism and v.channel)
+    others = [v.mechanism.name for v in close if v.mechanism is not named.mechanism]
+    if not others:
+        return (), channels, None
+    names = tuple(dict.fromkeys([named.mechanism.name, *others]))
+    return names, channels, SEPARATE_BY.get(frozenset(names[:2]), DEFAULT_SEPARATION)
 
 
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
@@ -130,6 +152,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     rounds: list[tuple[Ranked, ...]] = []
     misfits: list[MisfitDecision] = []
     not_sep: tuple[str, ...] = ()
+    other_channels: tuple[str, ...] = ()
     separate_by = None
     for k in range(max_causes):
         say("misfit of the reference model")
@@ -149,16 +172,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
             break
         best = decisive[0]
         if k == 0:
-            close = []
-            for r in decisive[1:]:
-                d, se = elpd_difference(best.fit.elpd, r.fit.elpd)
-                if not beyond(d, se, max(STRONG_ELPD, 0.1 * best.delpd) if best.misfit else None):
-                    close.append(r.fit.variants[-1].mechanism.name)
-            if close:
-                names = [best.fit.variants[-1].mechanism.name] + [c for c in close if c != best.fit.variants[-1].mechanism.name]
-                not_sep = tuple(dict.fromkeys(names))
-                key = frozenset(not_sep[:2])
-                separate_by = SEPARATE_BY.get(key, DEFAULT_SEPARATION)
+            not_sep, other_channels, separate_by = separability(decisive)
         causes.append(best.fit.variants[-1])
         reference = best.fit
     final = reference
@@ -168,7 +182,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     a = compare_whole_record(prep, base.predicted)
     b = compare_whole_record(prep, final.predicted)
     return Diagnosis(baseline=base, rounds=tuple(rounds), misfits=tuple(misfits), causes=tuple(causes), not_separable=not_sep,
-                     separate_by=separate_by, final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
+                     channels_not_separable=other_channels, separate_by=separate_by, final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b)
 
 

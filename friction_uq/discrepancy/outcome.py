@@ -48,6 +48,9 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     first = dg.ranking[0]
     v = dg.causes[0]
     name = v.mechanism.name + (f" on the {CHANNEL_LABELS.get(v.channel, v.channel)} gauge" if v.channel else "")
+    if dg.channels_not_separable:
+        alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
+        name += f" ({alt} gauge explains the record about as well)"
     more = ""
     if len(dg.causes) > 1:
         more = " then " + ", ".join(c.mechanism.name + (f" ({c.channel})" if c.channel else "") for c in dg.causes[1:])
@@ -93,6 +96,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
     return {
         "cause": cause.mechanism.name if cause else None,
         "cause_channel": cause.channel if cause else None,
+        "cause_channel_not_separable": list(dg.channels_not_separable),
         "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.causes],
         "not_separable": list(dg.not_separable),
         "separate_by": dg.separate_by,
