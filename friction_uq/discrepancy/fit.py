@@ -28,6 +28,11 @@ __all__ = ["GAIN_SD", "WholeRecordFit", "WholeRecordLikelihood", "fit_whole_reco
 LogPrior = Callable[[Mapping[str, float]], float]
 #: Step (unbounded coordinate) of the central differences giving the Laplace precision.
 JACOBIAN_STEP = 1e-3
+#: Mode search stops when a step changes the cost (half the squared whitened residuals, ~ samples / 2) by less
+#: than FTOL of it, or the parameters (unbounded) by less than XTOL: 1e-8 of a cost of 1e4-1e5 is 1e-4 to 1e-3
+#: nats, far below what the ELPD's SE resolves, where a stick-slip model's cost is a staircase in f that a
+#: stricter tolerance chased for thousands of simulator runs.
+FTOL, XTOL = 1e-8, 1e-8
 #: Blocks apart whose scores are taken as correlated in :func:`robust_covariance` (Bartlett weights).
 ROBUST_LAGS = 4
 
@@ -123,7 +128,7 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     res = None
     for alt in ({}, *extra_starts):
         za = np.array([float(p.to_unbounded(alt.get(p.name, start[p.name]))) for p in params])
-        r = optimize.least_squares(residuals, za, method="trf", x_scale=width, diff_step=1e-6, xtol=1e-12, ftol=1e-10,
+        r = optimize.least_squares(residuals, za, method="trf", x_scale=width, diff_step=1e-6, xtol=XTOL, ftol=FTOL,
                                    max_nfev=60 * (len(z0) + 1))
         if res is None or r.cost < res.cost:
             res = r
