@@ -106,7 +106,6 @@ def main() -> None:
     hoop: dict[str, list[float]] = {}
     header = (f"{'records':<36} {'n':>5} {'flag':>5} {'refused':>7} {'rate':>7}  95 % interval "
               "(flag: misfit detected, or refused: no stationary phase)")
-    jobs = [("clean (false alarms)", None)] * 0
     k = 0
     hits = 0
     for i in range(args.clean):
