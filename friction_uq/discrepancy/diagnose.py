@@ -17,8 +17,8 @@ Rule (documented in README.md):
   max(40, 10 % of the best dELPD)) explains the record about as well: the two are named together
   as ``not_separable`` from this record, with what would separate them;
 * then the search goes on with the named cause in the model (the reference becomes baseline +
-  cause), for at most three causes, so that a record with several effects gets them in order of
-  evidence.
+  cause), for at most four causes (the bundled set-up B hides four mechanisms), so that a record
+  with several effects gets them in order of evidence.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from .whole_record import WholeRecord, compare_whole_record
 
 #: Decisive evidence: dELPD above DECISIVE_ELPD and above DECISIVE_SE standard errors or STRONG_ELPD.
 DECISIVE_ELPD, DECISIVE_SE, STRONG_ELPD = 4.0, 2.0, 40.0
-MAX_CAUSES = 3
+MAX_CAUSES = 4
 #: Processes fitting one round's extended models by default.
 MAX_WORKERS = 4
 

@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -190,9 +191,20 @@ def propagate(
         raise ValueError(
             f"dispersive=True needs the bar's diameter (m) and nu, received diameter={diameter!r}, nu={nu!r}"
         )
+    transfer = _dispersive_transfer(length, dt, z, c0_v, float(diameter), float(nu), float(inner_diameter))
+    return _apply_transfer(x, length, transfer)
+
+
+@functools.lru_cache(maxsize=64)
+def _dispersive_transfer(length: int, dt: float, z: float, c0: float, diameter: float, nu: float,
+                         inner_diameter: float) -> np.ndarray:
+    """The bins' transfer factor of :func:`propagate` (dispersive): a forward model transports the same
+    bars over the same distances at every call, so it is computed once per bar and distance (read-only)."""
     f = np.fft.rfftfreq(length, d=dt)
-    cp = phase_velocity(f, c0=c0_v, diameter=diameter, nu=nu, inner_diameter=inner_diameter)
-    cutoff = first_mode_cutoff(c0=c0_v, diameter=diameter, nu=nu, inner_diameter=inner_diameter)
+    cp = phase_velocity(f, c0=c0, diameter=diameter, nu=nu, inner_diameter=inner_diameter)
+    cutoff = first_mode_cutoff(c0=c0, diameter=diameter, nu=nu, inner_diameter=inner_diameter)
     weight = _cutoff_weight(f, cutoff)
     cycles = np.mod(f * (z / cp), 1.0)
-    return _apply_transfer(x, length, weight * np.exp(-2j * np.pi * cycles))
+    out = weight * np.exp(-2j * np.pi * cycles)
+    out.flags.writeable = False
+    return out
