@@ -223,3 +223,24 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
         ll = back["discrepancy_end_friction/log_likelihood"]
         assert list(ll["calibration"].values) == ["hoop_gain", "sample_modulus"]
         assert ll.attrs["elpd"] == pytest.approx(float(ll["block_elpd"].sum() + ll["calibration_elpd"].sum()))
+
+
+def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(tmp_path):
+    """data/B/B-02 hides dispersion, a clearance, velocity weakening, plug friction and a hoop gauge 5 % low
+    (data/README.md); the installed command's diagnose names the four mechanisms, says the hoop's factor,
+    and f under them covers the wall's true f(V) = 0.0504 that the stationary f (biased by the plug)
+    misses."""
+    import json
+    from pathlib import Path
+
+    from friction_uq.cli import main
+
+    data = Path(__file__).resolve().parents[1] / "data" / "B" / "B-02.h5"
+    assert main(["diagnose", str(data), "--out", str(tmp_path), "--no-pdf", "--quiet"]) == 0
+    doc = json.loads((tmp_path / "B_B-02.json").read_text())
+    dd = doc["discrepancy"]
+    assert {c["name"] for c in dd["causes"]} == {"dispersion", "clearance", "velocity_friction", "plug_friction"}
+    assert dd["hoop_gain"]["finding"] and dd["hoop_gain"]["value"] < 0.98
+    assert dd["f_extended"]["q05"] <= 0.0504 <= dd["f_extended"]["q95"]
+    assert not doc["f"]["q05"] <= 0.0504 <= doc["f"]["q95"]
+    assert "plug_friction" in dd["sentence"] and "hoop gauge reads" in dd["sentence"]
