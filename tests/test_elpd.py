@@ -74,7 +74,8 @@ def test_calibration_terms_enter_the_difference_with_their_spread():
     assert d == pytest.approx(10.0 + a.calibration[0] - b.calibration[0])
     assert a.total == pytest.approx(10.0 + a.calibration[0])
     # the spread of a log-density difference of one datum drawn from a's predictive, by simulation
-    y = 1.0 + a.calibration_mean[0] + math.sqrt(a.calibration_var[0]) * np.random.default_rng(0).standard_normal(200_000)
+    z = np.random.default_rng(0).standard_normal(200_000)
+    y = 1.0 + a.calibration_mean[0] + math.sqrt(a.calibration_var[0]) * z
     diff = (stats.norm(1.0 + a.calibration_mean[0], math.sqrt(a.calibration_var[0])).logpdf(y)
             - stats.norm(1.0 + b.calibration_mean[0], math.sqrt(b.calibration_var[0])).logpdf(y))
     block_var = 4 * np.var(blocks, ddof=1)

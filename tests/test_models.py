@@ -112,7 +112,8 @@ def test_a_dispersive_record_is_reproduced_by_the_dispersive_model_fed_the_dispe
     ratios = {}
     for name, extra in (("dispersed", {"dispersive_loading": measured_loading(rec, prep.forces, dispersion=True)}),
                         ("carried without", {})):
-        pred = SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), dispersion=True, **extra).predict(values)
+        model = SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), dispersion=True, **extra)
+        pred = model.predict(values)
         for ch in ("internal_output_bar", "external_output_bar"):
             nz = prep.forces.channels[ch].noise
             resid = (rec.strain(ch) - nz.offset - pred.strains[ch])[loaded]

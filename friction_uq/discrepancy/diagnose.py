@@ -181,8 +181,9 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         final = replace(final, predicted=dg.predictive(final))
     a = compare_whole_record(prep, base.predicted)
     b = compare_whole_record(prep, final.predicted)
-    return Diagnosis(baseline=base, rounds=tuple(rounds), misfits=tuple(misfits), causes=tuple(causes), not_separable=not_sep,
-                     channels_not_separable=other_channels, separate_by=separate_by, final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
+    return Diagnosis(baseline=base, rounds=tuple(rounds), misfits=tuple(misfits), causes=tuple(causes),
+                     not_separable=not_sep, channels_not_separable=other_channels, separate_by=separate_by,
+                     final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b)
 
 

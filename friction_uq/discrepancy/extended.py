@@ -7,8 +7,8 @@ posterior by a Laplace approximation; f, nu and the sample's modulus stay free, 
 10 % lognormal prior, the hoop gauge's calibration factor marginalised under its 5 % prior) and scored by its expected log predictive
 density over blocks of 10 us of every gauge (:mod:`.elpd`: exact leave-one-block-out for AR(1)
 noise) and over the calibration data the fit takes as priors (the hoop gauge's factor, the sample's
-modulus), each left out in turn. The baseline is the same simulator without extension. What is named from these scores is
-:mod:`.diagnose`'s rule.
+modulus), each left out in turn. The baseline is the same simulator without extension. What is
+named from these scores is :mod:`.diagnose`'s rule.
 
 The headline f under an extended model is the wall's coefficient at the stationary window's mean
 sliding speed, pressure and slip (``f_effective`` of the mechanism), summarised over the draws.
@@ -104,8 +104,8 @@ class Diagnoser:
             for v in variants:
                 v.mechanism.apply(values, settings, gains, v.channel)
 
-        return SimulatorModel(self.prep.record.apparatus, self.loading, hoop=self.hoop, extra=tuple(extra), apply=apply,
-                              dispersive_loading=self.dispersive_loading)
+        return SimulatorModel(self.prep.record.apparatus, self.loading, hoop=self.hoop, extra=tuple(extra),
+                              apply=apply, dispersive_loading=self.dispersive_loading)
 
     def fit(self, variants: tuple[Variant, ...], start: Mapping[str, float], label: str) -> ModelFit:
         model = self._model(variants)
@@ -133,7 +133,8 @@ class Diagnoser:
         # from there only at a poorer mode; not needed (and not made) while the modulus is within its prior's sd
         if not variants:
             extra = tuple({"nu": nu, "sample_modulus": self.E0} for nu in NU_STARTS)
-        elif abs(self.modulus.to_unbounded(st["sample_modulus"]) - scales["sample_modulus"][0]) > scales["sample_modulus"][1]:
+        elif abs(self.modulus.to_unbounded(st["sample_modulus"]) - scales["sample_modulus"][0]) > \
+                scales["sample_modulus"][1]:
             extra = ({**{k: self.nominal[k] for k in ("f", "nu") if k in self.nominal}, "sample_modulus": self.E0},)
         else:
             extra = ()

@@ -25,7 +25,8 @@ def _entry(r: Ranked) -> dict[str, object]:
     params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
     return {"name": v.mechanism.name, "channel": v.channel, "model": r.fit.label, "delpd": r.delpd, "se": r.se,
             "decisive": r.decisive, "parameters": params,
-            "calibration_elpd": dict(zip(r.fit.elpd.calibration_names, map(float, r.fit.elpd.calibration))), "f_effective": summarize_draws(r.fit.f_effective),
+            "calibration_elpd": dict(zip(r.fit.elpd.calibration_names, map(float, r.fit.elpd.calibration))),
+            "f_effective": summarize_draws(r.fit.f_effective),
             "draws": int(len(r.fit.f_effective)), "ess": _ess(r.fit.fit.log_weights)}
 
 
