@@ -236,7 +236,7 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
     from friction_uq.cli import main
 
     data = Path(__file__).resolve().parents[1] / "data" / "B" / "B-02.h5"
-    assert main(["diagnose", str(data), "--out", str(tmp_path), "--no-pdf", "--quiet"]) == 0
+    assert main(["diagnose", str(data), "--out", str(tmp_path), "--quiet"]) == 0
     doc = json.loads((tmp_path / "B_B-02.json").read_text())
     dd = doc["discrepancy"]
     assert {c["name"] for c in dd["causes"]} == {"dispersion", "clearance", "velocity_friction", "plug_friction"}
@@ -244,3 +244,10 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
     assert dd["f_extended"]["q05"] <= 0.0504 <= dd["f_extended"]["q95"]
     assert not doc["f"]["q05"] <= 0.0504 <= doc["f"]["q95"]
     assert "plug_friction" in dd["sentence"] and "hoop gauge reads" in dd["sentence"]
+    # the report's first page leads with the headline f and the model it comes from, as the JSON's f_headline
+    from pypdf import PdfReader
+
+    first = " ".join(PdfReader(tmp_path / "B_B-02.pdf").pages[0].extract_text().split())
+    head = doc["f_headline"]
+    assert head["model"] == dd["model"]
+    assert f"Headline f = {head['q50']:.3f} [{head['q05']:.3f}, {head['q95']:.3f}]" in first, first[:300]

@@ -64,7 +64,13 @@ def page_summary(r: ReportInputs) -> Figure:
     s = r.summary
     f, nu = s["f"], s["nu"]
     share = r.nu_share
-    lines = [
+    headline = []
+    if r.diagnosis is not None and r.diagnosis.causes:  # the JSON's f_headline: f under the named causes
+        fx = r.diagnosis.final.f_summary()
+        headline = [f"Headline f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] under the model with the named "
+                    f"causes ({r.diagnosis.final.label}, page {whole_record_page(r) + 2}); the stationary analysis "
+                    "without them follows."]
+    lines = headline + [
         f"Friction coefficient f = {f.q50:.3f}, 90 % credible interval [{f.q05:.3f}, {f.q95:.3f}] "
         f"(posterior mean {f.mean:.3f}, sd {f.sd:.3f}).",
         f"Poisson ratio nu = {nu.q50:.3f} [{nu.q05:.3f}, {nu.q95:.3f}]; the forces fix only "
