@@ -211,6 +211,11 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
     assert fx["q05"] <= 0.05 <= fx["q95"], fx
     fe = dg.final.fit.draws["f_e"]
     assert np.quantile(fe, 0.005) <= 0.4 <= np.quantile(fe, 0.995)
+    # kappa = f nu / (1 - nu) under the extended model, beside the baseline's (eq. 17's product)
+    doc = outcome.to_json(dg, {"mean": 0.05, "sd": 0.003, "q05": 0.045, "q50": 0.05, "q95": 0.055})
+    nu = dg.final.fit.draws["nu"]
+    assert doc["kappa_extended"]["q50"] == pytest.approx(np.median(dg.final.f_effective * nu / (1 - nu)))
+    assert doc["kappa_baseline_whole_record"]["q50"] > 0.0
     # the calibration data's terms, in the JSON and in the DataTree as written and read back
     top = outcome.to_json(dg, {"mean": 0.05, "sd": 0.003, "q05": 0.045, "q50": 0.05, "q95": 0.055})["ranking"][0]
     assert set(top["calibration_elpd"]) == {"hoop_gain", "sample_modulus"}

@@ -20,6 +20,12 @@ def _ess(log_weights: np.ndarray) -> float:
     return effective_sample_size(np.exp(lw - np.max(lw)))
 
 
+def kappa_draws(mf: ModelFit) -> np.ndarray:
+    """kappa = f nu / (1 - nu) (eq. 17's product) for each draw of a fitted model, f its effective coefficient."""
+    nu = np.asarray(mf.fit.draws["nu"], float)
+    return mf.f_effective * nu / (1.0 - nu)
+
+
 def _entry(r: Ranked) -> dict[str, object]:
     v = r.fit.variants[-1]
     params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
@@ -108,6 +114,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
         "f_baseline_stationary": f_without,
         "f_baseline_whole_record": dg.baseline.f_summary(),
         "nu_extended": summarize_draws(dg.final.fit.draws["nu"]),
+        "kappa_extended": summarize_draws(kappa_draws(dg.final)),
+        "kappa_baseline_whole_record": summarize_draws(kappa_draws(dg.baseline)),
         "hoop_gain": {"value": hoop, "without_causes": baseline_hoop_gain(dg), "finding": hoop_gain_off(dg),
                       "meaning": "calibration factor of the tube hoop gauge (recorded / true) at the final model's "
                                  "whole-record fit: its most probable value under a 5 % prior"},

@@ -14,6 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..discrepancy.diagnose import DECISIVE_ELPD, Diagnosis
+from ..discrepancy.outcome import kappa_draws
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from .style import figure
 
@@ -48,9 +49,9 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     lines = [sentence, "",
              f"f, stationary phase (eq. 17 + hoop): {f_without['q50']:.4f} [{f_without['q05']:.4f}, {f_without['q95']:.4f}]",
              f"f, baseline over the whole record: {fb['q50']:.4f} [{fb['q05']:.4f}, {fb['q95']:.4f}] "
-             f"(nu {np.median(dg.baseline.fit.draws['nu']):.3f})",
+             f"(nu {np.median(dg.baseline.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.baseline)):.4f})",
              f"f, model '{dg.final.label}': {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] "
-             f"(nu {np.median(dg.final.fit.draws['nu']):.3f})",
+             f"(nu {np.median(dg.final.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.final)):.4f})",
              f"hoop gauge gain (final model, most probable under its 5 % prior): {dg.final.hoop_gain:.3f}", ""]
     for v in dg.causes:
         lines.append(f"{v.mechanism.name}{' (' + v.channel + ')' if v.channel else ''}: {v.mechanism.meaning}")
