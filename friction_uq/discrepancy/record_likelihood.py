@@ -119,23 +119,18 @@ class WholeRecordLikelihood:
     def hoop_gain(self, predicted_unit: np.ndarray) -> float:
         """The hoop gauge's calibration factor given a prediction at factor 1: its most probable value under
         its prior (jointly with the channel's offset error)."""
-        c = "tube_hoop"
-        if c not in self.gain_sd:
+        if "tube_hoop" not in self.gain_sd:
             return 1.0
-        nz = self.noise[c]
-        d, *_ = self._nuisances(c, predicted_unit, whiten(self._raw_scaled(c, predicted_unit), sd=nz.sd,
-                                                          rho=nz.rho_long_run))
-        return 1.0 + float(d[int(nz.offset_sd > 0.0)])  # the columns: [offset], gain
+        return 1.0 + self.gain_posterior("tube_hoop", predicted_unit)[0]
 
     def gain_posterior(self, c: str, predicted_unit: np.ndarray) -> tuple[float, float]:
         """Posterior mean and variance of channel ``c``'s gain error (its calibration included, jointly with
         the channel's offset error) given a prediction at factor 1."""
         nz = self.noise[c]
         w = whiten(self._raw_scaled(c, predicted_unit), sd=nz.sd, rho=nz.rho_long_run)
-        _, V, sds = self._nuisance_basis(c, predicted_unit)
-        A = V.T @ V + np.diag(1.0 / sds**2)
+        d, _, V, sds, _ = self._nuisances(c, predicted_unit, w)
         k = int(nz.offset_sd > 0.0)  # the columns: [offset], gain
-        return float(np.linalg.solve(A, V.T @ w)[k]), float(np.linalg.inv(A)[k, k])
+        return float(d[k]), float(np.linalg.inv(V.T @ V + np.diag(1.0 / sds**2))[k, k])
 
     def unit_strains(self, values: Mapping[str, float]) -> dict[str, np.ndarray]:
         """Predicted strains with the hoop gauge's factor 1: what the likelihood conditions on (the gauges'
