@@ -111,9 +111,9 @@ def test_diagnosed_tests_fit_the_law_to_f_under_their_models_not_to_a_biased_kap
     assert "flagged: set-up B does not follow the shared law: f offset +" in summary_text(doc)
     # one test without a diagnosis: back to the stationary kappa for all
     tests[0].f_model = None
-    mixed = analyse_tests(tests, tally_causes([]), seed=3)
+    mixed = analyse_tests(tests[:5], tally_causes([]), seed=3)  # set-up A alone: four laws, no offsets
     assert mixed.law_data.basis == "kappa"
-    assert any("only 14 of 15 tests were diagnosed" in x for x in mixed.sentences)
+    assert any("only 4 of 5 tests were diagnosed" in x for x in mixed.sentences)
 
 
 @pytest.mark.parametrize("final", [None, "", "discrepancy_clearance"])
@@ -200,3 +200,81 @@ def test_decisive_uses_students_t_for_few_tests():
     assert not decisive(4.3, 2.1, 10)  # t(0.975, 9) = 2.26: 4.75 needed
     assert decisive(4.3, 2.1, 1000)  # many tests: the normal 1.96
     assert not decisive(3.9, 0.1, 1000)  # never below 4
+
+
+def _one_test_data(draws, *, scale=1.0):
+    from friction_uq.campaign.laws import LawData
+
+    x = np.asarray(draws, float)
+    arr = lambda v: np.array([v], float)  # noqa: E731
+    return LawData(["T"], ["A"], arr(x.mean()), arr(x.std()), arr(8.0), arr(0.0), arr(1e8), arr(0.0),
+                   basis="f", draws=(x,))
+
+
+def _constant_fit(data):
+    from dataclasses import replace
+
+    from friction_uq.campaign.laws import Fit
+
+    fit_kde = Fit(Model("constant"), data, kbar=1.0, p_ref=1e8, seed=0, nsteps=2, burn=0)
+    fit_normal = Fit(Model("constant"), replace(data, draws=None), kbar=1.0, p_ref=1e8, seed=0, nsteps=2, burn=0)
+    return fit_kde, fit_normal
+
+
+def test_the_kernel_likelihood_of_normal_draws_is_the_normal_convolved_with_the_law_spread():
+    """A test's draws N(0.05, 0.002): its likelihood at the law's value a with relative scatter r is the
+    normal of the draws' mean and sd convolved with N(0, r a). Within 2 sd the kernel estimate from 20000
+    draws matches it to 0.03 in log density (beyond, the sample's own tail noise reaches 0.1); with a
+    scatter as wide as the posterior, to 0.01 everywhere."""
+    draws = np.random.default_rng(5).normal(0.05, 0.002, 20000)
+    fit_kde, fit_normal = _constant_fit(_one_test_data(draws))
+    for a, r, tol in ((np.array([0.046, 0.048, 0.05, 0.053]), 0.0, 0.03),
+                      (np.array([0.045, 0.05, 0.055, 0.06]), 0.04, 0.01)):
+        x = np.column_stack([a, np.full(a.size, r)])
+        assert fit_kde.pointwise(x)[:, 0] == pytest.approx(fit_normal.pointwise(x)[:, 0], abs=tol)
+
+
+def test_the_kernel_likelihood_keeps_a_skewed_posterior_that_its_mean_and_sd_misstate():
+    """Lognormal draws (a weakly fixed f with a long upper tail): the likelihood from the draws follows
+    the lognormal density convolved with the law's spread (by quadrature) to 0.08 in log density; the
+    normal of their mean and sd is off by 0.2 at the mode and by 0.9 in the upper tail."""
+    from scipy.stats import lognorm, norm
+
+    s, med = 0.25, 0.05
+    draws = lognorm(s, scale=med).rvs(20000, random_state=np.random.default_rng(6))
+    fit_kde, fit_normal = _constant_fit(_one_test_data(draws))
+    a, r = np.array([0.03, 0.035, 0.045, 0.05, 0.06, 0.08, 0.09]), 0.02
+    grid = np.linspace(0.005, 0.2, 4001)
+    exact = np.log([np.trapezoid(lognorm(s, scale=med).pdf(grid) * norm.pdf(ai, grid, r * ai), grid) for ai in a])
+    x = np.column_stack([a, np.full(a.size, r)])
+    assert fit_kde.pointwise(x)[:, 0] == pytest.approx(exact, abs=0.08)
+    assert np.max(np.abs(fit_normal.pointwise(x)[:, 0] - exact)) > 0.5
+
+
+def test_a_diagnosed_campaign_flags_the_setup_whose_stationary_analysis_is_off_and_names_the_cause():
+    """Two set-ups under one velocity law. B's stationary kappa reads 20 % high (a plug friction on its
+    output bar) and its diagnosis named plug friction, which A's never did; under the diagnosed models
+    (f to 3 %, with a skewed upper tail) B follows the law. The campaign names the velocity law, flags
+    B's stationary analysis, and says the named causes account for it."""
+    rng = np.random.default_rng(21)
+    tests = []
+    for setup, p_of_v, off in (("A", lambda v: 9e6 * v, 1.0), ("B", lambda v: 15e6 * v, 1.2)):
+        for k, V in enumerate(np.linspace(5.5, 12.5, 5)):
+            t = _test(rng, f"{setup}-0{k + 1}", setup, V, p_of_v(V), f_velocity(V), offset=off)
+            t.f_model = f_velocity(V) * (1 + rng.normal(0, 0.02)) * rng.lognormal(0.0, 0.03, 1000)
+            tests.append(t)
+    results = [RecordResult(path=f"{t.label}.h5", status="done", campaign=t.setup, test_id=t.label,
+                            causes=["clearance"] + (["plug_friction"] if t.setup == "B" else [])) for t in tests]
+    ca = analyse_tests(tests, tally_causes(results), seed=4)
+    assert ca.law_data.basis == "f" and ca.best == "velocity"
+    flags = [f for f in ca.flagged if "setup" in f]
+    assert [(f["setup"], f["basis"]) for f in flags] == [("B", "kappa")]
+    flag = flags[0]
+    assert flag["offset"]["q05"] < 0.2 < flag["offset"]["q95"]
+    assert flag["offset_diagnosed"]["q05"] < 0.0 < flag["offset_diagnosed"]["q95"]
+    assert flag["explained_by_causes"] and flag["named_by_causes"] == "B"
+    assert flag["causes_only_here"] == ["plug_friction"]
+    text = summary_text(json.loads(json.dumps(campaign_doc(results, ca, seed=1, settings={}), default=float)))
+    assert "flagged: set-up B's stationary analysis does not follow the shared law relative to A: kappa offset +" in text
+    assert "the causes named account for the stationary departure" in text
+    assert "named only in set-up B: plug_friction" in text

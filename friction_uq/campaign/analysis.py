@@ -23,6 +23,8 @@ from .laws import LAWS, NESTS, Elpd, Fit, LawData, Model, decisive, law_mean, lo
 from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin
 
 MIN_TESTS_FOR_LAWS = 5
+#: draws per test the laws' likelihood reads (a kernel density of them)
+LAW_DRAWS = 160
 
 
 @dataclass
@@ -98,17 +100,25 @@ def campaign_nu(tests: Sequence[RecordPosterior], prior_mean: float, prior_sd: f
     return float(num / prec), float(1.0 / np.sqrt(prec))
 
 
-def _law_data(tests: Sequence[RecordPosterior]) -> LawData:
+def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None) -> LawData:
     """The laws' data: f under each test's diagnosed model when every test was diagnosed (a cause such as
     a clearance or a plug friction biases the stationary kappa by a load-dependent amount that a law
-    in (p, V) would otherwise absorb), else the stationary kappa."""
-    diagnosed = all(t.f_model is not None for t in tests)
-    y = [t.f_model if diagnosed else t.kappa for t in tests]
+    in (p, V) would otherwise absorb), else the stationary kappa. Each test carries its draws (thinned
+    to :data:`LAW_DRAWS`) and their log prior: kappa's implied by the test's prior file, f's from the
+    file's f prior (for f under a diagnosed model, the prior of the base f the mechanism starts from:
+    half-normal(0.3) changes by < 1 % across one test's posterior, so the choice barely matters).
+    ``diagnosed=False`` takes the stationary kappa whatever the tests carry."""
+    if diagnosed is None:
+        diagnosed = all(t.f_model is not None for t in tests)
+    y = [thin(t.f_model if diagnosed else t.kappa, LAW_DRAWS) for t in tests]
+    priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
+    log_prior = tuple(priors[t.prior_file]["f"].logpdf(v) if diagnosed else implied_kappa_log_prior(v, priors[t.prior_file])
+                      for t, v in zip(tests, y))
     return LawData([t.label for t in tests], [t.setup for t in tests],
                    np.array([np.mean(v) for v in y]), np.array([np.std(v) for v in y]),
                    np.array([t.V["mean"] for t in tests]), np.array([t.V["sd"] for t in tests]),
                    np.array([np.mean(t.p_mean) for t in tests]), np.array([np.std(t.p_mean) for t in tests]),
-                   basis="f" if diagnosed else "kappa")
+                   basis="f" if diagnosed else "kappa", draws=tuple(y), draws_log_prior=log_prior)
 
 
 def _nested(a: Model, b: Model) -> bool:
@@ -152,6 +162,33 @@ def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np
         out[f"offset_{fit.model.offset_setup}"] = col["delta"]
     out["scatter_rel"] = col["r"]
     return out
+
+
+def stationary_flags(tests: Sequence[RecordPosterior], law: str, offsets: Sequence[str], setups: Sequence[str],
+                     tallies: dict[str, dict[str, object]], diagnosed_offsets: dict[str, tuple[Elpd, dict[str, float]]],
+                     already: set[str], *, seed: int) -> list[dict[str, object]]:
+    """Set-ups whose stationary analysis (eq. 17 over the window) departs from the shared law, for a
+    campaign whose law was fitted to f under the diagnosed models: the set-up measures off the law as
+    the field would read it, and the entry says what the same offset is once each test's named causes
+    are in its model (``offset_diagnosed``; ``explained_by_causes`` when it is no longer decisive)."""
+    data = _law_data(tests, diagnosed=False)
+    kbar, p_ref = float(np.mean(data.kappa)), float(np.mean(data.p))
+    base = loo(Fit(Model(law), data, kbar=kbar, p_ref=p_ref, seed=seed + 77), seed=seed + 77)
+    with_offset = {}
+    for k, s in enumerate(offsets):
+        fit = Fit(Model(law, s), data, kbar=kbar, p_ref=p_ref, seed=seed + 78 + k)
+        with_offset[s] = (loo(fit, seed=seed + 78 + k), _summ(fit.draws[:, -2]))
+    flags = setup_flags(base, with_offset, setups, tallies, quantity="kappa")
+    for f in flags:
+        s = str(f["setup"])
+        e, delta = diagnosed_offsets[s]
+        f["offset_diagnosed"] = delta
+        f["explained_by_causes"] = s not in already
+        f["note_diagnosed"] = (f"under each test's diagnosed model the offset of {s} is {delta['q50'] * 100:+.0f} % "
+                               f"[{delta['q05'] * 100:+.0f}, {delta['q95'] * 100:+.0f}]: "
+                               + ("the causes named account for the stationary departure" if s not in already
+                                  else "the causes named do not account for it"))
+    return flags
 
 
 def analyse(results: Sequence[RecordResult], records_dir: str | Path, *, seed: int = 20161) -> CampaignAnalysis:
@@ -207,12 +244,16 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     with_offset = {s: (elpds[Model(law_for_flags, s).name],
                        _summ(ca.fits[Model(law_for_flags, s).name].draws[:, -2])) for s in offsets}
     ca.flagged = setup_flags(elpds[law_for_flags], with_offset, setups, tallies, quantity=data.basis)
-    flagged_setups = {str(f["setup"]) for f in ca.flagged}
+    if data.basis == "f" and offsets:
+        ca.flagged += stationary_flags(tests, law_for_flags, offsets, setups, tallies, with_offset,
+                                       {str(f["setup"]) for f in ca.flagged}, seed=seed)
+    primary = [f for f in ca.flagged if f["basis"] == data.basis]
+    flagged_setups = {str(f["setup"]) for f in primary}
     if len(setups) == 2 and flagged_setups:
         flagged_setups = set(setups)
     trusted = [t for t in tests if t.setup not in flagged_setups] or tests
-    if len(setups) == 2 and ca.flagged and "named_by_causes" in ca.flagged[0]:
-        trusted = [t for t in tests if t.setup != ca.flagged[0]["named_by_causes"]]
+    if len(setups) == 2 and primary and "named_by_causes" in primary[0]:
+        trusted = [t for t in tests if t.setup != primary[0]["named_by_causes"]]
     ca.nu = campaign_nu(trusted, pm, psd)
     name = ca.chosen or str(ca.ranking[0]["model"])
     ca.law_draws = f_law_draws(ca.fits[name], ca.nu, seed=seed)

@@ -14,10 +14,21 @@ friction) no longer biases:
 * ``pressure+velocity``:  y = [d + (s - d) exp(-V / v_c)] (1 + c (p - p_ref) / p_ref)
 
 with p_ref the campaign's mean pressure. Each may carry a multiplicative offset (1 + delta) on one
-set-up (``set-up offset``: that set-up does not follow the shared law). The likelihood is normal
-with variance sd_y^2 + (dy/dV sd_V)^2 + (dy/dp sd_p)^2 + (r y)^2: the measured V and p
-uncertainty through the law's slopes (errors in variables, linearised), and a between-test
-scatter r (relative, half-normal(0.1) prior) that the per-test posteriors do not explain.
+set-up (``set-up offset``: that set-up does not follow the shared law). A test's y is uncertain by
+its own posterior, by the measured V and p through the law's slopes (errors in variables,
+linearised: (dy/dV sd_V)^2 + (dy/dp sd_p)^2), and by a between-test scatter r (relative,
+half-normal(0.1) prior) that the per-test posteriors do not explain. Given the test's stored draws
+y_j (``LawData.draws``), its likelihood is their kernel density convolved with that normal spread,
+each draw divided by its prior (bilby's hyper-likelihood from stored samples):
+
+    p(test | theta) = sum_j w_j N(y_j; law, sqrt(law_var + h^2)) / sum_j w_j,   w_j = 1 / pi(y_j),
+
+with h the draws' kernel bandwidth (scipy's ``gaussian_kde``, Scott's rule) and the draws shrunk
+towards their mean by sqrt(1 - h^2/sd^2) so that the mixture keeps their variance (the kernel
+shrinkage of West 1993, Liu and West 2001). It keeps the shape
+of a skewed posterior, which a normal of the draws' mean and sd does not: the long upper tail of a
+test whose f is weakly fixed would pull that mean up and inflate that sd. Without draws the
+test's likelihood is the normal N(y; law, sqrt(sd_y^2 + law_var)).
 Priors: a, d, s uniform on (0, 5); v_c log-uniform on (0.3, 300) m/s; c ~ N(0, 1); delta ~ N(0, 0.3).
 
 Sampled with emcee; leave-one-test-out ELPD by PSIS-LOO (ArviZ), with an exact refit for every
@@ -33,6 +44,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import logsumexp
 from scipy.stats import t as student_t
+
+from .._jit import njit
 
 LAWS = ("constant", "velocity", "pressure", "pressure+velocity")
 #: What the laws are fitted to, in words (``LawData.basis``).
@@ -62,6 +75,10 @@ class LawData:
     #: what ``kappa`` holds: "kappa" (f nu/(1-nu) of the stationary phase) or "f" (f itself, under
     #: each test's diagnosed model); :data:`BASES` says it in words
     basis: str = "kappa"
+    #: each test's posterior draws of the same quantity (thinned), and the log prior density they were
+    #: drawn under; None: the tests are summarised by ``kappa`` and ``kappa_sd`` alone
+    draws: tuple[np.ndarray, ...] | None = None
+    draws_log_prior: tuple[np.ndarray, ...] | None = None
 
     @property
     def n(self) -> int:
@@ -76,11 +93,66 @@ class LawData:
         """Factor from the data's unit to f: (1-nu)/nu for kappa, 1 for f."""
         return (1.0 - nu) / nu if self.basis == "kappa" else 1.0 + 0.0 * nu
 
+    def select(self, keep: np.ndarray) -> LawData:
+        """The tests where ``keep`` (a boolean mask) is true."""
+        idx = np.flatnonzero(keep)
+
+        def pick(seq: tuple[np.ndarray, ...] | None) -> tuple[np.ndarray, ...] | None:
+            return None if seq is None else tuple(seq[i] for i in idx)
+
+        return LawData([self.labels[i] for i in idx], [self.setups[i] for i in idx],
+                       *(getattr(self, f)[idx] for f in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")),
+                       basis=self.basis, draws=pick(self.draws), draws_log_prior=pick(self.draws_log_prior))
+
     def drop(self, i: int) -> LawData:
-        keep = np.arange(self.n) != i
-        return LawData([x for k, x in enumerate(self.labels) if k != i], [x for k, x in enumerate(self.setups) if k != i],
-                       *(getattr(self, f)[keep] for f in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")),
-                       basis=self.basis)
+        return self.select(np.arange(self.n) != i)
+
+    def kernels(self, scale: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The tests' draws over ``scale`` (n, J; padded where a test has fewer; shrunk, see above), their normalised log
+        weights 1/prior (n, J; -inf on padding) and squared kernel bandwidths (n,; Scott's rule, scipy's
+        ``gaussian_kde``); None without draws."""
+        if self.draws is None:
+            return None
+        from scipy.stats import gaussian_kde
+
+        J = max(len(x) for x in self.draws)
+        y, logw, h2 = np.zeros((self.n, J)), np.full((self.n, J), -np.inf), np.zeros(self.n)
+        for k, x in enumerate(self.draws):
+            yk = np.asarray(x, float) / scale
+            lp = np.zeros(yk.size) if self.draws_log_prior is None else np.asarray(self.draws_log_prior[k], float)
+            if np.ptp(yk) > 0:  # shrink the draws to their mean so that the mixture keeps their variance
+                kde = gaussian_kde(yk)
+                yk = yk.mean() + np.sqrt(1.0 - kde.factor**2) * (yk - yk.mean())
+                h2[k] = float(kde.covariance[0, 0])
+            y[k, :yk.size], logw[k, :yk.size] = yk, -lp - logsumexp(-lp)
+        return y, logw, h2
+
+
+@njit
+def _log_kernel_mixture(mean: np.ndarray, var: np.ndarray, y: np.ndarray, logw: np.ndarray) -> np.ndarray:
+    """log sum_j exp(logw[i, j]) N(y[i, j]; mean[w, i], var[w, i]) for every draw w and test i: (W, n)."""
+    W, n = mean.shape
+    J = y.shape[1]
+    out = np.empty((W, n))
+    wmax = np.empty(n)
+    for i in range(n):
+        wmax[i] = logw[i].max()
+    for w in range(W):
+        for i in range(n):
+            m, v = mean[w, i], var[w, i]
+            acc = 0.0
+            for j in range(J):  # each term <= exp(0): one pass, unless every term underflows
+                acc += np.exp(logw[i, j] - wmax[i] - 0.5 * (y[i, j] - m) ** 2 / v)
+            top = wmax[i]
+            if acc < 1e-250:  # the law far out in every draw's tail: shift by the largest term
+                top = -np.inf
+                for j in range(J):
+                    top = max(top, logw[i, j] - 0.5 * (y[i, j] - m) ** 2 / v)
+                acc = 0.0
+                for j in range(J):
+                    acc += np.exp(logw[i, j] - 0.5 * (y[i, j] - m) ** 2 / v - top)
+            out[w, i] = top + np.log(acc) - 0.5 * np.log(2.0 * np.pi * v)
+    return out
 
 
 @dataclass(frozen=True)
@@ -117,14 +189,18 @@ class Fit:
     def __init__(self, model: Model, data: LawData, *, kbar: float, p_ref: float, seed: int,
                  nwalkers: int = 32, nsteps: int = 1500, burn: int = 500) -> None:
         self.model, self.data, self.kbar, self.p_ref = model, data, kbar, p_ref
+        self._kernels = data.kernels(kbar)
         self.draws = self._sample(seed, nwalkers, nsteps, burn)
 
     def _theta(self, x: np.ndarray) -> dict[str, np.ndarray]:
         return {name: x[:, k:k + 1] for k, name in enumerate(self.model.params)}
 
-    def pointwise(self, x: np.ndarray, data: LawData | None = None) -> np.ndarray:
-        """log p(y_i | theta) for draws x (W, k): (W, n)."""
+    def pointwise(self, x: np.ndarray, data: LawData | None = None, *, chunk: int = 512) -> np.ndarray:
+        """log p(test_i | theta) for draws x (W, k): (W, n)."""
         d = data or self.data
+        kernels = self._kernels if data is None else data.kernels(self.kbar)
+        if len(x) > chunk:
+            return np.vstack([self.pointwise(x[i:i + chunk], data, chunk=chunk) for i in range(0, len(x), chunk)])
         th = self._theta(x)
         p_rel = (d.p - self.p_ref) / self.p_ref
         y = d.kappa / self.kbar
@@ -136,9 +212,12 @@ class Fit:
             on = np.array([s == self.model.offset_setup for s in d.setups])
             scale = np.where(on[None, :], 1.0 + th["delta"], 1.0)
             mean, dV, dp = mean * scale, dV * scale, dp * scale
-        var = ((d.kappa_sd / self.kbar) ** 2 + (dV * d.V_sd) ** 2 + (dp * d.p_sd / self.p_ref) ** 2
-               + (th["r"] * mean) ** 2)
-        return -0.5 * (y - mean) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
+        var = (dV * d.V_sd) ** 2 + (dp * d.p_sd / self.p_ref) ** 2 + (th["r"] * mean) ** 2
+        if kernels is None:
+            var = var + (d.kappa_sd / self.kbar) ** 2
+            return -0.5 * (y - mean) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
+        yj, logw, h2 = kernels
+        return _log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]), yj, logw)
 
     def log_prior(self, x: np.ndarray) -> np.ndarray:
         th = self._theta(x)
@@ -223,8 +302,7 @@ def loo(fit: Fit, *, seed: int) -> Elpd:
 
 
 def _one(d: LawData, i: int) -> LawData:
-    sel = np.arange(d.n) == i
-    return LawData([d.labels[i]], [d.setups[i]], *(getattr(d, f)[sel] for f in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")))
+    return d.select(np.arange(d.n) == i)
 
 
 def decisive(d_elpd: float, se: float, n: int | None = None) -> bool:

@@ -58,19 +58,21 @@ def _law_page(ca: CampaignAnalysis):
     name = ca.chosen or str(ca.ranking[0]["model"])
     nu = ca.nu[0]
     head = f"f at the campaign's nu = {nu:.3f}" if d.basis == "kappa" else d.meaning
-    fig, axes = figure(f"{head} against V and p; band: {name} (90 %)", nrows=1, ncols=2)
+    fig, axes = figure(f"{head} against V and p (median, 90 %); band: {name} (90 %)", nrows=1, ncols=2)
     setups = sorted(set(d.setups))
     for k, s in enumerate(setups):
         on = np.array([x == s for x in d.setups])
-        f = d.kappa[on] * d.to_f(nu)
-        fsd = d.kappa_sd[on] * d.to_f(nu)
+        # each test's median and 90 % interval from its draws (a normal of mean and sd would misdraw a skewed one)
+        q = (np.array([np.quantile(x, [0.05, 0.5, 0.95]) for x, o in zip(d.draws, on) if o]).T if d.draws is not None
+             else d.kappa[on] + np.outer([-1.645, 0.0, 1.645], d.kappa_sd[on])) * d.to_f(nu)
+        f, ferr = q[1], np.abs(q[[0, 2]] - q[1])
         # the set-up's (V, p) line: p rises with V through the striker speed
         coef = np.polyfit(d.V[on], d.p[on], 1) if on.sum() > 1 else np.array([0.0, d.p[on][0]])
         vv = np.linspace(d.V[on].min() * 0.9, d.V[on].max() * 1.1, 60)
         pp = np.polyval(coef, vv)
         band = np.quantile(ca.f_curve(name, vv, pp, s), [0.05, 0.5, 0.95], axis=0)
         for ax, x, xx, xs in ((axes[0], d.V[on], vv, 1.0), (axes[1], d.p[on], pp, 1e-6)):
-            ax.errorbar(x * xs, f, yerr=1.645 * fsd, fmt="o", color=f"C{k}", capsize=3, label=f"set-up {s}")
+            ax.errorbar(x * xs, f, yerr=ferr, fmt="o", color=f"C{k}", capsize=3, label=f"set-up {s}")
             ax.fill_between(xx * xs, band[0], band[2], color=f"C{k}", alpha=0.2)
             ax.plot(xx * xs, band[1], color=f"C{k}", lw=1)
     axes[0].set_xlabel("sliding velocity V (m/s)")
@@ -111,15 +113,18 @@ def write_campaign_report(ca: CampaignAnalysis, doc: dict[str, Any], path: str |
             pages.append(_forest(ca))
         if ca.law_data is not None and ca.ranking:
             pages += [_law_page(ca), _comparison_page(ca)]
-            flag_lines = [f"{'what':<12} {'offset / gap':<28} {'dELPD':>7} {'SE':>5}  causes"]
+            flag_lines = [f"{'what':<12} {'on':<6} {'offset / gap':<28} {'dELPD':>7} {'SE':>5}"]
             for f in ca.flagged:
                 if "setup" in f:
                     o = f["offset"]
-                    flag_lines.append(f"set-up {f['setup']:<5} {o['q50'] * 100:+6.1f} % [{o['q05'] * 100:+.1f}, "
-                                      f"{o['q95'] * 100:+.1f}] {f['d_elpd']:>7.1f} {f['d_se']:>5.1f}  "
-                                      + "; ".join(f["causes"].values()))
-                    if "note" in f:
-                        flag_lines.append("    " + str(f["note"]))
+                    flag_lines.append(f"set-up {f['setup']:<5} {f.get('basis', ca.law_data.basis):<6} "
+                                      f"{o['q50'] * 100:+6.1f} % [{o['q05'] * 100:+.1f}, {o['q95'] * 100:+.1f}]"
+                                      f"{'':<6} {f['d_elpd']:>7.1f} {f['d_se']:>5.1f}")
+                    flag_lines += ["    " + str(f[k]) for k in ("note", "note_diagnosed") if k in f]
+                    flag_lines += ["    " + str(c) for c in f["causes"].values()]
+                    if "causes_only_here" in f:
+                        flag_lines.append(f"    named only in set-up {f['named_by_causes']}: "
+                                          + ", ".join(map(str, f["causes_only_here"])))
                 else:
                     flag_lines.append(f"test {f['test']:<7} {f['below_median_by']:>6.1f} below median")
             if not ca.flagged:
