@@ -3,7 +3,8 @@
 A set-up is flagged when the best law with a multiplicative offset on that set-up beats the law
 without it decisively (leave-one-test-out dELPD > 4 and > t(0.975, tests - 1) SE). With exactly two set-ups an
 offset on one is the same model as an offset on the other: the campaign then says that the two
-disagree, by how much, and lets the per-record causes (when a diagnosis named them) say which.
+disagree, by how much, and lets the per-record causes (when a diagnosis named them) say which: the
+set-up where a cause was named that the other set-up never shows.
 
 A test is flagged when its own leave-one-out predictive density under the chosen model is an
 outlier: a pointwise ELPD more than 4 below the median of the others (a test the law and the
@@ -47,7 +48,7 @@ def causes_sentence(setup: str, tally: dict[str, object]) -> str:
     causes = tally.get("causes") or {}
     head = f"set-up {setup}: {tally['tests']} tests, {tally['diagnosed']} diagnosed"
     if not tally["diagnosed"]:
-        return head + " (no per-record diagnosis in these results)"
+        return head + " (no per-record diagnosis in these results: campaign --diagnose names the causes)"
     if not causes:
         return head + "; no cause named"
     return head + "; " + ", ".join(f"{c} named in {n}" for c, n in sorted(causes.items(), key=lambda kv: -kv[1]))
@@ -65,7 +66,7 @@ def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]
             continue
         other = [x for x in setups if x != s]
         entry: dict[str, object] = {
-            "setup": s, "offset": delta, "d_elpd": d, "d_se": se,
+            "setup": s, "basis": quantity, "offset": delta, "d_elpd": d, "d_se": se,
             "tests": int(tallies.get(s, {}).get("tests", 0)),
         }
         if pair:
@@ -73,11 +74,12 @@ def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]
             entry["note"] = (f"with two set-ups an offset on {s} is an offset on {other[0]}: they disagree by "
                              f"{delta['q50'] * 100:+.0f} % on {quantity}; which one is off needs a third set-up or "
                              "the per-record causes")
-            named = {x: sum((tallies.get(x, {}).get("causes") or {}).values()) for x in setups}
-            if named[s] > 0 and named[other[0]] == 0:
-                entry["named_by_causes"] = s
-            elif named[other[0]] > 0 and named[s] == 0:
-                entry["named_by_causes"] = other[0]
+            own = {x: set(tallies.get(x, {}).get("causes") or {}) for x in setups}
+            only = {x: sorted(own[x] - own[y]) for x, y in ((s, other[0]), (other[0], s))}
+            if only[s] and not only[other[0]]:
+                entry["named_by_causes"], entry["causes_only_here"] = s, only[s]
+            elif only[other[0]] and not only[s]:
+                entry["named_by_causes"], entry["causes_only_here"] = other[0], only[other[0]]
         entry["causes"] = {x: causes_sentence(x, tallies[x]) for x in ([s] + (other if pair else [])) if x in tallies}
         flags.append(entry)
     return flags

@@ -8,7 +8,9 @@ of the hyper-log-likelihood, or ``refused`` with the reason), ``friction_law`` (
 constant, velocity, pressure, pressure+velocity or null; ``chosen_model``; ``ranking``: every
 model with ELPD, dELPD and its SE against the top; ``posterior`` of the chosen (else top) model's
 parameters in f units; ``models``: the same for every model; ``nu`` the campaign's nu),
-``flagged`` (set-ups and tests), ``causes`` (per set-up tally of the per-record causes) and
+``flagged`` (set-ups and tests; a set-up's entry says the ``basis`` its offset was measured on:
+the law's, or, for a diagnosed campaign, also ``kappa`` of the stationary analysis with
+``offset_diagnosed`` and ``explained_by_causes``), ``causes`` (per set-up tally of the per-record causes) and
 ``statements`` (the sentences the summary prints).
 """
 
@@ -52,11 +54,16 @@ def statements(ca: CampaignAnalysis) -> list[str]:
         if "setup" in f:
             off = f["offset"]
             rel = f" relative to {f['relative_to']}" if "relative_to" in f else ""
-            out.append(f"flagged: set-up {f['setup']} does not follow the shared law{rel}: {ca.law_data.basis} offset "
+            basis = str(f.get("basis", ca.law_data.basis))
+            what = "'s stationary analysis" if basis != ca.law_data.basis else ""
+            out.append(f"flagged: set-up {f['setup']}{what} does not follow the shared law{rel}: {basis} offset "
                        f"{off['q50'] * 100:+.0f} % [{off['q05'] * 100:+.0f}, {off['q95'] * 100:+.0f}], dELPD "
                        f"{f['d_elpd']:.1f} (SE {f['d_se']:.1f})")
-            if "note" in f:
-                out.append(str(f["note"]))
+            for key in ("note", "note_diagnosed"):
+                if key in f:
+                    out.append(str(f[key]))
+            if "causes_only_here" in f:
+                out.append(f"named only in set-up {f['named_by_causes']}: " + ", ".join(map(str, f["causes_only_here"])))
             out.extend(str(c) for c in f["causes"].values())
         else:
             out.append(f"flagged: test {f['test']} lies {f['below_median_by']:.1f} below the others' leave-one-out "
