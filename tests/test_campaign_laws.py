@@ -275,6 +275,7 @@ def test_a_diagnosed_campaign_flags_the_setup_whose_stationary_analysis_is_off_a
     assert flag["explained_by_causes"] and flag["named_by_causes"] == "B"
     assert flag["causes_only_here"] == ["plug_friction"]
     text = summary_text(json.loads(json.dumps(campaign_doc(results, ca, seed=1, settings={}), default=float)))
-    assert "flagged: set-up B's stationary analysis does not follow the shared law relative to A: kappa offset +" in text
+    assert ("flagged: set-up B's stationary analysis does not follow the shared law relative to A: kappa offset +"
+            in text)
     assert "the causes named account for the stationary departure" in text
     assert "named only in set-up B: plug_friction" in text

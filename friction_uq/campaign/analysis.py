@@ -112,8 +112,8 @@ def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None
         diagnosed = all(t.f_model is not None for t in tests)
     y = [thin(t.f_model if diagnosed else t.kappa, LAW_DRAWS) for t in tests]
     priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
-    log_prior = tuple(priors[t.prior_file]["f"].logpdf(v) if diagnosed else implied_kappa_log_prior(v, priors[t.prior_file])
-                      for t, v in zip(tests, y))
+    log_prior = tuple(priors[t.prior_file]["f"].logpdf(v) if diagnosed
+                      else implied_kappa_log_prior(v, priors[t.prior_file]) for t, v in zip(tests, y))
     return LawData([t.label for t in tests], [t.setup for t in tests],
                    np.array([np.mean(v) for v in y]), np.array([np.std(v) for v in y]),
                    np.array([t.V["mean"] for t in tests]), np.array([t.V["sd"] for t in tests]),

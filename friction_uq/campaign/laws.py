@@ -108,8 +108,8 @@ class LawData:
         return self.select(np.arange(self.n) != i)
 
     def kernels(self, scale: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """The tests' draws over ``scale`` (n, J; padded where a test has fewer; shrunk, see above), their normalised log
-        weights 1/prior (n, J; -inf on padding) and squared kernel bandwidths (n,; Scott's rule, scipy's
+        """The tests' draws over ``scale`` (n, J; padded where a test has fewer; shrunk, see above), their
+        normalised log weights 1/prior (n, J; -inf on padding) and squared kernel bandwidths (n,; Scott's rule, scipy's
         ``gaussian_kde``); None without draws."""
         if self.draws is None:
             return None
@@ -217,7 +217,8 @@ class Fit:
             var = var + (d.kappa_sd / self.kbar) ** 2
             return -0.5 * (y - mean) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
         yj, logw, h2 = kernels
-        return _log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]), yj, logw)
+        return _log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]),
+                                   yj, logw)
 
     def log_prior(self, x: np.ndarray) -> np.ndarray:
         th = self._theta(x)

@@ -63,7 +63,8 @@ def statements(ca: CampaignAnalysis) -> list[str]:
                 if key in f:
                     out.append(str(f[key]))
             if "causes_only_here" in f:
-                out.append(f"named only in set-up {f['named_by_causes']}: " + ", ".join(map(str, f["causes_only_here"])))
+                out.append(f"named only in set-up {f['named_by_causes']}: "
+                           + ", ".join(map(str, f["causes_only_here"])))
             out.extend(str(c) for c in f["causes"].values())
         else:
             out.append(f"flagged: test {f['test']} lies {f['below_median_by']:.1f} below the others' leave-one-out "
