@@ -6,7 +6,8 @@
 ``bundled`` runs the 10 records of data/A and data/B in a fresh folder for each worker count
 (nothing up to date) and prints wall time, the CPU time the workers spent on the records (user +
 system, summed over records), the speed-up against the first worker count, and the peak memory
-of a worker process. ``simulated`` draws N test configurations (the bundled A-01 and B-01 set-ups
+of a worker process, and the wall time of the campaign's own analysis (pooling, laws, flags) after the
+records. ``simulated`` draws N test configurations (the bundled A-01 and B-01 set-ups
 with striker speeds uniform in 6-14 m/s and fresh noise seeds), simulates them (not timed) and
 runs them as one campaign without PDF reports; it prints the time per record and the campaign's
 conclusions. The machine may be shared: quote CPU time beside wall time.
@@ -34,18 +35,18 @@ def campaign(records: list[Path], out: Path, *, workers: int, pdf: bool) -> tupl
     return time.perf_counter() - t0, outcome.results, outcome.doc
 
 
-def row(label: str, workers: int, wall: float, results: list, base: float | None) -> str:
+def row(label: str, workers: int, wall: float, results: list, base: float | None, doc: dict) -> str:
     cpu = sum(r.cpu_seconds for r in results)
     rss = max((r.peak_rss_mb for r in results), default=float("nan"))
     n = len(results)
     speed = f"{base / wall:8.2f}" if base else f"{'-':>8}"
     failed = sum(r.status == "failed" for r in results)
     return (f"{label:<10} {workers:>7} {n:>7} {failed:>6} {wall:>9.1f} {cpu:>10.1f} {wall / n:>10.1f} "
-            f"{cpu / n:>9.1f} {speed} {rss:>12.0f}")
+            f"{cpu / n:>9.1f} {speed} {rss:>12.0f} {doc.get('wall_seconds', {}).get('analysis', float('nan')):>10.1f}")
 
 
 HEADER = (f"{'case':<10} {'workers':>7} {'records':>7} {'failed':>6} {'wall s':>9} {'CPU s':>10} {'wall/rec':>10} "
-          f"{'CPU/rec':>9} {'speed-up':>8} {'worker MB':>12}")
+          f"{'CPU/rec':>9} {'speed-up':>8} {'worker MB':>12} {'analysis s':>10}")
 
 
 def bundled(args: argparse.Namespace) -> None:
@@ -55,7 +56,7 @@ def bundled(args: argparse.Namespace) -> None:
         with tempfile.TemporaryDirectory() as tmp:
             out = Path(args.keep) / f"workers{w}" if args.keep else Path(tmp)
             wall, results, doc = campaign(records, out, workers=w, pdf=args.pdf)
-        lines.append(row("bundled", w, wall, results, base))
+        lines.append(row("bundled", w, wall, results, base, doc))
         base = base or wall
         print("\n".join(doc["statements"]))
     print(HEADER)
@@ -80,7 +81,7 @@ def simulated(args: argparse.Namespace) -> None:
     wall, results, doc = campaign(records, tmp / "out", workers=args.workers[0], pdf=False)
     print("\n".join(doc["statements"]))
     print(HEADER)
-    print(row("simulated", args.workers[0], wall, results, None))
+    print(row("simulated", args.workers[0], wall, results, None, doc))
     shutil.rmtree(tmp, ignore_errors=True)
 
 

@@ -113,6 +113,7 @@ def test_a_campaign_runs_on_a_separate_scheduler_and_a_bad_record_does_not_stop_
     bad = next(r for r in doc["records"] if r["status"] == "failed")
     assert bad["message"].startswith(str(d / "S-09.h5"))
     assert set(doc["pooled"]) == {"f", "kappa"} and doc["friction_law"]["best"] is None
+    assert doc["wall_seconds"]["records"] > 0 and doc["wall_seconds"]["analysis"] > 0
     for name in ("S_S-01", "S_S-02"):
         r = read_result(out / "records" / f"{name}.result.json")
         assert r.status == "done" and r.causes is None and 0.03 < r.summary["f"]["q50"] < 0.07

@@ -8,7 +8,8 @@ of the hyper-log-likelihood, or ``refused`` with the reason), ``friction_law`` (
 constant, velocity, pressure, pressure+velocity or null; ``chosen_model``; ``ranking``: every
 model with ELPD, dELPD and its SE against the top; ``posterior`` of the chosen (else top) model's
 parameters in f units; ``models``: the same for every model; ``nu`` the campaign's nu),
-``flagged`` (set-ups and tests; a set-up's entry says the ``basis`` its offset was measured on:
+``wall_seconds`` (``records``: the records' tasks, ``analysis``: the campaign's own analysis; added by
+``run_campaign``), ``flagged`` (set-ups and tests; a set-up's entry says the ``basis`` its offset was measured on:
 the law's, or, for a diagnosed campaign, also ``kappa`` of the stationary analysis with
 ``offset_diagnosed`` and ``explained_by_causes``), ``causes`` (per set-up tally of the per-record causes) and
 ``statements`` (the sentences the summary prints).
