@@ -6,6 +6,7 @@ Modules, one concern each:
 * :mod:`.runner` - records and seeds, the Dask cluster or scheduler, the progress bar;
 * :mod:`.pooling` - hierarchical pooling of f and kappa from the stored draws;
 * :mod:`.laws` - friction laws fitted jointly, leave-one-test-out ELPD;
+* :mod:`.kernels` - a test's stored draws as its likelihood (a weighted kernel mixture);
 * :mod:`.flags` - set-ups and tests off the shared law, per-record causes tallied;
 * :mod:`.analysis` - from the results to the campaign's conclusions;
 * :mod:`.outputs` - ``campaign.json``, ``campaign.nc``, the text summary;

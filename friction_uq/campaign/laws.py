@@ -18,17 +18,11 @@ set-up (``set-up offset``: that set-up does not follow the shared law). A test's
 its own posterior, by the measured V and p through the law's slopes (errors in variables,
 linearised: (dy/dV sd_V)^2 + (dy/dp sd_p)^2), and by a between-test scatter r (relative,
 half-normal(0.1) prior) that the per-test posteriors do not explain. Given the test's stored draws
-y_j (``LawData.draws``), its likelihood is their kernel density convolved with that normal spread,
-each draw divided by its prior (bilby's hyper-likelihood from stored samples):
-
-    p(test | theta) = sum_j w_j N(y_j; law, sqrt(law_var + h^2)) / sum_j w_j,   w_j = 1 / pi(y_j),
-
-with h the draws' kernel bandwidth (scipy's ``gaussian_kde``, Scott's rule) and the draws shrunk
-towards their mean by sqrt(1 - h^2/sd^2) so that the mixture keeps their variance (the kernel
-shrinkage of West 1993, Liu and West 2001). It keeps the shape
-of a skewed posterior, which a normal of the draws' mean and sd does not: the long upper tail of a
-test whose f is weakly fixed would pull that mean up and inflate that sd. Without draws the
-test's likelihood is the normal N(y; law, sqrt(sd_y^2 + law_var)).
+(``LawData.draws``), its likelihood is their kernel density convolved with that normal spread,
+each draw divided by its prior (bilby's hyper-likelihood from stored samples; :mod:`.kernels`).
+It keeps the shape of a skewed posterior, which a normal of the draws' mean and sd does not: the
+long upper tail of a test whose f is weakly fixed would pull that mean up and inflate that sd.
+Without draws the test's likelihood is the normal N(y; law, sqrt(sd_y^2 + law_var)).
 Priors: a, d, s uniform on (0, 5); v_c log-uniform on (0.3, 300) m/s; c ~ N(0, 1); delta ~ N(0, 0.3).
 
 Sampled with emcee; leave-one-test-out ELPD by PSIS-LOO (ArviZ), with an exact refit for every
@@ -45,7 +39,7 @@ import numpy as np
 from scipy.special import logsumexp
 from scipy.stats import t as student_t
 
-from .._jit import njit
+from .kernels import draw_kernels, log_kernel_mixture
 
 LAWS = ("constant", "velocity", "pressure", "pressure+velocity")
 #: What the laws are fitted to, in words (``LawData.basis``).
@@ -115,46 +109,7 @@ class LawData:
         ``gaussian_kde``); None without draws."""
         if self.draws is None:
             return None
-        from scipy.stats import gaussian_kde
-
-        J = max(len(x) for x in self.draws)
-        y, logw, h2 = np.zeros((self.n, J)), np.full((self.n, J), -np.inf), np.zeros(self.n)
-        for k, x in enumerate(self.draws):
-            yk = np.asarray(x, float) / scale
-            lp = np.zeros(yk.size) if self.draws_log_prior is None else np.asarray(self.draws_log_prior[k], float)
-            if np.ptp(yk) > 0:  # shrink the draws to their mean so that the mixture keeps their variance
-                kde = gaussian_kde(yk)
-                yk = yk.mean() + np.sqrt(1.0 - kde.factor**2) * (yk - yk.mean())
-                h2[k] = float(kde.covariance[0, 0])
-            y[k, :yk.size], logw[k, :yk.size] = yk, -lp - logsumexp(-lp)
-        return y, logw, h2
-
-
-@njit
-def _log_kernel_mixture(mean: np.ndarray, var: np.ndarray, y: np.ndarray, logw: np.ndarray) -> np.ndarray:
-    """log sum_j exp(logw[i, j]) N(y[i, j]; mean[w, i], var[w, i]) for every draw w and test i: (W, n)."""
-    W, n = mean.shape
-    J = y.shape[1]
-    out = np.empty((W, n))
-    wmax = np.empty(n)
-    for i in range(n):
-        wmax[i] = logw[i].max()
-    for w in range(W):
-        for i in range(n):
-            m, v = mean[w, i], var[w, i]
-            acc = 0.0
-            for j in range(J):  # each term <= exp(0): one pass, unless every term underflows
-                acc += np.exp(logw[i, j] - wmax[i] - 0.5 * (y[i, j] - m) ** 2 / v)
-            top = wmax[i]
-            if acc < 1e-250:  # the law far out in every draw's tail: shift by the largest term
-                top = -np.inf
-                for j in range(J):
-                    top = max(top, logw[i, j] - 0.5 * (y[i, j] - m) ** 2 / v)
-                acc = 0.0
-                for j in range(J):
-                    acc += np.exp(logw[i, j] - 0.5 * (y[i, j] - m) ** 2 / v - top)
-            out[w, i] = top + np.log(acc) - 0.5 * np.log(2.0 * np.pi * v)
-    return out
+        return draw_kernels(self.draws, self.draws_log_prior, scale)
 
 
 @dataclass(frozen=True)
@@ -221,8 +176,8 @@ class Fit:
             var = var + (d.kappa_sd / self.kbar) ** 2
             return -0.5 * (y - mean) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
         yj, logw, h2 = kernels
-        return _log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]),
-                                   yj, logw)
+        return log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]),
+                                  yj, logw)
 
     def log_prior(self, x: np.ndarray) -> np.ndarray:
         th = self._theta(x)
