@@ -41,7 +41,7 @@ def statements(ca: CampaignAnalysis) -> list[str]:
         if p.refused:
             out.append(p.refused)
         else:
-            out.append(f"pooled {name}: population mean {p.mu['q50']:.4g} [{p.mu['q05']:.4g}, {p.mu['q95']:.4g}], "
+            out.append(f"pooled {name} of the stationary analysis: population mean {p.mu['q50']:.4g} [{p.mu['q05']:.4g}, {p.mu['q95']:.4g}], "
                        f"between-test scatter {p.sigma['q50']:.2g} [{p.sigma['q05']:.2g}, {p.sigma['q95']:.2g}] "
                        f"(90 %; {len(p.tests)} tests, smallest ESS {min(p.ess.values()):.0f}, "
                        f"MC variance {p.mc_variance:.2g})")

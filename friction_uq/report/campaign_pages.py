@@ -30,7 +30,8 @@ def _text_page(title: str, lines: list[str]):
 
 
 def _forest(ca: CampaignAnalysis):
-    fig, axes = figure("Per-test posteriors (90 % intervals) and the pooled population", nrows=1, ncols=2)
+    fig, axes = figure("Per-test posteriors of the stationary analysis (90 % intervals) and the pooled population",
+                       nrows=1, ncols=2)
     colors = {s: f"C{k}" for k, s in enumerate(sorted({t.setup for t in ca.tests}))}
     for ax, name in zip(axes, ("f", "kappa")):
         y = np.arange(len(ca.tests))[::-1]
