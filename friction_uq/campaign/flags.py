@@ -76,10 +76,10 @@ def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]
                              "the per-record causes")
             own = {x: set(tallies.get(x, {}).get("causes") or {}) for x in setups}
             only = {x: sorted(own[x] - own[y]) for x, y in ((s, other[0]), (other[0], s))}
-            if only[s] and not only[other[0]]:
-                entry["named_by_causes"], entry["causes_only_here"] = s, only[s]
-            elif only[other[0]] and not only[s]:
-                entry["named_by_causes"], entry["causes_only_here"] = other[0], only[other[0]]
+            named = s if only[s] and not only[other[0]] else other[0] if only[other[0]] and not only[s] else None
+            if named is not None:
+                entry["named_by_causes"], entry["causes_only_here"] = named, only[named]
+                entry["note_causes"] = f"named only in set-up {named}: " + ", ".join(only[named])
         entry["causes"] = {x: causes_sentence(x, tallies[x]) for x in ([s] + (other if pair else [])) if x in tallies}
         flags.append(entry)
     return flags

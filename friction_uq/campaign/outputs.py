@@ -60,12 +60,7 @@ def statements(ca: CampaignAnalysis) -> list[str]:
             out.append(f"flagged: set-up {f['setup']}{what} does not follow the shared law{rel}: {basis} offset "
                        f"{off['q50'] * 100:+.0f} % [{off['q05'] * 100:+.0f}, {off['q95'] * 100:+.0f}], dELPD "
                        f"{f['d_elpd']:.1f} (SE {f['d_se']:.1f})")
-            for key in ("note", "note_diagnosed"):
-                if key in f:
-                    out.append(str(f[key]))
-            if "causes_only_here" in f:
-                out.append(f"named only in set-up {f['named_by_causes']}: "
-                           + ", ".join(map(str, f["causes_only_here"])))
+            out.extend(str(f[key]) for key in ("note", "note_diagnosed", "note_causes") if key in f)
             out.extend(str(c) for c in f["causes"].values())
         else:
             out.append(f"flagged: test {f['test']} lies {f['below_median_by']:.1f} below the others' leave-one-out "

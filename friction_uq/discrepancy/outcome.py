@@ -26,6 +26,12 @@ def kappa_draws(mf: ModelFit) -> np.ndarray:
     return mf.f_effective * nu / (1.0 - nu)
 
 
+def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
+    """The headline f of a diagnosed record: the final model's label and its f when a cause was named; None
+    when none was (the headline is then the stationary analysis' f)."""
+    return (dg.final.label, dg.final.f_summary()) if dg.causes else None
+
+
 def _entry(r: Ranked) -> dict[str, object]:
     v = r.fit.variants[-1]
     params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}

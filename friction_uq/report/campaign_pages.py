@@ -121,11 +121,8 @@ def write_campaign_report(ca: CampaignAnalysis, doc: dict[str, Any], path: str |
                     flag_lines.append(f"set-up {f['setup']:<5} {f.get('basis', ca.law_data.basis):<6} "
                                       f"{o['q50'] * 100:+6.1f} % [{o['q05'] * 100:+.1f}, {o['q95'] * 100:+.1f}]"
                                       f"{'':<6} {f['d_elpd']:>7.1f} {f['d_se']:>5.1f}")
-                    flag_lines += ["    " + str(f[k]) for k in ("note", "note_diagnosed") if k in f]
+                    flag_lines += ["    " + str(f[k]) for k in ("note", "note_diagnosed", "note_causes") if k in f]
                     flag_lines += ["    " + str(c) for c in f["causes"].values()]
-                    if "causes_only_here" in f:
-                        flag_lines.append(f"    named only in set-up {f['named_by_causes']}: "
-                                          + ", ".join(map(str, f["causes_only_here"])))
                 else:
                     flag_lines.append(f"test {f['test']:<7} {f['below_median_by']:>6.1f} below median")
             if not ca.flagged:

@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 from .._atomic import write_bytes
 from ..analysis import Identification, Prepared
 from ..discrepancy.check import WholeRecordCheck
+from ..discrepancy.outcome import headline as outcome_headline
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
@@ -65,11 +66,11 @@ def page_summary(r: ReportInputs) -> Figure:
     f, nu = s["f"], s["nu"]
     share = r.nu_share
     headline = []
-    if r.diagnosis is not None and r.diagnosis.causes:  # the JSON's f_headline: f under the named causes
-        fx = r.diagnosis.final.f_summary()
+    named = None if r.diagnosis is None else outcome_headline(r.diagnosis)  # the JSON's f_headline
+    if named is not None:
+        label, fx = named
         headline = [f"Headline f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] under the model with the named "
-                    f"causes ({r.diagnosis.final.label}, page {whole_record_page(r) + 2}); the stationary analysis "
-                    "without them follows."]
+                    f"causes ({label}, page {whole_record_page(r) + 2}); the stationary analysis without them follows."]
     lines = headline + [
         f"Friction coefficient f = {f.q50:.3f}, 90 % credible interval [{f.q05:.3f}, {f.q95:.3f}] "
         f"(posterior mean {f.mean:.3f}, sd {f.sd:.3f}).",

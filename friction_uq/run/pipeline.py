@@ -270,9 +270,8 @@ def run_file(
             doc["misfit"] = wrc.to_json()
         if diag is not None:
             doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json())
-            fx = diag.final.f_summary() if diag.causes else summary["f"].to_json()
-            doc["f_headline"] = {"model": diag.final.label if diag.causes else "baseline (stationary phase, eq. 17 + hoop)"}
-            doc["f_headline"].update({k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")})
+            label, fx = outcome.headline(diag) or ("baseline (stationary phase, eq. 17 + hoop)", summary["f"].to_json())
+            doc["f_headline"] = {"model": label} | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
         js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
         write_together({names["netcdf"]: nc_bytes, names["pdf"]: pdf_bytes, names["json"]: js_bytes},
                        last=names["json"])
