@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass
 
+from .likelihood import FORCE_MODES
 from .likelihood.hoop import HOOP_DISCREPANCY, HOOP_MODES
 
 
@@ -31,6 +32,8 @@ class AnalysisSettings:
         The tube's axial Poisson term in the hoop prediction.
     hoop_discrepancy : float
         Relative sd of the hoop model's error on the level.
+    force_mode : {"level", "series"}
+        How the force ratio enters the likelihood (:class:`friction_uq.likelihood.Likelihood`).
     """
 
     window: tuple[float, float] | None = None
@@ -39,10 +42,13 @@ class AnalysisSettings:
     hoop_mode: str = "level"
     axial_poisson: bool = True
     hoop_discrepancy: float = HOOP_DISCREPANCY
+    force_mode: str = "level"
 
     def __post_init__(self) -> None:
         if self.hoop_mode not in HOOP_MODES:
             raise ValueError(f"hoop mode {self.hoop_mode!r} is not understood, allowed values: {', '.join(HOOP_MODES)}")
+        if self.force_mode not in FORCE_MODES:
+            raise ValueError(f"force mode {self.force_mode!r} is not understood, allowed values: {', '.join(FORCE_MODES)}")
         if self.window is not None:
             object.__setattr__(self, "window", (float(self.window[0]), float(self.window[1])))
 

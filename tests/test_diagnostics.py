@@ -50,11 +50,11 @@ def test_datatree_groups_dims_and_provenance(tree, run_hoop, data):
     assert post.attrs["sample_dims"] == ["chain", "draw"]
     assert post.sizes == {"chain": 4, "draw": run_hoop.n_draws}
     assert tree["prior"]["f"].shape == (1, 2000)
-    assert tree["log_likelihood"]["F_eo"].dims == ("chain", "draw", "segment")
+    assert tree["log_likelihood"]["F_eo"].dims == ("chain", "draw", "F_eo_observation")  # one level
     assert tree["observed_data"]["hoop"].shape == (data.n,)
     assert tree.attrs["seed"] == 7 and tree.attrs["prior_path"].endswith("I1.toml")
-    # per draw, the segments add up to the total log-likelihood
-    ll = tree["log_likelihood"]["F_eo"].sum("segment") + tree["log_likelihood"]["hoop"].sum("hoop_observation")
+    # per draw, the observations add up to the total log-likelihood
+    ll = tree["log_likelihood"]["F_eo"].sum("F_eo_observation") + tree["log_likelihood"]["hoop"].sum("hoop_observation")
     np.testing.assert_allclose(ll.values, run_hoop.log_likelihood, rtol=1e-9)
 
 

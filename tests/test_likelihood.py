@@ -69,7 +69,7 @@ def test_ar1_noise_has_requested_sd_and_lag1():
 
 def test_force_term_sufficient_statistics_equal_explicit_residuals():
     d = closed_form_data(0.1, 0.35, seed=2, hoop=False, rho=(0.3, 0.7, 0.5))
-    lk = Likelihood(d, hoop=False)
+    lk = Likelihood(d, hoop=False, force_mode="series")
     r = np.array([0.0, 0.1, lk.force.r0, 0.5, 2.0])
     sd, rho = lk.force.noise(r)
     ref = ar1_loglike(lk.force.residuals(r), sd, rho)
@@ -80,7 +80,7 @@ def test_effective_variance_is_exact_marginal_over_true_force():
     """One sample, white noise: L(r) = integral N(F_io; x, sd_io^2) N(F_eo; r x, sd_eo^2) dx (flat prior on x)."""
     d = closed_form_data(0.05, 0.4, seed=3, hoop=False, n=8, rho=(0.0, 0.0, 0.0))
     d = replace(d, sd_io=300.0)  # make F_io's noise matter
-    lk = Likelihood(d, hoop=False)
+    lk = Likelihood(d, hoop=False, force_mode="series")
     for r in (0.05, 0.1426, 0.4):
         F_io, F_eo = d.F_io[0], d.F_eo[0]
         integrand = lambda x: stats.norm.pdf(F_io, x, d.sd_io) * stats.norm.pdf(F_eo, r * x, d.sd_eo)  # noqa: E731
@@ -91,7 +91,7 @@ def test_effective_variance_is_exact_marginal_over_true_force():
 def test_equal_rho_force_likelihood_is_exact_dense_marginal():
     """rho_io = rho_eo: u = e_eo - r e_io is exactly AR(1) with covariance sd_eo^2 R + r^2 sd_io^2 R."""
     d = closed_form_data(0.05, 0.4, seed=4, hoop=False, n=60, rho=(0.6, 0.6, 0.5))
-    lk = Likelihood(d, hoop=False)
+    lk = Likelihood(d, hoop=False, force_mode="series")
     for r in (0.1, 0.3):
         cov = ar1_cov(60, d.sd_eo, 0.6) + r**2 * ar1_cov(60, d.sd_io, 0.6)
         ref = stats.multivariate_normal(np.zeros(60), cov).logpdf(d.F_eo - r * d.F_io)
@@ -102,7 +102,7 @@ def test_force_term_with_offset_errors_is_exact_dense_marginal():
     """Offsets delta_io, delta_eo: u's covariance gains (sd_off_eo^2 + r^2 sd_off_io^2) 1 1'."""
     d = closed_form_data(0.05, 0.4, seed=4, hoop=False, n=60, rho=(0.6, 0.6, 0.5), n_baseline=50)
     assert d.sd_offset_eo > 0
-    lk = Likelihood(d, hoop=False)
+    lk = Likelihood(d, hoop=False, force_mode="series")
     for r in (0.1, 0.3):
         cov = ar1_cov(60, d.sd_eo, 0.6) + r**2 * ar1_cov(60, d.sd_io, 0.6) + d.sd_offset_eo**2 + r**2 * d.sd_offset_io**2
         ref = stats.multivariate_normal(np.zeros(60), cov).logpdf(d.F_eo - r * d.F_io)
@@ -122,7 +122,7 @@ def test_hoop_term_with_offset_error():
 
 def test_unequal_rho_uses_variance_weighted_lag1():
     d = closed_form_data(0.05, 0.4, seed=5, hoop=False, rho=(0.2, 0.8, 0.5))
-    lk = Likelihood(d, hoop=False)
+    lk = Likelihood(d, hoop=False, force_mode="series")
     r = 0.3
     sd, rho = lk.force.noise(np.array(r))
     a, b = d.sd_eo**2, r**2 * d.sd_io**2
@@ -132,7 +132,7 @@ def test_unequal_rho_uses_variance_weighted_lag1():
 
 def test_vectorised_call_equals_row_calls_and_pointwise_sums():
     d = closed_form_data(0.05, 0.4, 1.02, seed=6)
-    lk = Likelihood(d, hoop_mode="series")
+    lk = Likelihood(d, hoop_mode="series", force_mode="series")
     assert lk.names == ("f", "nu", "hoop_gain")
     theta = np.column_stack([np.linspace(0.03, 0.08, 7), np.linspace(0.3, 0.45, 7), np.linspace(0.9, 1.1, 7)])
     full = lk(theta)
@@ -149,7 +149,7 @@ def test_vectorised_call_equals_row_calls_and_pointwise_sums():
 def test_likelihood_peaks_at_true_kappa():
     """Profile over kappa: the maximum lies within 3 standard errors of the truth."""
     d = closed_form_data(0.05, 0.4, seed=7, hoop=False)
-    lk = Likelihood(d, hoop=False)
+    lk = Likelihood(d, hoop=False, force_mode="series")
     kap = np.linspace(0.030, 0.037, 2001)
     theta = np.column_stack([kap / cell.lateral_ratio(0.4), np.full_like(kap, 0.4)])
     ll = lk(theta)
@@ -243,7 +243,7 @@ def test_knot_interpolation_error_is_far_below_noise():
 
 def test_simulate_is_seeded_and_has_the_model_noise():
     d = closed_form_data(0.05, 0.4, seed=10)
-    lk = Likelihood(d)
+    lk = Likelihood(d, force_mode="series")
     theta = np.tile([0.05, 0.4, 1.0], (400, 1))
     a = lk.simulate(theta, rng=np.random.default_rng(3))
     np.testing.assert_array_equal(a["F_eo"], lk.simulate(theta, rng=np.random.default_rng(3))["F_eo"])

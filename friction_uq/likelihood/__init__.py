@@ -27,10 +27,14 @@ from ..noise import ar1_noise
 from ..window import StationaryData
 from .ar1 import ar1_loglike, ar1_offset_correction, ar1_pointwise, offset_sd
 from .force import ForceTerm
+from .force_level import LevelForceTerm
 from .hoop import HOOP_DISCREPANCY, HOOP_MODES, HoopTerm
 
+#: How the force ratio enters the likelihood: by the window levels (default) or sample by sample.
+FORCE_MODES = ("level", "series")
+
 __all__ = [
-    "HOOP_DISCREPANCY", "HOOP_MODES", "ForceTerm", "HoopTerm", "Likelihood",
+    "FORCE_MODES", "HOOP_DISCREPANCY", "HOOP_MODES", "ForceTerm", "HoopTerm", "LevelForceTerm", "Likelihood",
     "ar1_loglike", "ar1_noise", "ar1_offset_correction", "ar1_pointwise", "gauge_kernel", "offset_sd",
 ]
 
@@ -67,6 +71,11 @@ class Likelihood:
         How the hoop reading enters (:class:`~.hoop.HoopTerm`).
     hoop_discrepancy : float
         Relative sd of the hoop model's error on the level ("level" mode).
+    force_mode : {"level", "series"}
+        How the force ratio enters: "level" (default), the window means with a standard error from
+        batch means (:mod:`.force_level`), which holds when the record fluctuates in ways the model
+        does not describe; "series", every sample with the pre-pulse AR(1) noise as the only error
+        (:mod:`.force`), exact only when the window is the model plus that noise.
     model : ClosedFormModel or None
         The forward model over ``data``; None: ``ClosedFormModel(data, hoop=hoop,
         axial_poisson=axial_poisson)``.
@@ -82,8 +91,10 @@ class Likelihood:
 
     def __init__(
         self, data: StationaryData, *, hoop: bool | None = None, axial_poisson: bool = True, hoop_mode: str = "level",
-        model: ClosedFormModel | None = None, hoop_discrepancy: float = HOOP_DISCREPANCY,
+        model: ClosedFormModel | None = None, hoop_discrepancy: float = HOOP_DISCREPANCY, force_mode: str = "level",
     ) -> None:
+        if force_mode not in FORCE_MODES:
+            raise ValueError(f"force mode {force_mode!r} is not understood, allowed values: {', '.join(FORCE_MODES)}")
         _check_data(data)
         if model is not None:
             if hoop is not None and bool(hoop) != (model.hoop is not None):
@@ -96,7 +107,8 @@ class Likelihood:
             model = ClosedFormModel(data, hoop=bool(hoop), axial_poisson=axial_poisson)
         self.data = data
         self.model = model
-        self.force = ForceTerm(data)
+        self.force = LevelForceTerm(data) if force_mode == "level" else ForceTerm(data)
+        self.force_mode = force_mode
         self.hoop = (HoopTerm(data, prediction=model.hoop, mode=hoop_mode, discrepancy=hoop_discrepancy)
                      if hoop else None)
         self.parameters = model.parameters

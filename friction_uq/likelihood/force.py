@@ -64,6 +64,8 @@ class ForceTerm:
         F_io, F_eo (N), their noise sd (N) and AR(1) coefficients.
     """
 
+    mode = "series"
+
     def __init__(self, data: StationaryData) -> None:
         a = np.asarray(data.F_eo, float)
         b = np.asarray(data.F_io, float)

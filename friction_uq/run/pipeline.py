@@ -121,7 +121,8 @@ def run_file(
     use_hoop = bool(settings.hoop and prep.data.hoop is not None and left_out is None)
     # the likelihood of this analysis, built once and passed to every stage that needs it
     likelihood = Likelihood(prep.data, hoop=use_hoop, axial_poisson=settings.axial_poisson,
-                            hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy)
+                            hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy,
+                            force_mode=settings.force_mode)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: --out must be a directory, and this is a file")
