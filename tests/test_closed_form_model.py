@@ -47,7 +47,8 @@ def test_model_predicts_by_name_and_without_hoop():
 
 #: Log-likelihoods on a closed-form record (friction_uq.synthetic, f = 0.05, nu = 0.4, g = 1, seed 3)
 #: at THETA, computed with the likelihood before the closed form became a model of its own. The hoop
-#: values were recomputed (with the same likelihood code) when the synthetic record's hoop strain
+#: (the sample-by-sample force term, force_mode="series": the numbers it gave before the force ratio was
+#: read from the window's levels by default) values were recomputed (with the same likelihood code) when the synthetic record's hoop strain
 #: became the closed form's own prediction instead of a trapezoid rule (a 1e-6 relative change of
 #: the data); the force values, which that does not touch, are the original ones.
 THETA = np.array([[0.05, 0.4, 1.0], [0.06, 0.35, 1.05], [0.04, 0.45, 0.9]])
@@ -62,10 +63,10 @@ FROZEN = {
 def test_likelihood_over_the_model_gives_the_numbers_of_before():
     d = record_data(0.05, 0.4, 1.0, seed=3)
     got = {
-        "level": Likelihood(d, model=ClosedFormModel(d))(THETA),
-        "series": Likelihood(d, hoop_mode="series", model=ClosedFormModel(d))(THETA),
-        "series_no_axial": Likelihood(d, hoop_mode="series", axial_poisson=False)(THETA),
-        "force": Likelihood(d, model=ClosedFormModel(d, hoop=False))(THETA[:, :2]),
+        "level": Likelihood(d, model=ClosedFormModel(d), force_mode="series")(THETA),
+        "series": Likelihood(d, hoop_mode="series", model=ClosedFormModel(d), force_mode="series")(THETA),
+        "series_no_axial": Likelihood(d, hoop_mode="series", axial_poisson=False, force_mode="series")(THETA),
+        "force": Likelihood(d, model=ClosedFormModel(d, hoop=False), force_mode="series")(THETA[:, :2]),
     }
     for k, v in FROZEN.items():
         np.testing.assert_allclose(got[k], v, rtol=1e-10, err_msg=k)

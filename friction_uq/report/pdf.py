@@ -47,6 +47,7 @@ class ReportInputs:
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
     likelihood: object | None = None  # friction_uq.likelihood.Likelihood, built once by run
+    warnings: tuple[str, ...] = ()  # the run's checks that failed (friction_uq.run.warnings), shown first
 
 
 #: Top of the summary page's table (axes fraction) for up to ten rows: the sentences above stay clear of it.
@@ -71,7 +72,7 @@ def page_summary(r: ReportInputs) -> Figure:
         label, fx = named
         headline = [f"Headline f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] under the model with the named "
                     f"causes ({label}, page {whole_record_page(r) + 2}); the stationary analysis without them follows."]
-    lines = headline + [
+    lines = [f"WARNING: {w}" for w in r.warnings] + headline + [
         f"Friction coefficient f = {f.q50:.3f}, 90 % credible interval [{f.q05:.3f}, {f.q95:.3f}] "
         f"(posterior mean {f.mean:.3f}, sd {f.sd:.3f}).",
         f"Poisson ratio nu = {nu.q50:.3f} [{nu.q05:.3f}, {nu.q95:.3f}]; the forces fix only "

@@ -40,7 +40,7 @@ from ..diagnostics import (
     summarize,
 )
 from ..errors import OutputError, check_seed, os_error_text
-from ..likelihood import Likelihood
+from ..likelihood import Likelihood, LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import default_prior_path, load_priors
 from ..record import read_record
@@ -49,6 +49,7 @@ from ..settings import AnalysisSettings
 from .alongside import alongside, prepare_soon, whole_record_start
 from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
 from .outputs import netcdf_bytes, safe_stem, sha256_hex, summary_table
+from .warnings import run_warnings
 
 JSON_VARIABLES = ("f", "nu", "kappa", "p_mean", "tau_mean", "V", "ratio")
 
@@ -68,6 +69,7 @@ class RunResult:
     sensitivity: dict[str, FUnderPrior] = dataclasses.field(default_factory=dict)
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
+    warnings: tuple[str, ...] = ()  # the checks that failed (friction_uq.run.warnings); empty when all pass
 
 
 def run_file(
@@ -213,6 +215,9 @@ def run_file(
                 diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say, check=wrc)
                 outcome.add_to_datatree(dt, diag)
         stages["whole_record"] = time.perf_counter() - t
+        levels = likelihood.force if isinstance(likelihood.force, LevelForceTerm) else LevelForceTerm(prep.data)
+        warns = run_warnings(ppc=ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=summary["f"], lab=lab,
+                             conv=conv, conflict=conflict, check=wrc)
         t = time.perf_counter()
 
         dt.attrs.update({
@@ -227,13 +232,13 @@ def run_file(
         t = time.perf_counter()
         pdf_bytes = None
         if pdf:
-            inputs = dataclasses.replace(inputs, whole_record=wrc, diagnosis=diag)
+            inputs = dataclasses.replace(inputs, whole_record=wrc, diagnosis=diag, warnings=tuple(warns))
             pdf_bytes = render_report(inputs, record_part=record_part, posterior_part=posterior_part)
         stages["pdf"] += time.perf_counter() - t
         t = time.perf_counter()
 
         seconds = time.perf_counter() - t_start
-        doc: dict[str, object] = {}
+        doc: dict[str, object] = {"warnings": warns}
         allv = dict(summary) | {"V": V}
         for name in JSON_VARIABLES:
             v = allv[name]
@@ -280,6 +285,8 @@ def run_file(
         stages["outputs"] += time.perf_counter() - t
     outputs = {k: p for k, p in names.items() if k != "pdf" or pdf_bytes is not None}
     if table:
+        for w in warns:
+            print(f"WARNING: {w}")
         lines = []
         if wrc is not None:
             lines.append(wrc.decision.sentence(page=(9 if use_hoop else 8) if pdf_bytes is not None else None))
@@ -287,5 +294,5 @@ def run_file(
             lines.append(doc["discrepancy"]["sentence"])
         print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, conflict, lines))
     return RunResult(prep, samples, summary, conv, lab, outputs, seconds, conflict, tuple(said), stages, sens,
-                     wrc, diag)
+                     wrc, diag, tuple(warns))
 

@@ -1,0 +1,121 @@
+"""Checks that can fail, said loudly: the warnings of one analysis.
+
+Each check asks whether the model behind eq. 17 describes this record; when one says it does not,
+a one-sentence warning says what was seen, what f is then worth and which estimate is safer. The
+list is empty when every check passes; ``run`` prints it before the table, writes it first in the
+JSON (``warnings``) and on the report's first page.
+
+Checks and their limits (``docs/trust.md`` gives the calibration):
+
+* stationarity: the 10 us-smoothed force ratio stays inside its noise band about the window's
+  level less than :data:`PPC_COVERAGE_MIN` of the time, or the window's batch means scatter more
+  than the gauges' noise allows (their variance ratio beyond the 99.9 % point of chi-square / dof);
+* the whole-record check misses a gauge: over the *stationary* phase (the phase eq. 17 reads) on a
+  gauge f depends on, or anywhere else (a cause such as a plug friction shows outside that phase
+  and biases f inside it);
+* equilibrium (eq. 5): the output forces do not sum to the input force within
+  :data:`EQUILIBRIUM_TOL` over the window;
+* convergence of the sampler; the prior-data check.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from scipy import stats
+
+from ..analysis import Identification
+from ..diagnostics import Convergence, VariableSummary
+from ..diagnostics.ppc import RatioPPC
+from ..discrepancy.check import WholeRecordCheck
+from ..discrepancy.whole_record import CHANNEL_LABELS
+from ..prior_sensitivity import PriorDataConflict
+
+#: Least fraction of the window where the smoothed ratio lies in its 90 % noise band (about 0.9 on a
+#: record the model describes; its sd over records is ~0.06, so 0.5 is more than six sd below).
+PPC_COVERAGE_MIN = 0.5
+#: Tail probability of the batch-means spread test (chi-square with batches - 1 degrees of freedom).
+SPREAD_ALPHA = 1e-3
+#: Largest |1 - (F_io + F_eo) / F_i| over the window (eq. 5) before a gauge is suspected.
+EQUILIBRIUM_TOL = 0.05
+#: Channels whose stationary-phase misfit bears on f.
+F_CHANNELS = ("internal_output_bar", "external_output_bar", "tube_hoop")
+
+
+def _f_text(f: VariableSummary) -> str:
+    return f"f = {f.q50:.4g} [{f.q05:.4g}, {f.q95:.4g}]"
+
+
+def stationarity_warning(ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary,
+                         lab: Identification) -> str | None:
+    """The ratio wanders over the window more than the noise explains (module docstring)."""
+    limit = float(stats.chi2(dof).ppf(1.0 - SPREAD_ALPHA) / dof) ** 0.5
+    if ppc.coverage >= PPC_COVERAGE_MIN and excess_spread <= limit:
+        return None
+    return (f"The force ratio is not stationary over the window: its smoothed course stays in the noise band "
+            f"about its level {ppc.coverage * 100:.0f} % of the time (about 90 % expected) and its level "
+            f"wanders {excess_spread:.1f} times what the gauges' noise allows; eq. 17 then reads an average "
+            f"over a varying friction, so {_f_text(f)} is the mean ratio's f, its interval widened to the "
+            f"window's own scatter (the lab's eq. 17 on the window means: f = {lab.f:.4g} at nu {lab.nu:g}); a "
+            "steadier window (--window) or `friction-uq diagnose` is safer.")
+
+
+def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary) -> str | None:
+    """The whole-record check misses a gauge that f depends on over the stationary phase."""
+    if check is None:
+        return None
+    d = check.decision
+    if not d.detected:
+        return None
+    cells = [c for c in d.flagged() if c.phase == "stationary" and c.channel in F_CHANNELS]
+    if not cells:
+        w = d.flagged()[0]
+        return (f"The simulated test misses the {CHANNEL_LABELS[w.channel]} gauge over the {w.phase} phase (statistic "
+                f"{w.statistic:.0f} > {d.threshold:g}): something in this test is not in the model (a plug friction, "
+                f"a clearance, a gauge's calibration, ...) and may bias {_f_text(f)} although the stationary phase "
+                "looks right; `friction-uq diagnose` names the cause and gives f under it.")
+    w = cells[0]
+    how = (f"reads {abs(w.relative_level) * 100:.1f} % {'above' if w.relative_level > 0 else 'below'} the simulated "
+           "test" if abs(w.level_z) >= w.shape_z else
+           f"departs from the simulated test's shape (chi2/dof {w.chi2_dof:.1f})")
+    return (f"The {CHANNEL_LABELS[w.channel]} gauge {how} over the stationary phase "
+            f"(statistic {w.statistic:.0f} > {d.threshold:g}): the model behind eq. 17 misses something there, "
+            f"so {_f_text(f)} may be biased by about as much; `friction-uq diagnose` names the cause and "
+            "gives f under it.")
+
+
+def equilibrium_warning(lab: Identification, f: VariableSummary) -> str | None:
+    """The output forces do not balance the input force (eq. 5): a gauge's gain, sign or place is off."""
+    e = lab.equilibrium_error
+    if abs(e) <= EQUILIBRIUM_TOL:
+        return None
+    return (f"The output forces sum to {(1.0 - e) * 100:.0f} % of the input force over the window (eq. 5 wants "
+            f"100 % within {EQUILIBRIUM_TOL * 100:.0f} %): a gauge's gain, sign or distance is off, and "
+            f"{_f_text(f)} rests on the output gauges' ratio, off by as much as their gains are; check the "
+            "gauges' calibration (`friction-uq inspect`).")
+
+
+def convergence_warning(conv: Convergence) -> str | None:
+    if conv.ok:
+        return None
+    return (f"The sampler did not converge (R-hat max {conv.r_hat_max:.3f}, ESS min "
+            f"{min(conv.ess_bulk_min, conv.ess_tail_min):.0f}): the interval of f is not reliable; run again "
+            "with another --seed and compare.")
+
+
+def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
+    if conflict is None or not conflict.flagged:
+        return None
+    return (conflict.sentence().rstrip(".") + ": f then follows the prior file as much as the record; "
+            "quote it with f under the other nu priors (the report's nu page).")
+
+
+def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
+                 conv: Convergence, conflict: PriorDataConflict | None,
+                 check: WholeRecordCheck | None) -> list[str]:
+    """Every check's warning, in the order a reader should see them; empty when all pass."""
+    found: Sequence[str | None] = (
+        equilibrium_warning(lab, f), stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f),
+        convergence_warning(conv), conflict_warning(conflict),
+    )
+    return [w for w in found if w]
