@@ -14,7 +14,8 @@ import numpy as np
 
 from .forces import Forces, compute_forces
 from .physics import cell
-from .errors import SignalError
+from .errors import NoStationaryPhase, SignalError
+from .gauge_check import gauge_findings
 from .record import Record
 from .signals import ar1_mean_sd, moving_average
 from .window import (
@@ -35,6 +36,7 @@ class Prepared:
     forces: Forces
     window: Window
     data: StationaryData
+    gauge_notes: tuple[str, ...] = ()  # what the gauge check found (friction_uq.gauge_check), for the warnings
 
 
 def prepare(
@@ -46,8 +48,13 @@ def prepare(
 ) -> Prepared:
     """Forces, stationary window (automatic unless ``window`` is given, in seconds) and likelihood data."""
     forces = compute_forces(record, dispersion=dispersion)
+    findings = gauge_findings(forces, record.apparatus)
+    reversed_ = [g for g in findings if g.kind == "reversed"]
+    if reversed_:
+        raise SignalError(f"{record.path}: {reversed_[0].sentence}")
+    notes = tuple(g.sentence for g in findings)
     if window is None:
-        win = find_stationary_window(forces, record.apparatus, criterion)
+        win, notes = _automatic_window(record, forces, criterion, notes)
     else:
         win = window_from_times(forces, *window)
     data = stationary_data(
@@ -55,7 +62,24 @@ def prepare(
         striker_velocity=record.striker_velocity,
     )
     _check_polarity(record, data)
-    return Prepared(record, forces, win, data)
+    return Prepared(record, forces, win, data, notes)
+
+
+def _automatic_window(record: Record, forces, criterion: WindowCriterion,
+                      notes: tuple[str, ...]) -> tuple[Window, tuple[str, ...]]:
+    """The automatic window; when a gauge's balance is off, found without the ends' velocities (which
+    the suspect gauge enters) rather than refused as "no stationary phase"; every refusal names the file."""
+    try:
+        return find_stationary_window(forces, record.apparatus, criterion), notes
+    except NoStationaryPhase as exc:
+        if not notes:
+            raise NoStationaryPhase(f"{record.path}: {exc}") from None
+        try:
+            win = find_stationary_window(forces, record.apparatus, criterion, velocity=False)
+        except NoStationaryPhase:
+            raise NoStationaryPhase(f"{record.path}: {notes[0]}; no stationary phase either way: {exc}") from None
+    return win, notes + ("the window was found from the force ratio alone: the sample's ends do not move together by "
+                         "the gauges (eq. 6), as the suspect gauge makes them",)
 
 
 def _check_polarity(record: Record, data: StationaryData) -> None:

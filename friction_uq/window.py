@@ -74,9 +74,10 @@ def steady_mask(forces: Forces, apparatus: Apparatus, criterion: WindowCriterion
 
 
 def _steadiness(
-    forces: Forces, apparatus: Apparatus, criterion: WindowCriterion
+    forces: Forces, apparatus: Apparatus, criterion: WindowCriterion, *, velocity: bool = True,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Steady mask, smoothed ratio and the half-width of its steadiness band at each time."""
+    """Steady mask, smoothed ratio and the half-width of its steadiness band at each time
+    (``velocity=False``: without criterion 3, for a record whose internal gauge is suspect)."""
     t = forces.time
     fs = 1.0 / (t[1] - t[0])
     w = max(1, int(round(criterion.smooth * fs)))
@@ -121,7 +122,7 @@ def _steadiness(
     # a time is steady when the whole span around it is loaded and valid
     loaded_span = np.convolve(loaded.astype(int), np.ones(2 * half + 1, int), mode="same") == 2 * half + 1
     band = np.maximum(criterion.band_sigmas * sd_r, criterion.ratio_tol * np.abs(r_s))
-    return loaded_span & ratio_ok & vel_ok, r_s, band
+    return loaded_span & ratio_ok & (vel_ok if velocity else True), r_s, band
 
 
 def _longest_banded(values: np.ndarray, half_width: float) -> tuple[int, int]:
@@ -172,9 +173,10 @@ def _longest_run(mask: np.ndarray) -> tuple[int, int]:
 
 
 def find_stationary_window(
-    forces: Forces, apparatus: Apparatus, criterion: WindowCriterion = WindowCriterion()
+    forces: Forces, apparatus: Apparatus, criterion: WindowCriterion = WindowCriterion(), *, velocity: bool = True,
 ) -> Window:
-    """The longest steady run of the record (see module docstring).
+    """The longest steady run of the record (see module docstring); ``velocity=False`` leaves out
+    criterion 3 (the ends' velocities, which a gain error of the internal gauge breaks).
 
     Raises
     ------
@@ -183,7 +185,7 @@ def find_stationary_window(
     """
     t = forces.time
     dt = t[1] - t[0]
-    steady, r_s, band = _steadiness(forces, apparatus, criterion)
+    steady, r_s, band = _steadiness(forces, apparatus, criterion, velocity=velocity)
     mask = _close_gaps(steady, int(round(criterion.max_gap / dt)))
     i0, i1 = _longest_run(mask)
     if i1 > i0:

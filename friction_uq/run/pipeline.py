@@ -217,7 +217,7 @@ def run_file(
         stages["whole_record"] = time.perf_counter() - t
         levels = likelihood.force if isinstance(likelihood.force, LevelForceTerm) else LevelForceTerm(prep.data)
         warns = run_warnings(ppc=ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=summary["f"], lab=lab,
-                             conv=conv, conflict=conflict, check=wrc)
+                             conv=conv, conflict=conflict, check=wrc, gauge_notes=prep.gauge_notes)
         t = time.perf_counter()
 
         dt.attrs.update({

@@ -13,8 +13,8 @@ Checks and their limits (``docs/trust.md`` gives the calibration):
 * the whole-record check misses a gauge: over the *stationary* phase (the phase eq. 17 reads) on a
   gauge f depends on, or anywhere else (a cause such as a plug friction shows outside that phase
   and biases f inside it);
-* equilibrium (eq. 5): the output forces do not sum to the input force within
-  :data:`EQUILIBRIUM_TOL` over the window;
+* a gauge disagrees over the loading (:mod:`friction_uq.gauge_check`), or the output forces do not
+  sum to the input force within :data:`EQUILIBRIUM_TOL` over the window (eq. 5);
 * convergence of the sampler; the prior-data check.
 """
 
@@ -95,6 +95,14 @@ def equilibrium_warning(lab: Identification, f: VariableSummary) -> str | None:
             "gauges' calibration (`friction-uq inspect`).")
 
 
+def gauge_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
+    """What the gauge check found over the loading (:mod:`friction_uq.gauge_check`)."""
+    if not notes:
+        return None
+    return (f"A gauge disagrees with the others: {'; '.join(notes)}. {_f_text(f)} rests on the output gauges' "
+            "ratio and is off by as much as their gains are; `friction-uq diagnose` fits a gauge's gain.")
+
+
 def convergence_warning(conv: Convergence) -> str | None:
     if conv.ok:
         return None
@@ -112,10 +120,10 @@ def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
 
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
                  conv: Convergence, conflict: PriorDataConflict | None,
-                 check: WholeRecordCheck | None) -> list[str]:
+                 check: WholeRecordCheck | None, gauge_notes: Sequence[str] = ()) -> list[str]:
     """Every check's warning, in the order a reader should see them; empty when all pass."""
     found: Sequence[str | None] = (
-        equilibrium_warning(lab, f), stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f),
+        gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f), stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f),
         convergence_warning(conv), conflict_warning(conflict),
     )
     return [w for w in found if w]
