@@ -80,7 +80,7 @@ def khat_threshold(n_draws: int) -> float:
 
 def reweight(samples: PosteriorSamples, used: Priors, other: Priors, *, label: str, seed: int) -> FUnderPrior:
     """f under ``other`` from the draws of ``samples`` (sampled under ``used``) by PSIS."""
-    from arviz_stats.base import array_stats
+    from .stats import psis
 
     theta = samples.array().reshape(-1, len(samples.names))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -89,15 +89,9 @@ def reweight(samples: PosteriorSamples, used: Priors, other: Priors, *, label: s
     if not np.any(np.isfinite(log_w)):
         return FUnderPrior(label, other.subset(samples.names).describe(), *([math.nan] * 5), np.array([]),
                            "reweighted", math.inf, 0.0)
-    log_w = np.where(np.isfinite(log_w), log_w, -np.inf)
-    finite = np.isfinite(log_w)
-    try:  # psislw takes log-likelihood-like values and smooths exp(-ary): pass -log w
-        lw, k = array_stats.psislw(np.where(finite, -log_w, np.max(-log_w[finite]) + 1e3), r_eff=1.0)
-    except ValueError:  # a tail of identical weights: no Pareto fit, treat as unreliable
-        lw, k = np.where(finite, log_w, -np.inf), math.inf
-    w = np.exp(lw - np.max(lw))
-    w = np.where(finite, w, 0.0)
-    w = w / w.sum()
+    smoothed = psis(np.where(np.isfinite(log_w), log_w, -np.inf))
+    k = float(smoothed.pareto_k)
+    w = np.exp(smoothed.log_weights)
     mean = float(w @ f)
     sd = float(math.sqrt(max(float(w @ (f - mean) ** 2), 0.0)))
     q = weighted_quantiles(f, w, QUANTILES)

@@ -157,18 +157,13 @@ class Elpd:
 
 def psis_loo(log_lik: np.ndarray, log_weights: np.ndarray) -> Elpd:
     """PSIS-LOO from per-draw pointwise log densities (S, P) and the draws' log importance weights (S,)."""
-    from arviz_stats.base import array_stats
+    from ..stats import psis
 
     ll = np.asarray(log_lik, float)
     lw = (np.asarray(log_weights, float)[:, None] - ll).T  # leave-one-out importance ratios, (P, S)
-    smoothed = lw.copy()
-    k = np.full(lw.shape[0], -np.inf)
-    spread = np.ptp(lw, axis=-1) > 1e-12  # equal ratios need no smoothing (and PSIS refuses them)
-    if spread.any():
-        smoothed[spread], k[spread] = array_stats.psislw(lw[spread], axis=-1)
-    smoothed = smoothed - np.logaddexp.reduce(smoothed, axis=-1, keepdims=True)
-    point = np.logaddexp.reduce(smoothed + ll.T, axis=-1)
-    return Elpd(pointwise=point, pareto_k_max=float(np.nanmax(k)))
+    res = psis(lw)
+    point = np.logaddexp.reduce(res.log_weights + ll.T, axis=-1)
+    return Elpd(pointwise=point, pareto_k_max=float(np.nanmax(res.pareto_k)))
 
 
 def takeuchi_block_loo(log_density_mode: np.ndarray, jacobian: np.ndarray, whitened: np.ndarray,

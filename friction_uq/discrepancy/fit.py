@@ -21,6 +21,7 @@ import numpy as np
 from scipy import optimize
 
 from ..models.parameters import summarize_draws
+from ..stats import psis
 from .record_likelihood import GAIN_SD, WholeRecordLikelihood
 
 __all__ = ["GAIN_SD", "WholeRecordFit", "WholeRecordLikelihood", "fit_whole_record", "robust_covariance"]
@@ -167,9 +168,8 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
         log_q = -0.5 * np.sum(eps * eps, axis=1)
         log_p = np.array([log_post(zi) for zi in z])
         log_w = log_p - log_q
-        log_w = np.where(np.isfinite(log_w), log_w, -np.inf)
-        k = _pareto_k(log_w[np.isfinite(log_w)])
-        log_w = log_w - np.logaddexp.reduce(log_w)
+        smoothed = psis(np.where(np.isfinite(log_w), log_w, -np.inf))
+        log_w, k = smoothed.log_weights, float(smoothed.pareto_k)
     else:
         log_w, k = np.full(n_draws, -math.log(n_draws)), math.nan
     draws = {p.name: np.asarray(p.from_unbounded(z[:, i]), float) for i, p in enumerate(params)}
@@ -177,14 +177,3 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     return WholeRecordFit(names=names, mode=mode, draws=draws, log_weights=log_w, pareto_k=k,
                           loglike_mode=lik.loglike(mode), n_calls=calls + (n_draws if importance else 0),
                           cov_z=cov, jacobian=J[:n_data], whitened=res.fun[:n_data], laplace_draws=laplace)
-
-
-def _pareto_k(log_w: np.ndarray) -> float:
-    """Pareto k of importance weights (arviz-stats PSIS); nan when it cannot be computed."""
-    try:
-        from arviz_stats.base import array_stats
-
-        _, k = array_stats.psislw(np.asarray(log_w, float))
-        return float(np.asarray(k).ravel()[0])
-    except Exception:  # noqa: BLE001 - the diagnostic is optional, the draws stand without it
-        return math.nan

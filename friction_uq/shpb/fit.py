@@ -42,6 +42,7 @@ import numpy as np
 from scipy import optimize
 
 from ..discrepancy.elpd import Elpd, ar1_block_loo, psis_loo
+from ..stats import psis
 from ..likelihood import ar1_loglike
 from ..models.parameters import Parameter
 from .balance import BalanceObservation, Misfit
@@ -182,23 +183,13 @@ def _draws(zm: np.ndarray, cov: np.ndarray, rng: np.random.Generator, n_draws: i
 
 def _smoothed(log_w: np.ndarray) -> tuple[np.ndarray, float]:
     """PSIS-smoothed, normalised log weights and their Pareto k."""
-    from arviz_stats.base import array_stats
-
-    smoothed, k = array_stats.psislw(log_w - log_w.max())
-    smoothed = np.asarray(smoothed)
-    return smoothed - np.logaddexp.reduce(smoothed), float(np.asarray(k).ravel()[0])
+    res = psis(log_w)
+    return res.log_weights, float(res.pareto_k)
 
 
 def _loo_k(ll: np.ndarray, log_w: np.ndarray) -> np.ndarray:
     """Pareto k of each block's leave-one-out importance ratios (as in :func:`psis_loo`)."""
-    from arviz_stats.base import array_stats
-
-    lw = (log_w[:, None] - ll).T
-    k = np.full(lw.shape[0], -np.inf)
-    spread = np.ptp(lw, axis=-1) > 1e-12
-    if spread.any():
-        k[spread] = np.asarray(array_stats.psislw(lw[spread], axis=-1)[1])
-    return k
+    return np.asarray(psis((log_w[:, None] - ll).T).pareto_k)
 
 
 def fit_balance(obs: BalanceObservation, model: CombinedModel, *, rng: np.random.Generator,

@@ -1,0 +1,44 @@
+"""PSIS, the one implementation: against plain importance sampling on a conjugate normal."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from friction_uq.stats import psis, weighted_quantiles
+
+
+def test_psis_reweights_a_proposal_to_a_conjugate_normal_posterior():
+    """Prior N(0, 1), one datum y = 1 with sd 1: posterior N(0.5, 1/2). Draws from a wider proposal
+    N(0.3, 1.2^2), reweighted, give the posterior's mean and sd (tolerance: 5 Monte Carlo sd)."""
+    rng = np.random.default_rng(1)
+    x = rng.normal(0.3, 1.2, 4000)
+    log_p = -0.5 * x**2 - 0.5 * (1.0 - x) ** 2
+    log_q = -0.5 * ((x - 0.3) / 1.2) ** 2
+    res = psis(log_p - log_q)
+    assert res.pareto_k < 0.5
+    w = np.exp(res.log_weights)
+    assert w.sum() == pytest.approx(1.0)
+    mean = float(np.sum(w * x))
+    sd = math.sqrt(float(np.sum(w * (x - mean) ** 2)))
+    mc = math.sqrt(0.5 / res.ess)
+    assert mean == pytest.approx(0.5, abs=5 * mc)
+    assert sd == pytest.approx(math.sqrt(0.5), rel=0.05)
+    q = weighted_quantiles(x, res.log_weights, np.array([0.05, 0.95]))
+    np.testing.assert_allclose(q, 0.5 + np.array([-1.0, 1.0]) * 1.6449 * math.sqrt(0.5), atol=0.06)
+
+
+def test_a_proposal_narrower_than_the_target_has_a_large_k():
+    """Wrong sign (the library's weights exp(-ary)) would give the reciprocal weights a small k here."""
+    rng = np.random.default_rng(2)
+    x = rng.normal(0.0, 0.3, 2000)  # target N(0, 1)
+    res = psis(-0.5 * x**2 + 0.5 * (x / 0.3) ** 2)
+    assert res.pareto_k > 0.7
+
+
+def test_equal_and_non_finite_ratios():
+    res = psis(np.array([[0.0, 0.0, 0.0, 0.0], [1.0, -np.inf, 1.0, 1.0]]))
+    np.testing.assert_allclose(np.exp(res.log_weights[0]), 0.25)
+    assert np.exp(res.log_weights[1, 1]) == 0.0 and np.exp(res.log_weights[1]).sum() == pytest.approx(1.0)
