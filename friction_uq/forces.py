@@ -145,7 +145,13 @@ def compute_forces(record: Record, *, dispersion: bool = False) -> Forces:
     try:
         noise_in, arr_inc = prepulse_noise(x, span=span, polarity=+1)
     except SignalError as exc:
-        raise SignalError(f"{record.path}: /signals/input_bar: {exc} (no incident wave found)") from None
+        try:  # a compression front in the negated signal: the gauge (or its bridge) is wired the other way
+            prepulse_noise(-np.asarray(x, float), span=span, polarity=+1)
+        except SignalError:
+            raise SignalError(f"{record.path}: /signals/input_bar: {exc} (no incident wave found)") from None
+        raise SignalError(f"{record.path}: /signals/input_bar: the first pulse is a tension, where the incident wave "
+                          "is a compression: the gauge looks reversed (its wiring, its bridge or the sign convention, "
+                          "elongation positive)") from None
     y = x - noise_in.offset
     sep = arr_inc + 2.0 * ib.gauge_delay * fs  # reflected wave's front at the gauge
     margin = 0.02 * app.pulse_duration * fs

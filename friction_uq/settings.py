@@ -48,7 +48,8 @@ class AnalysisSettings:
         if self.hoop_mode not in HOOP_MODES:
             raise ValueError(f"hoop mode {self.hoop_mode!r} is not understood, allowed values: {', '.join(HOOP_MODES)}")
         if self.force_mode not in FORCE_MODES:
-            raise ValueError(f"force mode {self.force_mode!r} is not understood, allowed values: {', '.join(FORCE_MODES)}")
+            raise ValueError(f"force mode {self.force_mode!r} is not understood, allowed values: "
+                             f"{', '.join(FORCE_MODES)}")
         if self.window is not None:
             object.__setattr__(self, "window", (float(self.window[0]), float(self.window[1])))
 

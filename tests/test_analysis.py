@@ -112,5 +112,6 @@ def test_a_reversed_output_gauge_is_refused(tmp_path):
     _, strains, _ = closed_form_strains(test, paper_apparatus())
     p = write_closed_form_record(tmp_path / "rev.h5", test, seed=3,
                                  strains_override={"external_output_bar": -strains["external_output_bar"]})
-    with pytest.raises(SignalError, match=r"rev\.h5: /signals/external_output_bar: F_eo is tensile .* looks reversed"):
+    with pytest.raises(SignalError, match=r"rev\.h5: /signals/external_output_bar reads tension through the "
+                                          r"loading .* looks reversed"):
         prepare(read_record(p))

@@ -47,10 +47,11 @@ def test_model_predicts_by_name_and_without_hoop():
 
 #: Log-likelihoods on a closed-form record (friction_uq.synthetic, f = 0.05, nu = 0.4, g = 1, seed 3)
 #: at THETA, computed with the likelihood before the closed form became a model of its own. The hoop
-#: (the sample-by-sample force term, force_mode="series": the numbers it gave before the force ratio was
-#: read from the window's levels by default) values were recomputed (with the same likelihood code) when the synthetic record's hoop strain
+#: values were recomputed (with the same likelihood code) when the synthetic record's hoop strain
 #: became the closed form's own prediction instead of a trapezoid rule (a 1e-6 relative change of
-#: the data); the force values, which that does not touch, are the original ones.
+#: the data); the force values, which that does not touch, are the original ones. They are of the
+#: sample-by-sample force term (force_mode="series"), the default before the ratio was read from
+#: the window's levels.
 THETA = np.array([[0.05, 0.4, 1.0], [0.06, 0.35, 1.05], [0.04, 0.45, 0.9]])
 FROZEN = {
     "level": [-13017.892162257636, -13040.576619893598, -13023.35387783163],

@@ -43,7 +43,8 @@ def test_stick_slip_f_is_eq17_of_the_window_means_and_holds_the_truth(tmp_path):
     d = res.prepared.data
     f = res.summary["f"]
     nu = res.summary["nu"].q50
-    f_eq17 = math.log1p(float(np.mean(d.F_eo) / np.mean(d.F_io))) / float(cell.beta(nu, radius=d.radius, length=d.length))
+    ratio = float(np.mean(d.F_eo) / np.mean(d.F_io))
+    f_eq17 = math.log1p(ratio) / float(cell.beta(nu, radius=d.radius, length=d.length))
     assert abs(f.q50 - f_eq17) <= f.sd
     truth = effective_f(model, d.window[0], d.window[1], d.radius, d.length)
     assert f.q05 <= truth <= f.q95
@@ -65,10 +66,11 @@ def test_an_internal_gauge_reading_7_percent_low_is_named_not_refused(tmp_path):
     assert prep.gauge_notes and "sum to 93 % of the input force" in prep.gauge_notes[0]
     res = run_file(path, out_dir=tmp_path / "out", pdf=False, progress=False, table=False, notes=False,
                    whole_record=False)
-    assert res.warnings and res.warnings[0].startswith("A gauge disagrees with the others: the output forces sum to 93 %")
+    assert res.warnings
+    assert res.warnings[0].startswith("A gauge disagrees with the others: the output forces sum to 93 %")
 
 
-@pytest.mark.parametrize("channel", ["internal_output_bar", "external_output_bar"])
+@pytest.mark.parametrize("channel", ["internal_output_bar", "external_output_bar", "input_bar"])
 def test_a_reversed_gauge_is_named_with_the_file(tmp_path, channel):
     cfg = noisy_config(test_id="R", campaign="T")
     path = str(tmp_path / "rev.h5")

@@ -123,7 +123,8 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
                  check: WholeRecordCheck | None, gauge_notes: Sequence[str] = ()) -> list[str]:
     """Every check's warning, in the order a reader should see them; empty when all pass."""
     found: Sequence[str | None] = (
-        gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f), stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f),
+        gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f),
+        stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f),
         convergence_warning(conv), conflict_warning(conflict),
     )
     return [w for w in found if w]
