@@ -124,11 +124,15 @@ def analyse_one(group: str, k: int, rng: np.random.Generator, tmp: str, seed: in
         res = run_file(path, **kw)
     except NoStationaryPhase as exc:  # as a lab would: a window by hand over the plateau, then the same checks
         row["refused"] = str(exc)
-        hand = (model.plateau[0] - 150e-6, model.plateau[1])
-        try:
-            res = run_file(path, window=hand, **kw)
-        except FrictionUQError as exc2:
-            return row | {"refused": f"{exc}; by hand: {exc2}"}
+        res = None
+        for back in np.arange(0.0, 101e-6, 20e-6):  # the plateau's end, or earlier where the waves are valid
+            try:
+                res = run_file(path, window=(model.plateau[0] - 150e-6, model.plateau[1] - back), **kw)
+                break
+            except FrictionUQError as exc2:
+                last = exc2
+        if res is None:
+            return row | {"refused": f"{exc}; by hand: {last}"}
         row["edit"] = (what + " window by hand").strip()
     except FrictionUQError as exc:
         return row | {"refused": str(exc)}
@@ -160,7 +164,8 @@ def silent_miss(row: dict) -> bool:
 def _row_line(row: dict) -> str:
     head = f"{row['group']:<26} {row['edit']:<38}"
     if "truth" not in row:
-        return head + f" refused: {row['refused'][:110]}"
+        why = row["refused"]
+        return head + " refused: " + (why[:110] if "; by hand: " not in why else "by hand too: " + why.split("; by hand: ")[1])
     flag = "SILENT MISS" if silent_miss(row) else ""
     return (head + f" truth {row['truth']:.4f} f {row['q50']:.4f} [{row['q05']:.4f}, {row['q95']:.4f}] "
             f"z {(row['q50'] - row['truth']) / row['sd']:+.1f} warnings {len(row['warnings'])} {flag}")

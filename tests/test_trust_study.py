@@ -1,0 +1,40 @@
+"""The study of issue 22 on records the likelihood did not make (``benchmarks/bench_trust.py``), slow.
+
+At least 60 records from the project's simulator with settings the stationary model does not share
+(stick-slip, strongly coloured noise, a drifting zero, gains 0.9-1.1, a sign flipped, the hidden
+mechanisms of the catalogue) and clean ones, each through ``run``'s path. Required: no silent miss
+(f more than 3 posterior sd from the truth with ``warnings`` empty), and warnings on at most 10 %
+of the clean records.
+
+Known gap, kept visible rather than hidden: a plug friction of 200-400 N + 1-2 % of the input force
+biases the stationary f by 15-40 % and the stationary phase cannot tell it from wall friction;
+``run`` warns only when the whole-record check sees it (about half of these records), ``diagnose``
+names it. Its records are analysed and printed here but kept out of the silent-miss assertion
+(issue 22 stays open on it; docs/trust.md).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import pytest
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "benchmarks"))
+from bench_trust import silent_miss, study, table  # noqa: E402
+
+KNOWN_GAP = {"hidden_plug_friction"}
+
+
+@pytest.mark.slow
+def test_no_confident_wrong_f_and_few_warnings_on_clean_records():
+    rows = study(per=4, clean=12, seed=5, say=lambda line: None)
+    print(table(rows))
+    assert len(rows) >= 60
+    misses = [r for r in rows if silent_miss(r) and r["group"] not in KNOWN_GAP]
+    assert not misses, misses
+    clean = [r for r in rows if r["group"] == "clean"]
+    assert all("truth" in r for r in clean)
+    assert sum(bool(r["warnings"]) for r in clean) <= 0.1 * len(clean)
+    # every group but the clean one reaches the analysis at least once (a study that refuses all is no study)
+    assert all(any("truth" in r for r in rows if r["group"] == g) for g in {r["group"] for r in rows})
