@@ -36,5 +36,9 @@ def test_no_confident_wrong_f_and_few_warnings_on_clean_records():
     clean = [r for r in rows if r["group"] == "clean"]
     assert all("truth" in r for r in clean)
     assert sum(bool(r["warnings"]) for r in clean) <= 0.1 * len(clean)
-    # every group but the clean one reaches the analysis at least once (a study that refuses all is no study)
-    assert all(any("truth" in r for r in rows if r["group"] == g) for g in {r["group"] for r in rows})
+    # a flipped sign is refused naming the gauge as reversed, or analysed (the hoop gauge, then left out); every
+    # other group reaches the analysis at least once (a study that refuses all is no study)
+    assert all("truth" in r or "reversed" in r["refused"] for r in rows if r["group"] == "sign_flipped")
+    groups = {r["group"] for r in rows} - {"sign_flipped"}
+    assert all(any("truth" in r for r in rows if r["group"] == g) for g in groups)
+    assert all(".h5: " in r["refused"] for r in rows if "refused" in r)  # every refusal names the file
