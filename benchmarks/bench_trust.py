@@ -165,7 +165,8 @@ def _row_line(row: dict) -> str:
     head = f"{row['group']:<26} {row['edit']:<38}"
     if "truth" not in row:
         why = row["refused"]
-        return head + " refused: " + (why[:110] if "; by hand: " not in why else "by hand too: " + why.split("; by hand: ")[1])
+        return head + " refused: " + (why[:110] if "; by hand: " not in why
+                                      else "by hand too: " + why.split("; by hand: ")[1])
     flag = "SILENT MISS" if silent_miss(row) else ""
     return (head + f" truth {row['truth']:.4f} f {row['q50']:.4f} [{row['q05']:.4f}, {row['q95']:.4f}] "
             f"z {(row['q50'] - row['truth']) / row['sd']:+.1f} warnings {len(row['warnings'])} {flag}")

@@ -49,9 +49,9 @@ def prepare(
     """Forces, stationary window (automatic unless ``window`` is given, in seconds) and likelihood data."""
     forces = compute_forces(record, dispersion=dispersion)
     findings = gauge_findings(forces, record.apparatus)
-    reversed_ = [g for g in findings if g.kind == "reversed"]
-    if reversed_:
-        raise SignalError(f"{record.path}: {reversed_[0].sentence}")
+    wired = [g for g in findings if g.kind in ("reversed", "swapped")]
+    if wired:  # a wiring fault: the record is to be mended at its source, not analysed
+        raise SignalError(f"{record.path}: {wired[0].sentence}")
     notes = tuple(g.sentence for g in findings)
     if window is None:
         win, notes = _automatic_window(record, forces, criterion, notes)

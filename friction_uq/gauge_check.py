@@ -3,6 +3,8 @@
 A gauge wired the other way round, a gain off by some percent or two channels swapped shows in
 the forces at the cell before anything else is fitted:
 
+* swapped: the output forces balance the input force only with the two output channels exchanged;
+
 * sign: over the loading (where the input force F_i exceeds half its peak) the transmitted forces
   F_io and F_eo push (compression, positive): a mean beyond 3 noise standard errors below zero is a
   reversed gauge (or an inverted bridge);
@@ -36,7 +38,7 @@ LOADED_FRACTION = 0.5
 @dataclass(frozen=True)
 class GaugeFinding:
     """One disagreement: the channel suspected (or "" when the balance cannot say which), the kind
-    ("reversed" or "balance") and a sentence with the evidence."""
+    ("reversed", "swapped" or "balance") and a sentence with the evidence."""
 
     channel: str
     kind: str
@@ -85,9 +87,24 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
     if out:
         return out
     s = force_balance(forces)
+    swapped = _swapped_balance(forces, apparatus, m)
+    if math.isfinite(s) and abs(s - 1.0) > BALANCE_TOL and abs(swapped - 1.0) <= BALANCE_TOL:
+        return [GaugeFinding("internal_output_bar", "swapped", (
+            f"the output forces sum to {s * 100:.0f} % of the input force over the loading, and to "
+            f"{swapped * 100:.0f} % with /signals/internal_output_bar and /signals/external_output_bar exchanged: the two output channels "
+            "look swapped"))]
     if math.isfinite(s) and abs(s - 1.0) > BALANCE_TOL:
         out.append(GaugeFinding("", "balance", (
             f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
             f"{BALANCE_TOL * 100:.0f} %): a gauge's gain, its strain_per_volt or a bar's modulus is off by about "
             f"{abs(s - 1.0) * 100:.0f} %")))
     return out
+
+
+def _swapped_balance(forces: Forces, apparatus: Apparatus, m: np.ndarray) -> float:
+    """The force balance with the two output gauges' strains exchanged (each read on the other bar)."""
+    io, eo = apparatus.internal_output_bar, apparatus.external_output_bar
+    k_io, k_eo = io.area * io.young_modulus, eo.area * eo.young_modulus
+    F_io = forces.F_eo[m] / k_eo * k_io
+    F_eo = forces.F_io[m] / k_io * k_eo
+    return float(np.mean(F_io + F_eo) / np.mean(forces.F_i[m]))

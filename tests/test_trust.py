@@ -81,3 +81,16 @@ def test_a_reversed_gauge_is_named_with_the_file(tmp_path, channel):
                  t0=float(sim.time[0]))
     with pytest.raises(SignalError, match=rf"^{path}: /signals/{channel}.*reversed"):
         prepare(read_record(path))
+
+
+def test_swapped_output_channels_are_named(tmp_path):
+    cfg = noisy_config(test_id="S", campaign="T")
+    sim = simulate(cfg, seed=4)
+    noisy = dict(sim.noisy)
+    io, eo = noisy["internal_output_bar"], noisy["external_output_bar"]
+    noisy["internal_output_bar"], noisy["external_output_bar"] = eo, io
+    path = str(tmp_path / "swap.h5")
+    write_record(path, test_id="S", campaign="T", sample_rate=cfg.sample_rate, strains=noisy, apparatus=cfg.apparatus,
+                 t0=float(sim.time[0]))
+    with pytest.raises(SignalError, match=rf"^{path}: the output forces sum to .* look swapped"):
+        prepare(read_record(path))
