@@ -20,6 +20,7 @@ import numpy as np
 from .models.parameters import effective_sample_size
 from .priors import Priors
 from .sampler import PosteriorSamples, sample_posterior
+from .stats import khat_threshold, psis
 from .window import StationaryData
 
 #: Probabilities of the quantiles reported.
@@ -73,14 +74,8 @@ def _f_under(label: str, samples: PosteriorSamples) -> FUnderPrior:
                        float(q[0]), float(q[1]), float(q[2]), _thin(f))
 
 
-def khat_threshold(n_draws: int) -> float:
-    """Largest reliable Pareto k for ``n_draws`` draws: min(1 - 1/log10(S), 0.7)."""
-    return min(1.0 - 1.0 / math.log10(n_draws), 0.7)
-
-
 def reweight(samples: PosteriorSamples, used: Priors, other: Priors, *, label: str, seed: int) -> FUnderPrior:
     """f under ``other`` from the draws of ``samples`` (sampled under ``used``) by PSIS."""
-    from .stats import psis
 
     theta = samples.array().reshape(-1, len(samples.names))
     with np.errstate(divide="ignore", invalid="ignore"):

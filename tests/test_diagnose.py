@@ -256,3 +256,9 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
     head = doc["f_headline"]
     assert head["model"] == dd["model"]
     assert f"Headline f = {head['q50']:.3f} [{head['q05']:.3f}, {head['q95']:.3f}]" in first, first[:300]
+    # the headline's posterior says how it was approximated and how importance sampling judges that; a k over the
+    # threshold is a warning, and the stationary f's misfit warning points at the headline f
+    assert head["posterior_method"] == dd["posterior_method"] and head["pareto_k"] == dd["pareto_k"]
+    assert 0.0 < dd["pareto_k_threshold"] <= 0.7 and dd["importance_ess"] >= 1.0
+    assert (dd["pareto_k"] > dd["pareto_k_threshold"]) == any("Pareto k" in w for w in doc["warnings"])
+    assert any("which is the f to quote" in w for w in doc["warnings"])

@@ -94,6 +94,10 @@ class Diagnosis:
     #: the hoop gauge's calibration factor as the whole-record check reads it (f and nu free only: the model
     #: the misfit decision judges), when ``run`` made the check
     check_hoop_gain: float | None = None
+    #: the final model's normal approximation against its exact posterior (Diagnoser.importance_check), when a
+    #: cause was named: Pareto k and the importance weights' effective sample size
+    pareto_k: float = float("nan")
+    importance_ess: float = float("nan")
 
     @property
     def cause(self) -> Variant | None:
@@ -181,10 +185,14 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         final = replace(final, predicted=dg.predictive(final))
     a = compare_whole_record(prep, base.predicted)
     b = compare_whole_record(prep, final.predicted)
+    k = ess = float("nan")
+    if causes:
+        say("importance check of the final model's normal approximation")
+        k, ess = dg.importance_check(final)
     return Diagnosis(baseline=base, rounds=tuple(rounds), misfits=tuple(misfits), causes=tuple(causes),
                      not_separable=not_sep, channels_not_separable=other_channels, separate_by=separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
-                     baseline_comparison=a, final_comparison=b)
+                     baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess)
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

@@ -30,6 +30,7 @@ from .._parallel import can_fork
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
+from ..stats import psis
 from .elpd import Elpd, ar1_block_loo, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
@@ -39,6 +40,8 @@ BLOCK = 10e-6
 #: Further starting values of nu for the baseline's mode search.
 NU_STARTS = (0.33, 0.45)
 SAMPLE_MODULUS_SD_LOG = 0.1
+#: Draws of the importance check of a named model's normal approximation (:meth:`Diagnoser.importance_check`).
+IMPORTANCE_DRAWS = 200
 
 
 @dataclass(frozen=True)
@@ -110,12 +113,7 @@ class Diagnoser:
     def fit(self, variants: tuple[Variant, ...], start: Mapping[str, float], label: str) -> ModelFit:
         model = self._model(variants)
         lik = WholeRecordLikelihood(self.prep, model)
-
-        def log_prior(values: Mapping[str, float]) -> float:
-            out = self.log_prior_f_nu(values) + float(self.modulus_prior.logpdf(values["sample_modulus"]))
-            for v in variants:
-                out += v.mechanism.log_prior(values)
-            return out
+        log_prior = self.log_prior(variants)
 
         st = {"f": start["f"], "nu": start["nu"], "sample_modulus": start.get("sample_modulus", self.E0)}
         for v in variants:
@@ -157,6 +155,40 @@ class Diagnoser:
         f_eff = np.array([self._f_effective(variants, {n: float(fit.draws[n][s]) for n in names}) for s in range(S)])
         return ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd, f_effective=f_eff,
                         predicted={c: v[None] for c, v in pred.items()}, lik=lik)
+
+    def log_prior(self, variants: tuple[Variant, ...]) -> Callable[[Mapping[str, float]], float]:
+        """The log prior density of a model's parameters (f, nu, the sample's modulus, the mechanisms')."""
+        def log_prior(values: Mapping[str, float]) -> float:
+            out = self.log_prior_f_nu(values) + float(self.modulus_prior.logpdf(values["sample_modulus"]))
+            for v in variants:
+                out += v.mechanism.log_prior(values)
+            return out
+
+        return log_prior
+
+    def importance_check(self, mf: ModelFit, *, n: int = IMPORTANCE_DRAWS) -> tuple[float, float]:
+        """Pareto k and effective sample size of the model's normal approximation against its exact posterior.
+
+        ``n`` draws from the normal the fit's draws come from (their mean and covariance in the unbounded
+        coordinates) are weighted by the exact posterior density (the whole-record likelihood, the priors, the
+        transforms' Jacobians) over the normal's (:func:`friction_uq.stats.psis`). k above
+        :func:`friction_uq.stats.khat_threshold` says the normal approximation misses the posterior's shape.
+        """
+        params = [mf.lik.model.parameters[name] for name in mf.fit.names]
+        z = np.stack([p.to_unbounded(mf.fit.draws[p.name]) for p in params], axis=1)
+        mean, cov = z.mean(axis=0), np.atleast_2d(np.cov(z, rowvar=False))
+        rng = np.random.default_rng(np.random.SeedSequence([self.seed, 11, zlib.crc32(mf.label.encode())]))
+        prop = stats.multivariate_normal(mean, cov, allow_singular=True)
+        zs = prop.rvs(size=n, random_state=rng).reshape(n, len(params))
+        log_prior = self.log_prior(mf.variants)
+        log_r = np.empty(n)
+        for i, zi in enumerate(zs):
+            vals = {p.name: float(p.from_unbounded(v)) for p, v in zip(params, zi)}
+            lp = log_prior(vals)
+            jac = sum(float(p.log_jacobian(v)) for p, v in zip(params, zi))
+            log_r[i] = (mf.lik.loglike(vals) + lp + jac if np.isfinite(lp) else -np.inf) - prop.logpdf(zi)
+        res = psis(log_r)
+        return float(res.pareto_k), float(res.ess)
 
     def _calibration(self, lik: WholeRecordLikelihood, fit: WholeRecordFit, unit: Mapping[str, np.ndarray],
                      modulus_scale: tuple[float, float]) -> dict[str, tuple[float, float, float]]:

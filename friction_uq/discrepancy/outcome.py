@@ -5,8 +5,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..models.parameters import effective_sample_size, summarize_draws
+from ..stats import khat_threshold
 from .diagnose import Diagnosis, ModelFit, Ranked
+from .extended import IMPORTANCE_DRAWS
 from .whole_record import CHANNEL_LABELS
+
+#: How the named model's posterior is approximated; ``pareto_k`` checks it against the exact posterior.
+POSTERIOR_METHOD = ("normal in the unbounded coordinates at the mode, with the robust (sandwich) covariance; "
+                    "pareto_k: 200 of its draws importance-weighted by the exact posterior (k above the threshold: "
+                    "its shape is not confirmed)")
 
 #: A hoop gain this far from 1 (its most probable value under its 5 % prior) is reported as a calibration finding
 #: (clean records: see benchmarks/bench_misfit.py for how often a right gauge reads this far off).
@@ -117,6 +124,10 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
         "rounds": [[_entry(r) for r in rnd] for rnd in dg.rounds[1:]],
         "model": dg.final.label,
         "f_extended": dg.final.f_summary(),
+        "posterior_method": POSTERIOR_METHOD,
+        "pareto_k": dg.pareto_k,
+        "pareto_k_threshold": khat_threshold(IMPORTANCE_DRAWS),
+        "importance_ess": dg.importance_ess,
         "f_baseline_stationary": f_without,
         "f_baseline_whole_record": dg.baseline.f_summary(),
         "nu_extended": summarize_draws(dg.final.fit.draws["nu"]),

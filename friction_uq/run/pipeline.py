@@ -217,7 +217,8 @@ def run_file(
         stages["whole_record"] = time.perf_counter() - t
         levels = likelihood.force if isinstance(likelihood.force, LevelForceTerm) else LevelForceTerm(prep.data)
         warns = run_warnings(ppc=ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=summary["f"], lab=lab,
-                             conv=conv, conflict=conflict, check=wrc, gauge_notes=prep.gauge_notes)
+                             conv=conv, conflict=conflict, check=wrc, gauge_notes=prep.gauge_notes,
+                             diagnosis=diag)
         t = time.perf_counter()
 
         dt.attrs.update({
@@ -278,6 +279,9 @@ def run_file(
             doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json())
             label, fx = outcome.headline(diag) or ("baseline (stationary phase, eq. 17 + hoop)", summary["f"].to_json())
             doc["f_headline"] = {"model": label} | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
+            if diag.causes:
+                doc["f_headline"] |= {"posterior_method": doc["discrepancy"]["posterior_method"],
+                                      "pareto_k": diag.pareto_k}
         js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
         write_together({names["netcdf"]: nc_bytes, names["pdf"]: pdf_bytes, names["json"]: js_bytes},
                        last=names["json"])

@@ -15,7 +15,8 @@ Checks and their limits (``docs/trust.md`` gives the calibration):
   and biases f inside it);
 * a gauge disagrees over the loading (:mod:`friction_uq.gauge_check`), or the output forces do not
   sum to the input force within :data:`EQUILIBRIUM_TOL` over the window (eq. 5);
-* convergence of the sampler; the prior-data check.
+* convergence of the sampler; the prior-data check;
+* with ``diagnose``: the named model's normal approximation against its exact posterior (Pareto k).
 """
 
 from __future__ import annotations
@@ -28,8 +29,10 @@ from ..analysis import Identification
 from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
+from ..discrepancy.extended import IMPORTANCE_DRAWS
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from ..prior_sensitivity import PriorDataConflict
+from ..stats import khat_threshold
 
 #: Least fraction of the window where the smoothed ratio lies in its 90 % noise band (about 0.9 on a
 #: record the model describes; its sd over records is ~0.06, so 0.5 is more than six sd below).
@@ -60,7 +63,19 @@ def stationarity_warning(ppc: RatioPPC, excess_spread: float, dof: int, f: Varia
             "steadier window (--window) or `friction-uq diagnose` is safer.")
 
 
-def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary) -> str | None:
+def _next_step(diagnosis, f: VariableSummary) -> str:
+    """What to do about a misfit: diagnose it, or (diagnosed) quote f under the causes it named."""
+    if diagnosis is None:
+        return "`friction-uq diagnose` names the cause and gives f under it."
+    if not diagnosis.causes:
+        return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
+    fx = diagnosis.final.f_summary()
+    names = ", ".join(v.label for v in diagnosis.causes)
+    return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "
+            "(the JSON's f_headline), which is the f to quote.")
+
+
+def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary, diagnosis=None) -> str | None:
     """The whole-record check misses a gauge that f depends on over the stationary phase."""
     if check is None:
         return None
@@ -73,15 +88,14 @@ def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary) -> str | 
         return (f"The simulated test misses the {CHANNEL_LABELS[w.channel]} gauge over the {w.phase} phase (statistic "
                 f"{w.statistic:.0f} > {d.threshold:g}): something in this test is not in the model (a plug friction, "
                 f"a clearance, a gauge's calibration, ...) and may bias {_f_text(f)} although the stationary phase "
-                "looks right; `friction-uq diagnose` names the cause and gives f under it.")
+                f"looks right; {_next_step(diagnosis, f)}")
     w = cells[0]
     how = (f"reads {abs(w.relative_level) * 100:.1f} % {'above' if w.relative_level > 0 else 'below'} the simulated "
            "test" if abs(w.level_z) >= w.shape_z else
            f"departs from the simulated test's shape (chi2/dof {w.chi2_dof:.1f})")
     return (f"The {CHANNEL_LABELS[w.channel]} gauge {how} over the stationary phase "
             f"(statistic {w.statistic:.0f} > {d.threshold:g}): the model behind eq. 17 misses something there, "
-            f"so {_f_text(f)} may be biased by about as much; `friction-uq diagnose` names the cause and "
-            "gives f under it.")
+            f"so {_f_text(f)} may be biased by about as much; {_next_step(diagnosis, f)}")
 
 
 def equilibrium_warning(lab: Identification, f: VariableSummary) -> str | None:
@@ -103,6 +117,16 @@ def gauge_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
             "ratio and is off by as much as their gains are; `friction-uq diagnose` fits a gauge's gain.")
 
 
+def approximation_warning(diagnosis) -> str | None:
+    """The named model's normal approximation is not confirmed by importance sampling (Pareto k too large)."""
+    if diagnosis is None or not diagnosis.causes or not diagnosis.pareto_k > khat_threshold(IMPORTANCE_DRAWS):
+        return None
+    fx = diagnosis.final.f_summary()
+    return (f"f under the named causes, {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}], is a normal approximation "
+            f"whose shape importance sampling does not confirm (Pareto k {diagnosis.pareto_k:.2f} > "
+            f"{khat_threshold(IMPORTANCE_DRAWS):.2f}): its interval is approximate, its ends least of all.")
+
+
 def convergence_warning(conv: Convergence) -> str | None:
     if conv.ok:
         return None
@@ -120,11 +144,12 @@ def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
 
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
                  conv: Convergence, conflict: PriorDataConflict | None,
-                 check: WholeRecordCheck | None, gauge_notes: Sequence[str] = ()) -> list[str]:
+                 check: WholeRecordCheck | None, gauge_notes: Sequence[str] = (),
+                 diagnosis=None) -> list[str]:
     """Every check's warning, in the order a reader should see them; empty when all pass."""
     found: Sequence[str | None] = (
         gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f),
-        stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f),
-        convergence_warning(conv), conflict_warning(conflict),
+        stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f, diagnosis),
+        convergence_warning(conv), conflict_warning(conflict), approximation_warning(diagnosis),
     )
     return [w for w in found if w]

@@ -4,6 +4,6 @@ One implementation, tested once, used by the whole-record fits, the leave-one-ou
 prior sensitivity, so that the sign convention of the underlying library is handled in one place.
 """
 
-from .psis import PSIS, psis, weighted_quantiles
+from .psis import PSIS, khat_threshold, psis, weighted_quantiles
 
-__all__ = ["PSIS", "psis", "weighted_quantiles"]
+__all__ = ["PSIS", "khat_threshold", "psis", "weighted_quantiles"]

@@ -61,6 +61,11 @@ def psis(log_ratios: np.ndarray) -> PSIS:
     return PSIS(out.reshape(lr.shape), k.reshape(lr.shape[:-1]))
 
 
+def khat_threshold(n_draws: int) -> float:
+    """Largest reliable Pareto k for ``n_draws`` draws: min(1 - 1/log10(S), 0.7) (Vehtari et al. 2024)."""
+    return min(1.0 - 1.0 / math.log10(n_draws), 0.7)
+
+
 def weighted_quantiles(values: np.ndarray, log_weights: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Quantiles ``q`` of weighted draws (weights exp(log_weights), normalised here)."""
     v = np.asarray(values, float)
