@@ -99,14 +99,30 @@ def _check_results(paths: Sequence[Path]) -> None:
             raise FrictionUQError(f"{path}: not a friction-uq result file (not JSON: {exc})") from None
 
 
+_TIME_UNITS = {"s": "1", "ms": "1e-3", "us": "1e-6", "\u00b5s": "1e-6"}  # exact decimal scales
+
+
 def _window(text: str) -> tuple[float, float]:
+    """T0:T1 in seconds, or with a unit (s, ms, us) on either bound or on the second for both: 400us:600us,
+    400:600us, 0.4ms:0.6ms, 4e-4:6e-4."""
+    import re
+    from decimal import Decimal, InvalidOperation
+
+    bad = (f"window {text!r} is not T0:T1 on the record's time base, in seconds or with a unit: "
+           "400us:600us, 0.4ms:0.6ms or 4e-4:6e-4")
+    parts = text.split(":")
+    m = [re.fullmatch(r"\s*([-+0-9.eE]+)\s*(s|ms|us|\u00b5s)?\s*", p) for p in parts]
+    if len(parts) != 2 or not all(m):
+        raise argparse.ArgumentTypeError(bad)
+    unit_b = m[1].group(2)
     try:
-        a, b = text.split(":")
-        return float(a), float(b)
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"window {text!r} is not T0:T1 in seconds on the record's time base, e.g. 3.2e-4:4.4e-4"
-        ) from None
+        vals = [float(Decimal(x.group(1)) * Decimal(_TIME_UNITS[x.group(2) or unit_b or "s"])) for x in m]
+    except (ValueError, InvalidOperation):
+        raise argparse.ArgumentTypeError(bad) from None
+    if not (m[0].group(2) or unit_b) and max(abs(v) for v in vals) > 1.0:
+        raise argparse.ArgumentTypeError(f"window {text!r}: {vals[0]:g} to {vals[1]:g} s is longer than any record; "
+                                         f"for microseconds write {parts[0]}us:{parts[1]}us")
+    return vals[0], vals[1]
 
 
 def _nu(text: str) -> float:
@@ -136,7 +152,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Deterministic identification of f from eq. 17 over the stationary window.")
     s.add_argument("file", type=Path, help="test record (test.h5)")
     s.add_argument("--nu", type=_nu, default=0.4, help="sample Poisson ratio (default 0.4)")
-    s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds on the record's time base (default: automatic); write --window=T0:T1 when T0 is negative")
+    s.add_argument("--window", type=_window, help="stationary window T0:T1 on the record's time base, in seconds or with a unit: 400us:600us, "
+                       "0.4ms:0.6ms, 4e-4:6e-4 (default: automatic); write --window=T0:T1 when T0 is negative")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of a table")
 
@@ -174,7 +191,8 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("--priors", type=Path, help="prior file (TOML; default: the package's <material>.toml)")
         s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
         s.add_argument("--seed", type=_seed, default=20161, help="random seed, 0 <= seed < 2**64 (default 20161)")
-        s.add_argument("--window", type=_window, help="stationary window T0:T1 in seconds on the record's time base (default: automatic); write --window=T0:T1 when T0 is negative")
+        s.add_argument("--window", type=_window, help="stationary window T0:T1 on the record's time base, in seconds or with a unit: 400us:600us, "
+                       "0.4ms:0.6ms, 4e-4:6e-4 (default: automatic); write --window=T0:T1 when T0 is negative")
         s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
         s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
         s.add_argument("--no-pdf", action="store_true", help="skip the PDF report")

@@ -1,5 +1,6 @@
 """The command line, end to end, as a user runs it."""
 
+import json
 import subprocess
 import sys
 
@@ -58,6 +59,19 @@ def test_bad_window_is_a_usage_error(record, capsys):
         main(["analyze", str(record), "--window", "abc"])
     assert e.value.code == 2
     assert "T0:T1" in capsys.readouterr().err
+
+
+def test_window_takes_seconds_or_a_unit(record, capsys):
+    """--window 400us:600us, 0.4ms:0.6ms and 4e-4:6e-4 are the same window; bare numbers too large for seconds
+    are refused with the microsecond spelling."""
+    outs = []
+    for w in ("400us:600us", "400:600us", "0.4ms:0.6ms", "4e-4:6e-4"):
+        assert main(["analyze", str(record), "--window", w, "--json"]) == 0
+        outs.append(json.loads(capsys.readouterr().out)["window"])
+    assert all(o == outs[0] for o in outs)
+    with pytest.raises(SystemExit) as e:
+        main(["analyze", str(record), "--window", "400:600"])
+    assert e.value.code == 2 and "write 400us:600us" in capsys.readouterr().err
 
 
 def test_console_script_runs():
