@@ -2,7 +2,8 @@
 
 :func:`check_whole_record` is what ``friction-uq run`` runs beside the sampling of the
 stationary-phase posterior (it needs none of its draws): the simulator driven by the measured
-incident wave is fitted to every gauge (:mod:`.fit`, started from the lab's eq. 17 estimate and
+incident wave (its bars dispersive when the analysis corrects for dispersion, ``--dispersion``) is
+fitted to every gauge (:mod:`.fit`, started from the lab's eq. 17 estimate and
 from nu either side of the prior), the posterior draws are simulated
 (:mod:`.whole_record`) and the misfit decision is taken (:mod:`.misfit`).
 """
@@ -51,7 +52,11 @@ def check_whole_record(prep: Prepared, log_prior: Callable[[Mapping[str, float]]
     """
     t0 = time.perf_counter()
     rec = prep.record
-    model = SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), hoop=hoop and rec.has_hoop)
+    # an analysis with the dispersion correction is checked against bars that disperse, as it reads them
+    disp = bool(getattr(prep.forces, "dispersion", False))
+    model = SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), hoop=hoop and rec.has_hoop,
+                           dispersion=disp,
+                           dispersive_loading=measured_loading(rec, prep.forces, dispersion=True) if disp else None)
     lik = WholeRecordLikelihood(prep, model)
     rng = np.random.default_rng(np.random.SeedSequence([seed, 8]))
     fit = fit_whole_record(lik, log_prior, {"f": start["f"], "nu": start["nu"]}, n_draws=n_draws, rng=rng,
