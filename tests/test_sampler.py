@@ -189,7 +189,13 @@ def test_progress_callback_and_stderr_line(paper_data, capsys):
     assert [p.steps for p in seen] == [100, 200, 300]
     stderr_progress(seen[-1])
     err = capsys.readouterr().err
-    assert err.startswith("sampling: step 300/300, tau ") and "acceptance" in err
+    # the share of what the stopping rule needs (capped by max_steps), not "step 300/20000"
+    assert err.startswith("sampling: ") and "of the steps the stopping rule needs (300 of ~" in err
+    assert "acceptance" in err and not seen[-1].done
+    done = Progress(600, 20000, 10.0, 0.01, 60.0, 0.3, 1.0, 50.0, 0.05)
+    assert done.done and done.line().startswith("sampling: done at step 600 (tau 10.0, steady within 1.0 %)")
+    early = Progress(100, 20000, 10.0, float("inf"), 10.0, 0.3, 1.0, 50.0, 0.05)
+    assert "20 % of the steps the stopping rule needs (100 of ~500, tau 10.0 not yet measured twice)" in early.line()
 
 
 def test_hoop_without_hoop_gain_prior_is_refused(paper_data):

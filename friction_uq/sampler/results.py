@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass, field
 
@@ -26,14 +27,23 @@ class Progress:
     tau_factor: float  # the stopping rule's steps/tau and relative tau change (SamplerSettings)
     tau_rtol: float
 
+    @property
+    def done(self) -> bool:
+        """The stopping rule is met: steps > tau_factor tau and tau steady within tau_rtol."""
+        return self.steps_over_tau > self.tau_factor and self.tau_change < self.tau_rtol
+
     def line(self) -> str:
-        """A short line for a terminal."""
-        return (
-            f"sampling: step {self.steps}/{self.max_steps}, tau {self.tau_max:.1f} "
-            f"(steps/tau {self.steps_over_tau:.0f}, needs {self.tau_factor:g}; change {100 * self.tau_change:.1f} %, "
-            f"needs < {100 * self.tau_rtol:g} %), "
-            f"acceptance {self.acceptance:.2f}, {self.seconds:.1f} s"
-        )
+        """A short line for a terminal: how far along what the stopping rule needs (not the step cap)."""
+        if self.done:
+            return (f"sampling: done at step {self.steps} (tau {self.tau_max:.1f}, steady within "
+                    f"{100 * self.tau_change:.1f} %), acceptance {self.acceptance:.2f}, {self.seconds:.1f} s")
+        need = min(self.max_steps, int(math.ceil(self.tau_factor * self.tau_max))) if math.isfinite(self.tau_max) \
+            else self.max_steps
+        share = min(1.0, self.steps / max(need, 1))
+        steady = ("steady" if self.tau_change < self.tau_rtol else f"still moving {100 * self.tau_change:.0f} %"
+                  if math.isfinite(self.tau_change) else "not yet measured twice")
+        return (f"sampling: {100 * share:.0f} % of the steps the stopping rule needs ({self.steps} of ~{need}, "
+                f"tau {self.tau_max:.1f} {steady}), acceptance {self.acceptance:.2f}, {self.seconds:.1f} s")
 
 
 def stderr_progress(info: Progress) -> None:
