@@ -149,7 +149,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     say = progress or (lambda msg: None)
     dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales,
                    nominal=start)
-    say("baseline")
+    say(f"baseline (up to {max_causes} rounds of about ten extended models follow)")
     base = dg.fit((), start, "baseline")
     reference = base
     causes: list[Variant] = []
@@ -158,6 +158,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     not_sep: tuple[str, ...] = ()
     other_channels: tuple[str, ...] = ()
     separate_by = None
+    fit_seconds, fitted = 0.0, 0  # process-seconds per extended model, for the progress lines' estimates
     for k in range(max_causes):
         say("misfit of the reference model")
         reference = replace(reference, predicted=dg.predictive(reference))
@@ -167,8 +168,14 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         used = tuple(v.mechanism.name for v in causes)
         jobs = [(tuple(causes) + (cand,), dict(reference.fit.mode), "+".join([v.label for v in causes] + [cand.label]))
                 for cand in candidates(exclude=used)]
-        say(f"{len(jobs)} extended models ({', '.join(j[2] for j in jobs)}) on {workers} process(es)")
+        per_model = fit_seconds / fitted if fitted else None
+        eta = f", about {per_model * len(jobs) / max(1, min(workers, len(jobs))):.0f} s" if per_model else ""
+        say(f"round {k + 1}: {len(jobs)} extended models ({', '.join(j[2] for j in jobs)}) on {workers} "
+            f"process(es){eta}; {time.perf_counter() - t0:.0f} s so far")
+        t_round = time.perf_counter()
         fits = dg.fit_many(jobs, workers=workers)
+        fit_seconds += (time.perf_counter() - t_round) * max(1, min(workers, len(jobs)))
+        fitted += len(jobs)
         ranked = rank(reference, fits, misfit=misfits[-1].detected)
         rounds.append(ranked)
         decisive = [r for r in ranked if r.decisive]
