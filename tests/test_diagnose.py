@@ -255,7 +255,8 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
     first = " ".join(PdfReader(tmp_path / "B_B-02.pdf").pages[0].extract_text().split())
     head = doc["f_headline"]
     assert head["model"] == dd["model"]
-    assert f"Headline f = {head['q50']:.3f} [{head['q05']:.3f}, {head['q95']:.3f}]" in first, first[:300]
+    assert first.startswith(f"Headline f = {head['q50']:.4f} [{head['q05']:.4f}, {head['q95']:.4f}] (90 %), from the "
+                            "model with the causes"), first[:300]
     # the headline's posterior says how it was approximated and how importance sampling judges that; a k over the
     # threshold is a warning, and the stationary f's misfit warning points at the headline f
     assert head["posterior_method"] == dd["posterior_method"] and head["pareto_k"] == dd["pareto_k"]

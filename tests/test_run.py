@@ -81,8 +81,8 @@ def test_pdf_is_a_multipage_report(paper_run):
     data = (out / "paper_P-01.pdf").read_bytes()
     assert data[:4] == b"%PDF"
     pages = data.count(b"/Type /Page") - data.count(b"/Type /Pages")
-    # summary + pages 1-7 + page 8 (hoop gauge vs model: the hoop term was used) + 9-10 (the whole test
-    # simulated against the four gauges, two per page)
+    # summary (page 1) + pages 2-8 + page 9 (hoop gauge vs model: the hoop term was used) + 10-11 (the whole
+    # test simulated against the four gauges, two per page)
     assert pages == 11
 
 
@@ -94,12 +94,17 @@ def test_pdf_pages_in_order_though_made_on_two_cores(paper_run):
     _, out, _ = paper_run
     reader = PdfReader(out / "paper_P-01.pdf")
     texts = [page.extract_text() for page in reader.pages]
-    titles = ["friction-uq report", "1. Record", "2. Waves", "3. Stationary window", "4. Joint posterior",
-              "5. How the uncertainty of nu", "6. Convergence", "7. Posterior predictive", "8. Tube hoop gauge",
-              "the whole test simulated with the posterior", "the whole test simulated with the posterior"]
+    titles = ["friction-uq report", "2. Record", "3. Waves", "4. Stationary window", "5. Joint posterior",
+              "6. How the uncertainty of nu", "7. Convergence", "8. Posterior predictive", "9. Tube hoop gauge",
+              "10. paper P-01: the whole test simulated with the posterior",
+              "11. paper P-01: the whole test simulated with the posterior"]
     assert len(texts) == len(titles)
     for k, (text, title) in enumerate(zip(texts, titles)):
-        assert title in text, (k, title)
+        assert title in " ".join(text.split()), (k, title)  # each page's title starts with its PDF page number
+    pages = texts[0][texts[0].index("Pages"):]
+    for n, what in ((2, "raw gauges"), (5, "posterior vs prior"), (9, "hoop gauge vs model"),
+                    (10, "whole test vs gauges")):
+        assert f"{n} {what}" in " ".join(pages.split()), (n, what)  # the summary's list uses the same numbers
     assert "(1/2)" in texts[9] and "(2/2)" in texts[10]
     assert reader.metadata["/Title"] == "friction-uq paper P-01"
 

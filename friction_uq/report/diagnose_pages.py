@@ -1,7 +1,8 @@
 """Pages of ``diagnose``: the mechanisms ranked by dELPD, and the named mechanism's fit.
 
-Page A: dELPD over the baseline with +-2 SE bars for every mechanism of the catalogue (the decisive
-threshold drawn), the rule, the causes named, and f under the baseline and the extended model.
+Page A: every round's dELPD with +-2 SE bars for every mechanism of the catalogue against that
+round's reference model (the decisive threshold drawn, the named cause in bold, the colours in the
+legend), the rule, the causes named, and f under the baseline and the extended model.
 Page B: per gauge, the residual of the baseline and of the extended model over the whole record
 (standardised by the noise), with the named mechanism's parameters.
 """
@@ -23,25 +24,48 @@ from .style import figure
 WRAP = 70
 
 
-def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, test: str) -> Figure:
-    fig, axes = figure(f"{test}: what the baseline misses, mechanism by mechanism", nrows=1, ncols=2,
-                       gridspec_kw={"width_ratios": [3, 2]})
-    ax = axes[0]
-    ranked = list(dg.ranking)
-    y = np.arange(len(ranked))[::-1]
-    d = np.array([r.delpd for r in ranked])
-    se = np.array([r.se for r in ranked])
-    colours = ["tab:red" if r.decisive else "0.5" for r in ranked]
+def _ranking_axes(ax, dg: Diagnosis) -> None:
+    """Every round's candidates, each against its round's reference model (the baseline, then the baseline
+    with the causes named before), the named cause's label in bold; what the colours mean in the legend."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    rows, labels, named, seps = [], [], [], []
+    for k, rnd in enumerate(dg.rounds):
+        cause = dg.causes[k] if k < len(dg.causes) else None
+        for r in rnd:
+            rows.append(r)
+            labels.append(f"{k + 1}: {r.fit.variants[-1].label}")
+            named.append(cause is not None and r.fit.variants[-1] is cause)
+        seps.append(len(rows))
+    y = np.arange(len(rows))[::-1]
+    d = np.array([r.delpd for r in rows])
+    se = np.array([r.se for r in rows])
     shown = np.sign(d) * np.log10(1.0 + np.abs(d))
     lo = np.sign(d - 2 * se) * np.log10(1.0 + np.abs(d - 2 * se))
     hi = np.sign(d + 2 * se) * np.log10(1.0 + np.abs(d + 2 * se))
-    ax.barh(y, shown, color=colours)
+    ax.barh(y, shown, color=["tab:red" if r.decisive else "0.6" for r in rows])
     ax.errorbar(shown, y, xerr=[shown - lo, hi - shown], fmt="none", ecolor="k", lw=0.8)
-    ax.axvline(np.log10(1.0 + DECISIVE_ELPD), color="tab:blue", ls="--", lw=0.8, label="dELPD = 4")
-    ax.set_yticks(y, [r.fit.label for r in ranked], fontsize=8)
-    ax.set_xlabel("dELPD over the baseline, sign(d) log10(1 + |d|), bars +- 2 SE")
-    ax.legend(loc="lower right")
-    ax.set_title("expected log predictive density (block LOO) over the baseline")
+    ax.axvline(np.log10(1.0 + DECISIVE_ELPD), color="tab:blue", ls="--", lw=0.8)
+    ax.axvline(0.0, color="k", lw=0.6)
+    for s in seps[:-1]:
+        ax.axhline(len(rows) - s - 0.5, color="0.3", lw=0.6)
+    ax.set_yticks(y, labels, fontsize=7 if len(rows) > 16 else 8)
+    for t, bold in zip(ax.get_yticklabels(), named):
+        t.set_fontweight("bold" if bold else "normal")
+    ax.set_xlabel("dELPD over the round's reference model, sign(d) log10(1 + |d|), bars +- 2 SE;\n"
+                  "left of 0: predicts the record worse than the reference (its parameters cost more "
+                  "than they explain)", fontsize=8)
+    ax.legend([Patch(color="tab:red"), Patch(color="0.6"), Line2D([], [], color="tab:blue", ls="--")],
+              ["decisive (bold: the cause named in that round)", "not decisive", "dELPD = 4"],
+              loc="lower right", fontsize=7)
+    ax.set_title("rounds 1, 2, ...: each mechanism added to the model of the round before", fontsize=9)
+
+
+def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, test: str) -> Figure:
+    fig, axes = figure(f"{test}: what the baseline misses, mechanism by mechanism", nrows=1, ncols=2,
+                       gridspec_kw={"width_ratios": [3, 2]})
+    _ranking_axes(axes[0], dg)
     ax2 = axes[1]
     ax2.axis("off")
     fx = dg.final.f_summary()

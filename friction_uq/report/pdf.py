@@ -17,6 +17,7 @@ from .._atomic import write_bytes
 from ..analysis import Identification, Prepared
 from ..discrepancy.check import WholeRecordCheck
 from ..discrepancy.outcome import headline as outcome_headline
+from .quote import quote_line
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
@@ -66,15 +67,12 @@ def page_summary(r: ReportInputs) -> Figure:
     s = r.summary
     f, nu = s["f"], s["nu"]
     share = r.nu_share
-    headline = []
     named = None if r.diagnosis is None else outcome_headline(r.diagnosis)  # the JSON's f_headline
-    if named is not None:
-        label, fx = named
-        headline = [f"Headline f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] under the model with the named "
-                    f"causes ({label}, page {whole_record_page(r) + 2}); the stationary analysis without them follows."]
-    lines = [f"WARNING: {w}" for w in r.warnings] + headline + [
-        f"Friction coefficient f = {f.q50:.3f}, 90 % credible interval [{f.q05:.3f}, {f.q95:.3f}] "
-        f"(posterior mean {f.mean:.3f}, sd {f.sd:.3f}).",
+    stationary = ("The stationary analysis without the named causes (page " f"{whole_record_page(r) + 2} for them): "
+                  if named is not None else "The stationary analysis: ")
+    lines = [f"WARNING: {w}" for w in r.warnings] + [
+        stationary + f"f = {f.q50:.4f}, 90 % credible interval [{f.q05:.4f}, {f.q95:.4f}] "
+        f"(posterior mean {f.mean:.4f}, sd {f.sd:.4f}).",
         f"Poisson ratio nu = {nu.q50:.3f} [{nu.q05:.3f}, {nu.q95:.3f}]; the forces fix only "
         f"kappa = f nu/(1-nu) = {s['kappa'].q50:.4f} [{s['kappa'].q05:.4f}, {s['kappa'].q95:.4f}] (eq. 17).",
         f"{100 * share:.0f} % of the variance of f comes from the uncertainty of nu (law of total variance).",
@@ -87,7 +85,7 @@ def page_summary(r: ReportInputs) -> Figure:
         f"{'OK' if r.convergence.ok else 'NOT REACHED'} (R-hat max {r.convergence.r_hat_max:.3f}, "
         f"ESS min {min(r.convergence.ess_bulk_min, r.convergence.ess_tail_min):.0f}).",
         f"Posterior predictive check: the observed ratio lies in the 90 % band {100 * r.ppc.coverage:.0f} % of "
-        "the window" + (" - the constant-ratio model misses something here (page 7)." if r.ppc.coverage < 0.7 else "."),
+        "the window" + (" - the constant-ratio model misses something here (page 8)." if r.ppc.coverage < 0.7 else "."),
     ]
     if r.conflict is not None:
         lines.append(r.conflict.sentence())
@@ -99,10 +97,14 @@ def page_summary(r: ReportInputs) -> Figure:
         lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, s["f"].to_json()))
     # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
     # together where they would run into the table below them
-    texts = ["\n".join(textwrap.wrap(line, 110)) for line in lines]
+    first = "\n".join(textwrap.wrap(quote_line(f.to_json(), r.diagnosis, len(r.warnings)), 80))
+    ax.text(0.0, 1.0, first, fontsize=13, va="top", transform=ax.transAxes, weight="bold",
+            color="firebrick" if r.warnings else "black")
+    top = 0.97 - 0.06 * (first.count("\n") + 1)
+    texts = ["\n".join(textwrap.wrap(line, 135)) for line in lines]
     need = sum(0.034 * (t.count("\n") + 1) + 0.016 for t in texts)
-    k = min(1.0, (0.97 - SUMMARY_TABLE_TOP) / need)
-    y = 0.97
+    k = min(1.0, (top - SUMMARY_TABLE_TOP) / need)
+    y = top
     for line, text in zip(lines, texts):
         color = "firebrick" if line.startswith("WARNING") else "black"
         ax.text(0.0, y, text, fontsize=10 * k, va="top", transform=ax.transAxes, color=color)
@@ -121,9 +123,9 @@ def page_summary(r: ReportInputs) -> Figure:
     prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
             f"seed {r.samples.seed}, friction-uq {r.version}")
     ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
-    ax.text(0.84, 0.97, "Pages\n 1 raw gauges\n 2 waves, forces, equilibrium\n 3 window and noise\n"
-            " 4 posterior vs prior\n 5 nu -> f\n 6 convergence\n 7 predictive check"
-            + ("\n 8 hoop gauge vs model" if r.samples.hoop else "")
+    ax.text(0.84, 0.86, "Pages\n 2 raw gauges\n 3 waves, forces, equilibrium\n 4 window and noise\n"
+            " 5 posterior vs prior\n 6 nu -> f\n 7 convergence\n 8 predictive check"
+            + ("\n 9 hoop gauge vs model" if r.samples.hoop else "")
             + (f"\n{whole_record_page(r):2d} whole test vs gauges" if r.whole_record is not None else "")
             + (f"\n{whole_record_page(r) + 2:2d} mechanisms ranked\n{whole_record_page(r) + 3:2d} extended fit"
                if r.diagnosis is not None else ""),
@@ -149,9 +151,10 @@ def _render(builders: list[Callable[[], Figure]]) -> bytes:
 RECORD_PAGES = 3
 
 
-def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None) -> bytes:
-    """The pages that need no posterior draw: the record's (pages 1-3) and the whole-record check's. A run
-    renders them on its other core, after the check, while it samples (:func:`render_report` merges them)."""
+def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None, *, hoop: bool = True) -> bytes:
+    """The pages that need no posterior draw: the record's (pages 2-4) and the whole-record check's (from page
+    10, or 9 without the hoop page: ``hoop``). A run renders them on its other core, after the check, while it
+    samples (:func:`render_report` merges them)."""
     from .whole_record_pages import pages_whole_record
 
     p = prepared
@@ -163,7 +166,7 @@ def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None
     assert len(builders) == RECORD_PAGES
     if whole_record is not None:
         builders += [lambda fig=fig: fig for fig in pages_whole_record(
-            whole_record, test=f"{p.record.campaign} {p.record.test_id}")]
+            whole_record, test=f"{p.record.campaign} {p.record.test_id}", first_page=10 if hoop else 9)]
     return _render(builders)
 
 
@@ -183,7 +186,7 @@ def render_posterior_part(r: ReportInputs) -> bytes:
 
 
 def render_report(r: ReportInputs, record_part: bytes | None = None, posterior_part: bytes | None = None) -> bytes:
-    """The PDF, in memory: summary page, pages 1-7, page 8 when the hoop term was used, the
+    """The PDF, in memory: summary page (1), pages 2-8, page 9 when the hoop term was used, the
     whole-record pages and, with a diagnosis, its two pages. ``record_part`` and ``posterior_part``: the
     pages of :func:`render_record_part` and :func:`render_posterior_part` for ``r``, rendered already
     (None: rendered here); the summary and the diagnosis pages are rendered here, and all are merged."""
@@ -191,7 +194,7 @@ def render_report(r: ReportInputs, record_part: bytes | None = None, posterior_p
 
     p = r.prepared
     if record_part is None:
-        record_part = render_record_part(p, r.whole_record)
+        record_part = render_record_part(p, r.whole_record, hoop=r.samples.hoop)
     if posterior_part is None:
         posterior_part = render_posterior_part(r)
     own = [lambda: page_summary(r)] + [lambda fig=fig: fig for fig in diagnosis_pages(r)]
@@ -209,8 +212,9 @@ def render_report(r: ReportInputs, record_part: bytes | None = None, posterior_p
 
 
 def whole_record_page(r: ReportInputs) -> int:
-    """Number of the first whole-record page (after page 7, or 8 with the hoop page)."""
-    return 9 if r.samples.hoop else 8
+    """PDF page number of the first whole-record page (after page 8, or 9 with the hoop page; the summary is
+    page 1)."""
+    return 10 if r.samples.hoop else 9
 
 
 def diagnosis_pages(r: ReportInputs) -> list[Figure]:
@@ -222,8 +226,9 @@ def diagnosis_pages(r: ReportInputs) -> list[Figure]:
 
     test = f"{r.prepared.record.campaign} {r.prepared.record.test_id}"
     fw = r.summary["f"].to_json()
-    return [page_ranking(r.diagnosis, f_without=fw, sentence=sentence(r.diagnosis, fw), test=test),
-            page_extended_fit(r.diagnosis, test=test)]
+    n = whole_record_page(r) + 2
+    return [page_ranking(r.diagnosis, f_without=fw, sentence=sentence(r.diagnosis, fw), test=f"{n}. {test}"),
+            page_extended_fit(r.diagnosis, test=f"{n + 1}. {test}")]
 
 
 def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:

@@ -29,7 +29,7 @@ def _prior_lines(description: str) -> list[str]:
     return out
 
 
-def page_corner(samples: PosteriorSamples, dt: xr.DataTree, *, number: int = 4) -> Figure:
+def page_corner(samples: PosteriorSamples, dt: xr.DataTree, *, number: int = 5) -> Figure:
     """Corner plot of the sampled parameters, prior densities on the diagonal."""
     import corner
     import matplotlib.pyplot as plt
@@ -56,7 +56,11 @@ def page_corner(samples: PosteriorSamples, dt: xr.DataTree, *, number: int = 4) 
                     h, edges = np.histogram(xs, bins=30, range=(lo, hi), density=True)
                     ax.stairs(h * frac, edges, color="C1", lw=1.2, label="prior")
             if i == 0:
-                ax.legend(["posterior", "prior"], fontsize=8, loc="upper right")
+                from matplotlib.lines import Line2D
+
+                handles = [Line2D([], [], color="k", lw=1.2), Line2D([], [], color="k", ls="--", lw=1.0),
+                           Line2D([], [], color="C1", lw=1.2)]
+                ax.legend(handles, ["posterior", "posterior 5, 50, 95 %", "prior"], fontsize=8, loc="upper right")
         fig.suptitle(f"{number}. Joint posterior of f and nu (90 % and 50 % regions) against the priors", y=0.995)
         fig.text(0.52, 0.80, "priors (orange):\n" + "\n".join(_prior_lines(samples.prior_description)),
                  fontsize=8, va="top")
@@ -65,7 +69,7 @@ def page_corner(samples: PosteriorSamples, dt: xr.DataTree, *, number: int = 4) 
 
 def page_propagation(
     samples: PosteriorSamples, band: FNuBand, sensitivity: dict[str, FUnderPrior], share: float,
-    *, nu_assumed: float = 0.4, number: int = 5,
+    *, nu_assumed: float = 0.4, number: int = 6,
 ) -> Figure:
     """nu -> f: f against nu with its band, f under three nu priors, the variance share due to nu."""
     fig, axes = figure(f"{number}. How the uncertainty of nu becomes the uncertainty of f", nrows=1, ncols=2)
@@ -79,8 +83,9 @@ def page_propagation(
     ax.set_xlabel("Poisson ratio of the sample nu (-)")
     ax.set_ylabel("friction coefficient f (-)")
     ax.set_title(f"share of Var(f) due to nu (law of total variance): {100 * share:.0f} %", loc="left")
-    ax.legend(loc="upper right")
+    ax.legend(loc="lower left")
     ax.set_ylim(0, max(float(np.max(band.q95[band.nu >= 0.2])) * 1.1, float(np.quantile(f, 0.999)) * 1.1))
+    _band_zoom(ax, band, nu, f, step)
     ax = axes[1]
     for k, (label, s) in enumerate(sensitivity.items()):
         hist, edges = np.histogram(s.draws, bins=60, density=True)
@@ -90,11 +95,27 @@ def page_propagation(
     ax.set_xlabel("friction coefficient f (-)")
     ax.set_ylabel("posterior density (1/-)")
     ax.set_title("f under three priors for nu: median [90 % interval]", loc="left")
+    ax.set_ylim(0, ax.get_ylim()[1] * 1.45)  # room for the legend above the highest peak
     ax.legend(loc="upper right", fontsize=8)
     return fig
 
 
-def page_convergence(samples: PosteriorSamples, conv: Convergence, *, number: int = 6) -> Figure:
+def _band_zoom(ax, band: FNuBand, nu: np.ndarray, f: np.ndarray, step: int) -> None:
+    """An inset over the posterior's nu range, where the 90 % band of f given nu (the forces' share of f's
+    uncertainty, a few % wide) can be seen beside the draws."""
+    lo, hi = np.quantile(nu, [0.005, 0.995])
+    keep = (band.nu >= lo - 0.01) & (band.nu <= hi + 0.01)
+    if keep.sum() < 2:
+        return
+    ins = ax.inset_axes([0.55, 0.55, 0.42, 0.32])
+    ins.fill_between(band.nu[keep], band.q05[keep], band.q95[keep], color="C0", alpha=0.35)
+    ins.plot(band.nu[keep], band.q50[keep], color="C0", lw=1)
+    ins.plot(nu[::step], f[::step], ".", ms=1, color="k", alpha=0.2)
+    ins.set_title("zoom: the band, where the draws are", fontsize=7)
+    ins.tick_params(labelsize=6)
+
+
+def page_convergence(samples: PosteriorSamples, conv: Convergence, *, number: int = 7) -> Figure:
     """Traces per chain (independent ensembles), R-hat, ESS, autocorrelation times."""
     names = list(samples.names)
     fig, axes = figure(f"{number}. Convergence: {'OK' if conv.ok else 'NOT CONVERGED - read with care'}",
@@ -120,7 +141,7 @@ def page_convergence(samples: PosteriorSamples, conv: Convergence, *, number: in
     return fig
 
 
-def page_ppc(ppc: RatioPPC, *, number: int = 7) -> Figure:
+def page_ppc(ppc: RatioPPC, *, number: int = 8) -> Figure:
     """Posterior predictive check of F_eo/F_io over the window."""
     fig, ax = figure(f"{number}. Posterior predictive check: F_eo / F_io over the stationary window")
     t = ppc.time * US
@@ -138,7 +159,7 @@ def page_ppc(ppc: RatioPPC, *, number: int = 7) -> Figure:
     return fig
 
 
-def page_hoop(samples: PosteriorSamples, data, forces, *, number: int = 8, n_draws: int = 200, seed: int = 0,
+def page_hoop(samples: PosteriorSamples, data, forces, *, number: int = 9, n_draws: int = 200, seed: int = 0,
               likelihood=None) -> Figure:
     """The hoop gauge against the model: whole record, window prediction band, residual shape.
 

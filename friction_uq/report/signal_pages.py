@@ -24,7 +24,7 @@ def page_raw(record: Record) -> Figure:
     """Page: the four gauges as recorded (converted to strain, compression positive)."""
     names = list(record.channels)
     fig, axes = figure(
-        f"1. Record {record.campaign} {record.test_id}: gauges as recorded "
+        f"2. Record {record.campaign} {record.test_id}: gauges as recorded "
         f"({record.sample_rate / 1e6:g} MHz, {record.duration * US:.0f} us)",
         nrows=len(names), ncols=1, sharex=True,
     )
@@ -44,7 +44,7 @@ def page_raw(record: Record) -> Figure:
 def page_forces(record: Record, forces: Forces, window: Window) -> Figure:
     """Page: waves transported to the cell, forces (eq. 2-4), equilibrium (eq. 5) and velocities."""
     fig, axes = figure(
-        "2. Waves transported to the cell, forces and equilibrium" + (" (dispersion corrected)" if forces.dispersion else ""),
+        "3. Waves transported to the cell, forces and equilibrium" + (" (dispersion corrected)" if forces.dispersion else ""),
         nrows=2, ncols=2, sharex=True,
     )
     t = forces.time * US
@@ -102,7 +102,7 @@ def page_window(record: Record, forces: Forces, window: Window) -> Figure:
         gs = fig.add_gridspec(2, 4, height_ratios=[1.3, 1], hspace=0.45, wspace=0.35)
         ax = fig.add_subplot(gs[0, :])
     fig.suptitle(
-        f"3. Stationary window {window.t0 * US:.1f} - {window.t1 * US:.1f} us "
+        f"4. Stationary window {window.t0 * US:.1f} - {window.t1 * US:.1f} us "
         f"({'automatic' if window.automatic else 'given by hand'}) and noise segments"
     )
     t = forces.time * US

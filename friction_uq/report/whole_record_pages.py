@@ -46,13 +46,15 @@ def _channel(ax_sig, ax_res, chk: WholeRecordCheck, ch: str) -> None:
     ax_res.set_ylim(-lim, lim)
 
 
-def pages_whole_record(chk: WholeRecordCheck, *, test: str) -> list[Figure]:
-    """Two pages, two channels each (reflected and internal; external and hoop)."""
+def pages_whole_record(chk: WholeRecordCheck, *, test: str, first_page: int | None = None) -> list[Figure]:
+    """Two pages, two channels each (reflected and internal; external and hoop); ``first_page``: the PDF page
+    number of the first, written before the titles."""
     chans = [c for c in CHANNEL_LABELS if c in chk.comparison.spans]
     out = []
     for k in range(0, len(chans), 2):
         pair = chans[k:k + 2]
-        fig, axes = figure(f"{test}: the whole test simulated with the posterior, against the gauges "
+        number = "" if first_page is None else f"{first_page + k // 2}. "
+        fig, axes = figure(f"{number}{test}: the whole test simulated with the posterior, against the gauges "
                            f"({k // 2 + 1}/{(len(chans) + 1) // 2})", nrows=2, ncols=2,
                            gridspec_kw={"height_ratios": [2, 1]})
         for j in range(2):

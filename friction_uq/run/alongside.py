@@ -37,7 +37,7 @@ def alongside(prep: Prepared, priors, start: dict[str, float], *, hoop: bool, se
     if pages:
         from ..report.pdf import render_record_part
 
-        part = render_record_part(prep, wrc)
+        part = render_record_part(prep, wrc, hoop=hoop)
     return wrc, part
 
 

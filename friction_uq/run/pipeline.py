@@ -289,11 +289,14 @@ def run_file(
         stages["outputs"] += time.perf_counter() - t
     outputs = {k: p for k, p in names.items() if k != "pdf" or pdf_bytes is not None}
     if table:
+        from ..report.quote import quote_line
+
+        print(quote_line(summary["f"].to_json(), diag, len(warns)))
         for w in warns:
             print(f"WARNING: {w}")
         lines = []
         if wrc is not None:
-            lines.append(wrc.decision.sentence(page=(9 if use_hoop else 8) if pdf_bytes is not None else None))
+            lines.append(wrc.decision.sentence(page=(10 if use_hoop else 9) if pdf_bytes is not None else None))
         if diag is not None:
             lines.append(doc["discrepancy"]["sentence"])
         print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, conflict, lines))

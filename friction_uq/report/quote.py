@@ -1,0 +1,31 @@
+"""The f to quote, in one line: which f, from which model, and whether to trust it.
+
+The terminal's first result line and the report's first line both come from :func:`quote_line`, so
+that a person reading either sees the same number first: f under the named causes when ``diagnose``
+named any (the JSON's ``f_headline``), the stationary analysis' f otherwise, and the count of the
+warnings to read before quoting it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from ..discrepancy.outcome import headline
+
+
+def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, Mapping[str, float]]:
+    """(where it comes from, its summary: q05, q50, q95, ...)."""
+    named = None if diagnosis is None else headline(diagnosis)
+    if named is not None:
+        label, fx = named
+        return f"the model with the causes diagnose named ({label})", fx
+    return "the stationary analysis (eq. 17 and the hoop gauge)", f_stationary
+
+
+def quote_line(f_stationary: Mapping[str, float], diagnosis=None, n_warnings: int = 0) -> str:
+    """'Headline f = 0.0487 [0.0445, 0.0531] (90 %), from ...; every check passed' (or the warnings' count)."""
+    source, fx = f_to_quote(f_stationary, diagnosis)
+    trust = ("every check passed" if n_warnings == 0 else
+             f"{n_warnings} warning{'s' if n_warnings > 1 else ''}: read {'them' if n_warnings > 1 else 'it'} "
+             "before quoting it")
+    return f"Headline f = {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] (90 %), from {source}; {trust}."
