@@ -247,13 +247,13 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
     assert {c["name"] for c in dd["causes"]} == {"dispersion", "clearance", "velocity_friction", "plug_friction"}
     assert dd["hoop_gain"]["finding"] and dd["hoop_gain"]["value"] < 0.98
     assert dd["f_extended"]["q05"] <= 0.0504 <= dd["f_extended"]["q95"]
-    assert not doc["f"]["q05"] <= 0.0504 <= doc["f"]["q95"]
+    assert not doc["f_stationary"]["q05"] <= 0.0504 <= doc["f_stationary"]["q95"]
     assert "plug_friction" in dd["sentence"] and "hoop gauge reads" in dd["sentence"]
     # the report's first page leads with the headline f and the model it comes from, as the JSON's f_headline
     from pypdf import PdfReader
 
     first = " ".join(PdfReader(tmp_path / "B_B-02.pdf").pages[0].extract_text().split())
-    head = doc["f_headline"]
+    head = doc["f"]  # the f to quote (schema version 2)
     assert head["model"] == dd["model"]
     assert first.startswith(f"Headline f = {head['q50']:.4f} [{head['q05']:.4f}, {head['q95']:.4f}] (90 %), from the "
                             "model with the causes"), first[:300]

@@ -50,7 +50,8 @@ def test_stick_slip_f_is_eq17_of_the_window_means_and_holds_the_truth(tmp_path):
     assert f.q05 <= truth <= f.q95
     assert any("not stationary" in w for w in res.warnings)
     doc = json.loads(res.outputs["json"].read_text())
-    assert list(doc)[0] == "warnings" and doc["warnings"] == list(res.warnings)
+    assert list(doc)[:4] == ["schema", "schema_version", "warnings", "f"] and doc["warnings"] == list(res.warnings)
+    assert doc["f"]["q50"] == doc["f_stationary"]["q50"] == f.q50  # no diagnosis: the f to quote is the stationary f
 
 
 def test_a_clean_record_has_no_warning(tmp_path):

@@ -156,7 +156,10 @@ def _up_to_date(old: RecordResult, new: RecordResult, out_dir: Path) -> bool:
 
 
 def _summary(doc: dict[str, Any]) -> dict[str, dict[str, float]]:
-    return {k: {s: float(doc[k][s]) for s in ("mean", "sd", "q05", "q50", "q95")} for k in SUMMARY_VARIABLES}
+    """The stationary analysis' summaries (its f is ``f_stationary`` in a run JSON of schema version 2)."""
+    key = {"f": "f_stationary"} if "f_stationary" in doc else {}
+    return {k: {s: float(doc[key.get(k, k)][s]) for s in ("mean", "sd", "q05", "q50", "q95")}
+            for k in SUMMARY_VARIABLES}
 
 
 def _peak_rss_mb() -> float:

@@ -67,7 +67,7 @@ def page_summary(r: ReportInputs) -> Figure:
     s = r.summary
     f, nu = s["f"], s["nu"]
     share = r.nu_share
-    named = None if r.diagnosis is None else outcome_headline(r.diagnosis)  # the JSON's f_headline
+    named = None if r.diagnosis is None else outcome_headline(r.diagnosis)  # the JSON's f (the f to quote)
     stationary = ("The stationary analysis without the named causes (page " f"{whole_record_page(r) + 2} for them): "
                   if named is not None else "The stationary analysis: ")
     lines = [f"WARNING: {w}" for w in r.warnings] + [

@@ -2,7 +2,7 @@
 
 The terminal's first result line and the report's first line both come from :func:`quote_line`, so
 that a person reading either sees the same number first: f under the named causes when ``diagnose``
-named any (the JSON's ``f_headline``), the stationary analysis' f otherwise, and the count of the
+named any (the JSON's ``f``), the stationary analysis' f otherwise, and the count of the
 warnings to read before quoting it.
 """
 

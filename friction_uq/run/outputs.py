@@ -38,6 +38,26 @@ def netcdf_bytes(dt) -> bytes:
 
 
 
+#: The run's JSON: its schema name and version (2: ``f`` is the f to quote, the stationary analysis' f is
+#: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
+RUN_SCHEMA = "friction-uq/run-result"
+RUN_SCHEMA_VERSION = 2
+
+
+def quoted_f(f_stationary: dict[str, float], diagnosis=None) -> dict[str, object]:
+    """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`), the model it comes from
+    and, under named causes, how its posterior was approximated and the Pareto k that judges it."""
+    from ..report.quote import f_to_quote
+
+    source, fx = f_to_quote(f_stationary, diagnosis)
+    out: dict[str, object] = {"model": source} | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
+    if diagnosis is not None and diagnosis.causes:
+        from ..discrepancy.outcome import POSTERIOR_METHOD
+
+        out |= {"posterior_method": POSTERIOR_METHOD, "pareto_k": diagnosis.pareto_k}
+    return out
+
+
 def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,
                   outputs: dict[str, Path], seconds: float, conflict: PriorDataConflict | None = None,
                   findings: list[str] | None = None) -> str:

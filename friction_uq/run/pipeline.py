@@ -48,7 +48,7 @@ from ..sampler import PosteriorSamples, sample_posterior, stderr_progress
 from ..settings import AnalysisSettings
 from .alongside import alongside, prepare_soon, whole_record_start
 from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
-from .outputs import netcdf_bytes, safe_stem, sha256_hex, summary_table
+from .outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION, netcdf_bytes, quoted_f, safe_stem, sha256_hex, summary_table
 from .warnings import run_warnings
 
 JSON_VARIABLES = ("f", "nu", "kappa", "p_mean", "tau_mean", "V", "ratio")
@@ -239,11 +239,13 @@ def run_file(
         t = time.perf_counter()
 
         seconds = time.perf_counter() - t_start
-        doc: dict[str, object] = {"warnings": warns}
+        doc: dict[str, object] = {"schema": RUN_SCHEMA, "schema_version": RUN_SCHEMA_VERSION, "warnings": warns,
+                                  "f": quoted_f(summary["f"].to_json(), diag)}
         allv = dict(summary) | {"V": V}
         for name in JSON_VARIABLES:
             v = allv[name]
-            doc[name] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50, "q95": v.q95}
+            doc["f_stationary" if name == "f" else name] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50,
+                                                            "q95": v.q95}
         if "hoop_gain" in summary:
             v = summary["hoop_gain"]
             doc["hoop_gain"] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50, "q95": v.q95}
@@ -277,11 +279,6 @@ def run_file(
             doc["misfit"] = wrc.to_json()
         if diag is not None:
             doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json())
-            label, fx = outcome.headline(diag) or ("baseline (stationary phase, eq. 17 + hoop)", summary["f"].to_json())
-            doc["f_headline"] = {"model": label} | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
-            if diag.causes:
-                doc["f_headline"] |= {"posterior_method": doc["discrepancy"]["posterior_method"],
-                                      "pareto_k": diag.pareto_k}
         js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
         write_together({names["netcdf"]: nc_bytes, names["pdf"]: pdf_bytes, names["json"]: js_bytes},
                        last=names["json"])

@@ -72,7 +72,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     fx = diagnosis.final.f_summary()
     names = ", ".join(v.label for v in diagnosis.causes)
     return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "
-            "(the JSON's f_headline), which is the f to quote.")
+            "(the JSON's f), which is the f to quote.")
 
 
 def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary, diagnosis=None) -> str | None:
