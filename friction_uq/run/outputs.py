@@ -47,10 +47,14 @@ RUN_SCHEMA_VERSION = 2
 def quoted_f(f_stationary: dict[str, float], diagnosis=None) -> dict[str, object]:
     """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`), the model it comes from
     and, under named causes, how its posterior was approximated and the Pareto k that judges it."""
+    from ..discrepancy.outcome import headline
     from ..report.quote import f_to_quote
 
     source, fx = f_to_quote(f_stationary, diagnosis)
-    out: dict[str, object] = {"model": source} | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
+    named = None if diagnosis is None else headline(diagnosis)
+    model = "stationary" if named is None else named[0]
+    out: dict[str, object] = ({"model": model, "source": source}
+                              | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")})
     if diagnosis is not None and diagnosis.causes:
         from ..discrepancy.outcome import POSTERIOR_METHOD
 
