@@ -207,6 +207,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        out = getattr(args, "out", None)
+        if args.command in ("run", "diagnose", "campaign") and out is not None:
+            from ._logfile import libraries_to_log
+
+            with libraries_to_log(out):
+                return _dispatch(args)
         return _dispatch(args)
     except FrictionUQError as exc:
         print(f"friction-uq: error: {exc}", file=sys.stderr)

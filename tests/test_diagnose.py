@@ -137,7 +137,7 @@ def test_clean_record_names_no_cause(tmp_path):
     assert fx["q05"] <= 0.06 <= fx["q95"]
     doc = outcome.to_json(dg, {"mean": 0.06, "sd": 0.003, "q05": 0.055, "q50": 0.06, "q95": 0.065})
     assert doc["cause"] is None and doc["not_separable"] == []
-    assert "No mechanism" in doc["sentence"]
+    assert doc["sentence"].startswith("No cause of the catalogue")
 
 
 def test_a_hoop_gauge_calibration_error_is_said_not_named(tmp_path):
@@ -166,7 +166,11 @@ def test_plug_friction_is_named_and_f_recovered(tmp_path):
     assert {"name", "delpd", "se", "parameters", "draws", "ess"} <= set(doc["ranking"][0])
     assert doc["ranking"][0]["ess"] == pytest.approx(doc["ranking"][0]["draws"])  # independent, equally weighted
     assert doc["reference_misfit"][0]["detected"] == dg.misfits[0].detected
-    assert "plug_friction" in doc["sentence"] and "with it" in doc["sentence"]
+    # in an experimentalist's words, with the cause's effect on f: f before -> after it, then the f to quote
+    steps = outcome.f_steps(dg)
+    assert [v.mechanism.name for v, _, _ in steps] == ["plug_friction"] and steps[0][2] < steps[0][1]
+    assert "the plug rubbing on the tube (plug_friction), f " in doc["sentence"]
+    assert f"f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] with them (the f to quote)" in doc["sentence"]
 
 
 def test_external_gauge_gain_is_named_with_its_channel(tmp_path):

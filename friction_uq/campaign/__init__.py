@@ -16,6 +16,7 @@ Modules, one concern each:
 from __future__ import annotations
 
 import os
+import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -74,7 +75,8 @@ def run_campaign(
     t0 = time.perf_counter()
     results = run_tasks(tasks, workers=workers, scheduler=scheduler, progress=progress)
     t1 = time.perf_counter()
-    ca = analyse(results, records_dir, seed=seed) if any(r.ok for r in results) else None
+    say = (lambda line: print(f"campaign: {line}", file=sys.stderr, flush=True)) if progress else None
+    ca = analyse(results, records_dir, seed=seed, say=say) if any(r.ok for r in results) else None
     settings = {"dispersion": dispersion, "hoop": hoop, "pdf": pdf, "diagnose": diagnose,
                 "priors": str(priors_path) if priors_path else None}
     doc = campaign_doc(results, ca, seed=seed, settings=settings)
@@ -82,6 +84,8 @@ def run_campaign(
     doc["wall_seconds"] = {"records": t1 - t0, "analysis": time.perf_counter() - t1}
     outputs = {"json": write_json(doc, out / "campaign.json")}
     if ca is not None:
+        if say is not None:
+            say("writing campaign.nc and campaign.pdf")
         outputs["netcdf"] = write_netcdf(ca, out / "campaign.nc")
         from ..report.campaign_pages import write_campaign_report
 

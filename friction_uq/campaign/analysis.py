@@ -9,7 +9,9 @@ model), chooses the best-supported law by leave-one-test-out ELPD, gives its par
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import time
+
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -191,16 +193,21 @@ def stationary_flags(tests: Sequence[RecordPosterior], law: str, offsets: Sequen
     return flags
 
 
-def analyse(results: Sequence[RecordResult], records_dir: str | Path, *, seed: int = 20161) -> CampaignAnalysis:
-    """Pool, fit the laws, choose, flag (see the module docstring)."""
+def analyse(results: Sequence[RecordResult], records_dir: str | Path, *, seed: int = 20161,
+            say: Callable[[str], None] | None = None) -> CampaignAnalysis:
+    """Pool, fit the laws, choose, flag (see the module docstring); ``say`` takes the progress lines."""
     ok = [r for r in results if r.ok]
+    if say is not None:
+        say(f"reading the draws of {len(ok)} test(s)")
     tests = [read_test_posterior(r, Path(records_dir)) for r in ok]
-    return analyse_tests(tests, tally_causes(ok), seed=seed)
+    return analyse_tests(tests, tally_causes(ok), seed=seed, say=say)
 
 
 def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str, object]], *,
-                  seed: int = 20161) -> CampaignAnalysis:
+                  seed: int = 20161, say: Callable[[str], None] | None = None) -> CampaignAnalysis:
     """The campaign's conclusions from the tests' draws and the tally of their causes."""
+    say = say or (lambda _line: None)
+    t0 = time.perf_counter()
     tests = list(tests)
     pooled: dict[str, Pooled] = {}
     if tests:
@@ -225,6 +232,9 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     models = {m.name: m for m in [Model(law) for law in LAWS] + [Model(law, s) for s in offsets for law in LAWS]}
     elpds: dict[str, Elpd] = {}
     for k, (name, m) in enumerate(models.items()):
+        done = time.perf_counter() - t0
+        eta = f", about {done / k * (len(models) - k):.0f} s left" if k else ""
+        say(f"friction law {k + 1} of {len(models)} ({name}): fit and leave-one-test-out; {done:.0f} s so far{eta}")
         fit = Fit(m, data, kbar=kbar, p_ref=p_ref, seed=seed + 1000 * k)
         ca.fits[name] = fit
         elpds[name] = loo(fit, seed=seed + 1000 * k)

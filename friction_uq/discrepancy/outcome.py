@@ -7,7 +7,7 @@ import numpy as np
 from ..models.parameters import effective_sample_size, summarize_draws
 from ..stats import khat_threshold
 from .diagnose import Diagnosis, ModelFit, Ranked
-from .extended import IMPORTANCE_DRAWS
+from .extended import IMPORTANCE_DRAWS, Variant
 from .whole_record import CHANNEL_LABELS
 
 #: How the named model's posterior is approximated; ``pareto_k`` checks it against the exact posterior.
@@ -49,38 +49,67 @@ def _entry(r: Ranked) -> dict[str, object]:
             "draws": int(len(r.fit.f_effective)), "ess": _ess(r.fit.fit.log_weights)}
 
 
+#: Each mechanism in an experimentalist's words (docs/glossary.md has the longer entries).
+PLAIN_NAMES = {
+    "velocity_friction": "wall friction that changes with the sliding speed",
+    "pressure_friction": "wall friction that changes with the wall pressure",
+    "slip_friction": "wall friction that changes with the distance slid",
+    "clearance": "a radial gap between sample and tube",
+    "plug_friction": "the plug rubbing on the tube",
+    "gauge_gain": "a bar gauge's calibration",
+    "dispersion": "wave dispersion in the bars",
+    "end_friction": "friction on the sample's end faces",
+}
+
+
 def _describe(dg: Diagnosis) -> str:
-    """Where the baseline misses most, in words (largest level misfit among the cells)."""
+    """Where the simple model (eq. 17 with the 1-D simulation) misses most, in words (largest level misfit)."""
     comp = dg.baseline_comparison
     worst = max(comp.figures, key=lambda f: abs(f.level))
     direction = "above" if worst.relative_level > 0 else "below"
-    return (f"the {CHANNEL_LABELS[worst.channel]} gauge is {abs(worst.relative_level) * 100:.1f} % {direction} the "
-            f"baseline over the {worst.phase} phase")
+    return (f"the {CHANNEL_LABELS[worst.channel]} gauge reads {abs(worst.relative_level) * 100:.1f} % {direction} the "
+            f"simple model over the {worst.phase} phase")
+
+
+def f_steps(dg: Diagnosis) -> list[tuple[Variant, float, float]]:
+    """Each named cause with the median f before and after it was added, in the order named: round k's
+    reference model is the one with the first k causes (diagnose.diagnose)."""
+    out, before = [], float(np.median(dg.baseline.f_effective))
+    for k, v in enumerate(dg.causes):
+        chosen = next((r.fit for r in dg.rounds[k] if r.fit.variants[-1] == v), None) if k < len(dg.rounds) else None
+        after = before if chosen is None else float(np.median(chosen.f_effective))
+        out.append((v, before, after))
+        before = after
+    return out
+
+
+def _cause_words(v: Variant) -> str:
+    where = f" on the {CHANNEL_LABELS.get(v.channel, v.channel)} gauge" if v.channel else ""
+    return f"{PLAIN_NAMES.get(v.mechanism.name, v.mechanism.name)}{where} ({v.mechanism.name})"
 
 
 def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
-    """One line for the terminal and the summary page."""
+    """One line for the terminal and the summary page, in an experimentalist's words: the causes, the one that
+    moves f most first, with f before and after each; then f to quote; then where the simple model missed."""
     fx = dg.final.f_summary()
     if not dg.causes:
-        return (f"No mechanism of the catalogue explains the record decisively better than the baseline (best "
-                f"{dg.ranking[0].fit.label}: dELPD {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f}); f = "
-                f"{f_without['q50']:.3f} [{f_without['q05']:.3f}, {f_without['q95']:.3f}] stands{_hoop_finding(dg)}.")
-    first = dg.ranking[0]
-    v = dg.causes[0]
-    name = v.mechanism.name + (f" on the {CHANNEL_LABELS.get(v.channel, v.channel)} gauge" if v.channel else "")
+        return (f"No cause of the catalogue explains the record clearly better than the simple model (closest: "
+                f"{dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f} "
+                f"nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
+                f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
+    steps = sorted(f_steps(dg), key=lambda s: -abs(s[2] - s[1]))
+    named = "; ".join(f"{_cause_words(v)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
     if dg.channels_not_separable:
         alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
-        name += f" ({alt} gauge explains the record about as well)"
-    more = ""
-    if len(dg.causes) > 1:
-        more = " then " + ", ".join(c.mechanism.name + (f" ({c.channel})" if c.channel else "") for c in dg.causes[1:])
+        named += f" (the same on {alt} gauge explains the record about as well)"
     sep = ""
     if dg.not_separable:
-        sep = (f"; not separable from this record: {', '.join(dg.not_separable)} (would separate them: "
-               f"{dg.separate_by})")
-    return (f"{_describe(dg)[0].upper()}{_describe(dg)[1:]}: {name} (dELPD {first.delpd:.0f} +- {first.se:.0f}){more}"
-            f"{sep}; f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] with it, {f_without['q50']:.3f} without"
-            f"{_hoop_finding(dg)}.")
+        sep = (f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would.")
+    first = dg.ranking[0]
+    return (f"Causes found, the one that moves f most first: {named}. f = {fx['q50']:.3f} [{fx['q05']:.3f}, "
+            f"{fx['q95']:.3f}] with them (the f to quote), {f_without['q50']:.3f} from the stationary analysis "
+            f"without them. Why: {_describe(dg)}; the first cause's evidence is {first.delpd:.0f} +- {first.se:.0f} "
+            f"nats.{sep}{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
 
 
 def baseline_hoop_gain(dg: Diagnosis) -> float:
@@ -105,7 +134,7 @@ def _hoop_finding(dg: Diagnosis) -> str:
     if not hoop_gain_off(dg):
         return ""
     g = dg.final.hoop_gain
-    return (f"; the tube hoop gauge reads {g:.2f} times the model's strain, {baseline_hoop_gain(dg):.2f} without "
+    return (f"the tube hoop gauge reads {g:.2f} times the model's strain, {baseline_hoop_gain(dg):.2f} without "
             "the causes (its calibration factor, most probable value under a 5 % prior)")
 
 
