@@ -94,10 +94,12 @@ class Diagnosis:
     #: the hoop gauge's calibration factor as the whole-record check reads it (f and nu free only: the model
     #: the misfit decision judges), when ``run`` made the check
     check_hoop_gain: float | None = None
-    #: the final model's normal approximation against its exact posterior (Diagnoser.importance_check), when a
-    #: cause was named: Pareto k and the importance weights' effective sample size
+    #: the final model's normal approximation against its exact posterior (Diagnoser.exact_posterior), when a
+    #: cause was named: Pareto k, the importance weights' effective sample size, and how the exact draws were
+    #: obtained (friction_uq.stats.exact: "importance", "importance (second proposal)" or "emcee")
     pareto_k: float = float("nan")
     importance_ess: float = float("nan")
+    posterior_method: str | None = None
 
     @property
     def cause(self) -> Variant | None:
@@ -193,13 +195,16 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     a = compare_whole_record(prep, base.predicted)
     b = compare_whole_record(prep, final.predicted)
     k = ess = float("nan")
+    method = None
     if causes:
-        say("importance check of the final model's normal approximation")
-        k, ess = dg.importance_check(final)
+        say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
+        final, ex = dg.exact_posterior(final)
+        k, ess, method = ex.pareto_k, ex.ess, ex.method
     return Diagnosis(baseline=base, rounds=tuple(rounds), misfits=tuple(misfits), causes=tuple(causes),
                      not_separable=not_sep, channels_not_separable=other_channels, separate_by=separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
-                     baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess)
+                     baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
+                     posterior_method=method)
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

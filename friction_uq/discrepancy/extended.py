@@ -30,9 +30,9 @@ from .._parallel import can_fork
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
-from ..stats import psis
+from ..stats.exact import ExactDraws, exact_draws
 from .elpd import Elpd, ar1_block_loo, calibration_loo, takeuchi_block_loo, with_calibration
-from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
+from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record, robust_covariance
 from .mechanisms import MECHANISMS, Context, Mechanism
 
 #: Block of the leave-one-block-out ELPD (s).
@@ -40,8 +40,10 @@ BLOCK = 10e-6
 #: Further starting values of nu for the baseline's mode search.
 NU_STARTS = (0.33, 0.45)
 SAMPLE_MODULUS_SD_LOG = 0.1
-#: Draws of the importance check of a named model's normal approximation (:meth:`Diagnoser.importance_check`).
+#: Draws of the importance stage of a named model's exact posterior (:meth:`Diagnoser.exact_posterior`).
 IMPORTANCE_DRAWS = 200
+#: Equal-weight draws of the exact (sandwich-adjusted) posterior kept for the named model.
+EXACT_DRAWS = 1000
 
 
 @dataclass(frozen=True)
@@ -136,7 +138,7 @@ class Diagnoser:
             extra = ({**{k: self.nominal[k] for k in ("f", "nu") if k in self.nominal}, "sample_modulus": self.E0},)
         else:
             extra = ()
-        block_of = self._blocks(lik)
+        block_of = lik.blocks(self.block)
         fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False,
                                prior_scale=scales, extra_starts=extra, score_blocks=block_of)
         unit = lik.unit_strains(fit.mode)
@@ -166,29 +168,40 @@ class Diagnoser:
 
         return log_prior
 
-    def importance_check(self, mf: ModelFit, *, n: int = IMPORTANCE_DRAWS) -> tuple[float, float]:
-        """Pareto k and effective sample size of the model's normal approximation against its exact posterior.
+    def exact_posterior(self, mf: ModelFit, *, n: int = IMPORTANCE_DRAWS) -> tuple[ModelFit, ExactDraws]:
+        """The model with its exact posterior, robust to a model that still misses (:mod:`friction_uq.stats.exact`).
 
-        ``n`` draws from the normal the fit's draws come from (their mean and covariance in the unbounded
-        coordinates) are weighted by the exact posterior density (the whole-record likelihood, the priors, the
-        transforms' Jacobians) over the normal's (:func:`friction_uq.stats.psis`). k above
-        :func:`friction_uq.stats.khat_threshold` says the normal approximation misses the posterior's shape.
+        The fit's normal approximation (robust covariance) is weighted by the exact posterior density (the
+        whole-record likelihood, the priors, the transforms' Jacobians): Pareto k says how far the normal
+        was from it; beyond the limit a second proposal or emcee samples it. The exact draws are then
+        given the robust covariance by the open-faced sandwich adjustment, which keeps their shape. The
+        returned model's draws and f_effective are these; its mode, ELPD and predictions are unchanged.
         """
-        params = [mf.lik.model.parameters[name] for name in mf.fit.names]
-        z = np.stack([p.to_unbounded(mf.fit.draws[p.name]) for p in params], axis=1)
-        mean, cov = z.mean(axis=0), np.atleast_2d(np.cov(z, rowvar=False))
-        rng = np.random.default_rng(np.random.SeedSequence([self.seed, 11, zlib.crc32(mf.label.encode())]))
-        prop = stats.multivariate_normal(mean, cov, allow_singular=True)
-        zs = prop.rvs(size=n, random_state=rng).reshape(n, len(params))
+        fit = mf.fit
+        params = [mf.lik.model.parameters[name] for name in fit.names]
+        mode = np.array([float(p.to_unbounded(fit.mode[p.name])) for p in params])
+        cov = fit.cov_z if fit.cov_z is not None else np.eye(len(params)) * 1e-6
+        robust = robust_covariance(fit.jacobian, fit.whitened, cov, mf.lik.blocks(self.block))
         log_prior = self.log_prior(mf.variants)
-        log_r = np.empty(n)
-        for i, zi in enumerate(zs):
-            vals = {p.name: float(p.from_unbounded(v)) for p, v in zip(params, zi)}
+
+        def log_post(z: np.ndarray) -> float:
+            vals = {p.name: float(p.from_unbounded(v)) for p, v in zip(params, z)}
             lp = log_prior(vals)
-            jac = sum(float(p.log_jacobian(v)) for p, v in zip(params, zi))
-            log_r[i] = (mf.lik.loglike(vals) + lp + jac if np.isfinite(lp) else -np.inf) - prop.logpdf(zi)
-        res = psis(log_r)
-        return float(res.pareto_k), float(res.ess)
+            if not np.isfinite(lp):
+                return -np.inf
+            try:
+                return mf.lik.loglike(vals) + lp + sum(float(p.log_jacobian(v)) for p, v in zip(params, z))
+            except ValueError:  # parameters the simulator cannot run
+                return -np.inf
+
+        rng = np.random.default_rng(np.random.SeedSequence([self.seed, 11, zlib.crc32(mf.label.encode())]))
+        ex = exact_draws(log_post, mode, cov, robust, rng=rng, n_importance=n, n_out=EXACT_DRAWS)
+        draws = {p.name: np.asarray(p.from_unbounded(ex.z_adjusted[:, i]), float) for i, p in enumerate(params)}
+        f_eff = np.array([self._f_effective(mf.variants, {k: float(v[s]) for k, v in draws.items()})
+                          for s in range(EXACT_DRAWS)])
+        new_fit = replace(fit, draws=draws, log_weights=np.full(EXACT_DRAWS, -math.log(EXACT_DRAWS)),
+                          pareto_k=ex.pareto_k, laplace_draws=fit.laplace_draws or fit.draws)
+        return replace(mf, fit=new_fit, f_effective=f_eff), ex
 
     def _calibration(self, lik: WholeRecordLikelihood, fit: WholeRecordFit, unit: Mapping[str, np.ndarray],
                      modulus_scale: tuple[float, float]) -> dict[str, tuple[float, float, float]]:
@@ -226,17 +239,6 @@ class Diagnoser:
             out.append(ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd,
                                 f_effective=f_eff, predicted=predicted, lik=lik))
         return out
-
-    def _blocks(self, lik: WholeRecordLikelihood) -> np.ndarray:
-        """The block of each whitened residual of ``lik`` (:meth:`WholeRecordLikelihood.whitened`): 10 us
-        blocks of each gauge in turn; the nuisances' pseudo-residuals (last) belong to no
-        block: they are given the first."""
-        blocks, offset = [], 0
-        for c in lik.channels:
-            i0, _, _, i3 = lik.bounds[c]
-            blocks.append(offset + np.arange(i3 - i0) // self.block)
-            offset += -(-(i3 - i0) // self.block)
-        return np.concatenate(blocks + [np.zeros(lik.n_pseudo, int)])
 
     def predictive(self, mf: ModelFit, n: int = 30) -> dict[str, np.ndarray]:
         """Simulated gauges for the first ``n`` draws of a fitted model (channel -> (n, samples)), the hoop

@@ -10,10 +10,11 @@ from .diagnose import Diagnosis, ModelFit, Ranked
 from .extended import IMPORTANCE_DRAWS, Variant
 from .whole_record import CHANNEL_LABELS
 
-#: How the named model's posterior is approximated; ``pareto_k`` checks it against the exact posterior.
-POSTERIOR_METHOD = ("normal in the unbounded coordinates at the mode, with the robust (sandwich) covariance; "
-                    "pareto_k: 200 of its draws importance-weighted by the exact posterior (k above the threshold: "
-                    "its shape is not confirmed)")
+#: How the named model's posterior is obtained (the JSON's ``posterior_method`` says which route was taken).
+POSTERIOR_NOTE = ("exact posterior of the model with the named causes: 200 draws of its normal approximation (robust "
+                  "covariance) importance-weighted by the whole-record posterior (Pareto-smoothed; pareto_k judges the "
+                  "normal); when k > 0.7 a Student-t proposal, then emcee; the exact draws then mapped to the robust "
+                  "(sandwich) covariance, keeping their shape (open-faced sandwich adjustment, Shaby 2014)")
 
 #: A hoop gain this far from 1 (its most probable value under its 5 % prior) is reported as a calibration finding
 #: (clean records: see benchmarks/bench_misfit.py for how often a right gauge reads this far off).
@@ -153,7 +154,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
         "rounds": [[_entry(r) for r in rnd] for rnd in dg.rounds[1:]],
         "model": dg.final.label,
         "f_extended": dg.final.f_summary(),
-        "posterior_method": POSTERIOR_METHOD,
+        "posterior_method": dg.posterior_method,
+        "posterior_note": POSTERIOR_NOTE,
         "pareto_k": dg.pareto_k,
         "pareto_k_threshold": khat_threshold(IMPORTANCE_DRAWS),
         "importance_ess": dg.importance_ess,
@@ -187,11 +189,13 @@ def group_key(label: str) -> str:
 
 
 def add_to_datatree(dt, dg: Diagnosis) -> None:
-    """One group per fitted model under ``discrepancy``: the Laplace draws (posterior) and the pointwise
-    block elpd (log_likelihood)."""
+    """One group per fitted model under ``discrepancy``: the draws (posterior: the normal approximation's, and
+    for the model the headline f comes from its exact posterior's, :meth:`Diagnoser.exact_posterior`) and the
+    pointwise block elpd (log_likelihood)."""
     import xarray as xr
 
-    fits: list[ModelFit] = [dg.baseline] + [r.fit for rnd in dg.rounds for r in rnd]
+    fits: list[ModelFit] = [dg.baseline] + [dg.final if dg.causes and r.fit.label == dg.final.label else r.fit
+                                            for rnd in dg.rounds for r in rnd]
     # the group of the model the headline f comes from (empty: no cause named, the stationary posterior's f)
     dt.attrs["discrepancy_final_group"] = f"discrepancy_{group_key(dg.final.label)}" if dg.causes else ""
     for mf in fits:
@@ -200,8 +204,9 @@ def add_to_datatree(dt, dg: Diagnosis) -> None:
         post["f_effective"] = (("chain", "draw"), mf.f_effective[None])
         ll = {"block_elpd": (("block",), mf.elpd.pointwise),
               "calibration_elpd": (("calibration",), mf.elpd.calibration)}
-        dt[f"discrepancy_{key}/posterior"] = xr.DataTree(xr.Dataset(post, attrs={"model": mf.label,
-                                                                                  "hoop_gain": mf.hoop_gain}))
+        method = dg.posterior_method if mf is dg.final and dg.causes else "normal approximation (robust covariance)"
+        dt[f"discrepancy_{key}/posterior"] = xr.DataTree(xr.Dataset(post, attrs={
+            "model": mf.label, "hoop_gain": mf.hoop_gain, "posterior_method": method}))
         dt[f"discrepancy_{key}/log_likelihood"] = xr.DataTree(xr.Dataset(
             ll, coords={"calibration": list(mf.elpd.calibration_names)}, attrs={
             "elpd": mf.elpd.total, "elpd_se": mf.elpd.se,

@@ -186,3 +186,13 @@ class WholeRecordLikelihood:
             pseudo.append(d / sds)
             logdet += ld
         return np.concatenate(out + pseudo), logdet
+
+    def blocks(self, block: int) -> np.ndarray:
+        """The block of each residual of :meth:`whitened`: blocks of ``block`` samples of each gauge in turn;
+        the nuisances' pseudo-residuals (last) belong to no block: they are given the first."""
+        out, offset = [], 0
+        for c in self.channels:
+            i0, _, _, i3 = self.bounds[c]
+            out.append(offset + np.arange(i3 - i0) // block)
+            offset += -(-(i3 - i0) // block)
+        return np.concatenate(out + [np.zeros(self.n_pseudo, int)])

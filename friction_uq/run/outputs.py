@@ -56,9 +56,7 @@ def quoted_f(f_stationary: dict[str, float], diagnosis=None) -> dict[str, object
     out: dict[str, object] = ({"model": model, "source": source}
                               | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")})
     if diagnosis is not None and diagnosis.causes:
-        from ..discrepancy.outcome import POSTERIOR_METHOD
-
-        out |= {"posterior_method": POSTERIOR_METHOD, "pareto_k": diagnosis.pareto_k}
+        out |= {"posterior_method": diagnosis.posterior_method, "pareto_k": diagnosis.pareto_k}
     return out
 
 

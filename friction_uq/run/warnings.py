@@ -29,10 +29,8 @@ from ..analysis import Identification
 from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
-from ..discrepancy.extended import IMPORTANCE_DRAWS
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from ..prior_sensitivity import PriorDataConflict
-from ..stats import khat_threshold
 
 #: Least fraction of the window where the smoothed ratio lies in its 90 % noise band (about 0.9 on a
 #: record the model describes; its sd over records is ~0.06, so 0.5 is more than six sd below).
@@ -117,16 +115,6 @@ def gauge_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
             "ratio and is off by as much as their gains are; `friction-uq diagnose` fits a gauge's gain.")
 
 
-def approximation_warning(diagnosis) -> str | None:
-    """The named model's normal approximation is not confirmed by importance sampling (Pareto k too large)."""
-    if diagnosis is None or not diagnosis.causes or not diagnosis.pareto_k > khat_threshold(IMPORTANCE_DRAWS):
-        return None
-    fx = diagnosis.final.f_summary()
-    return (f"f under the named causes, {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}], is a normal approximation "
-            f"whose shape importance sampling does not confirm (Pareto k {diagnosis.pareto_k:.2f} > "
-            f"{khat_threshold(IMPORTANCE_DRAWS):.2f}): its interval is approximate, its ends least of all.")
-
-
 def convergence_warning(conv: Convergence) -> str | None:
     if conv.ok:
         return None
@@ -150,6 +138,6 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
     found: Sequence[str | None] = (
         gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f),
         stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f, diagnosis),
-        convergence_warning(conv), conflict_warning(conflict), approximation_warning(diagnosis),
+        convergence_warning(conv), conflict_warning(conflict),
     )
     return [w for w in found if w]
