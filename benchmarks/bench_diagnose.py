@@ -101,7 +101,10 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--max-causes", type=int, default=1,
                     help="causes searched in turn (1: the first named cause, what the study scores)")
+    ap.add_argument("--only", help="comma-separated groups (clean, or hidden mechanisms) to analyse; the records "
+                    "are those of the whole study (the others are drawn and skipped)")
     args = ap.parse_args()
+    only = set(args.only.split(",")) if args.only else None
     priors = load_priors(default_prior_path("I1"))
     rng = np.random.default_rng(args.seed)
     tmp = tempfile.mkdtemp()
@@ -113,7 +116,10 @@ def main() -> None:
         if make is not None:
             cfg = make(cfg, rng)
         path = os.path.join(tmp, f"r{k}.h5")
-        simulate_to_file(cfg, path, seed=int(rng.integers(2**31)))
+        sim_seed = int(rng.integers(2**31))
+        if only is not None and hidden not in only:
+            continue
+        simulate_to_file(cfg, path, seed=sim_seed)
         c = stats.setdefault(hidden, Counter())
         c["n"] += 1
         t = time.perf_counter()

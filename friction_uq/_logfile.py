@@ -39,6 +39,19 @@ class _Kept(logging.Handler):
             self.lines.append(f"{record.name} {record.levelname}: (unformattable message)")
 
 
+#: The handler of the :func:`libraries_to_log` in force (None outside one).
+_ACTIVE: list[logging.Handler] = []
+
+
+def reroute() -> None:
+    """Send the libraries' loggers to the log again: a library that sets up its own handlers when it is
+    imported (dask.distributed does) is imported after :func:`libraries_to_log` began; call this after."""
+    if _ACTIVE:
+        for name in LIBRARIES:
+            lg = logging.getLogger(name)
+            lg.handlers, lg.propagate = [_ACTIVE[-1]], False
+
+
 @contextlib.contextmanager
 def libraries_to_log(out_dir: str | os.PathLike[str]) -> Iterator[None]:
     """While inside: Python warnings and the libraries' log records are kept for ``out_dir/friction-uq.log``."""
@@ -49,6 +62,7 @@ def libraries_to_log(out_dir: str | os.PathLike[str]) -> Iterator[None]:
         lg = logging.getLogger(name)
         saved.append((lg, lg.handlers[:], lg.propagate))
         lg.handlers, lg.propagate = [handler], False
+    _ACTIVE.append(handler)
     capture = logging.getLogger("py.warnings")
     capture.setLevel(logging.WARNING)
     logging.captureWarnings(True)
@@ -57,6 +71,7 @@ def libraries_to_log(out_dir: str | os.PathLike[str]) -> Iterator[None]:
             warnings.simplefilter("default")
             yield
     finally:
+        _ACTIVE.remove(handler)
         logging.captureWarnings(False)
         for lg, handlers, propagate in saved:
             lg.handlers, lg.propagate = handlers, propagate

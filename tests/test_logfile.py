@@ -30,3 +30,14 @@ def test_nothing_is_written_without_a_message_or_without_the_folder(tmp_path):
     with libraries_to_log(missing):
         logging.getLogger("numba").warning("something")
     assert not missing.exists()  # a refused command leaves nothing behind
+
+
+def test_a_library_that_installs_its_handlers_later_is_rerouted(tmp_path, capsys):
+    from friction_uq._logfile import reroute
+
+    with libraries_to_log(tmp_path):
+        late = logging.StreamHandler()  # as dask.distributed does when it is first imported
+        logging.getLogger("distributed").handlers = [late]
+        reroute()
+        logging.getLogger("distributed.nanny").warning("killing")
+    assert "killing" not in capsys.readouterr().err and "killing" in (tmp_path / LOG_NAME).read_text()

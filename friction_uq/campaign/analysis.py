@@ -21,10 +21,14 @@ from ..errors import FrictionUQError
 from ..priors import load_priors
 from .flags import outlier_tests, setup_flags, tally_causes
 from .job import RecordResult
-from .laws import LAWS, NESTS, Elpd, Fit, LawData, Model, decisive, law_mean, loo, rank
+from ..stats import WeightRule, stacking_weights
+from .laws import LAWS, Elpd, Fit, LawData, Model, law_mean, loo, rank
+from .next_test import Candidate, advice, rank_next_tests
 from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin
 
 MIN_TESTS_FOR_LAWS = 5
+#: The verdict's rule on the laws' stacking weights (friction_uq.stats.weights).
+WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
 #: draws per test the laws' likelihood reads (a kernel density of them)
 LAW_DRAWS = 160
 
@@ -61,6 +65,12 @@ class CampaignAnalysis:
     nu: tuple[float, float] = (float("nan"), float("nan"))
     flagged: list[dict[str, object]] = field(default_factory=list)
     sentences: list[str] = field(default_factory=list)
+    #: each law's stacking weight (friction_uq.stats.stacking_weights)
+    weights: dict[str, float] = field(default_factory=dict)
+    #: candidate next tests, the most informative first (.next_test), when the laws are not separated
+    next_tests: list[Candidate] = field(default_factory=list)
+    #: law -> the name of its model in ``fits`` that the weights are of (the law, or with set-ups left out)
+    law_models: dict[str, str] = field(default_factory=dict)
 
     def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:
         """Draws of f along (V, p) for one set-up under a fitted model, at the campaign's nu: (draws, len(V))."""
@@ -68,8 +78,7 @@ class CampaignAnalysis:
         x = fit.draws[:: max(1, len(fit.draws) // n)]
         th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
         y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref)
-        if fit.model.offset_setup == setup:
-            y = y * (1.0 + th["delta"])
+        y = y * fit.model.setup_scale(th, [setup] * len(np.atleast_1d(V)))
         return y * fit.kbar * fit.data.to_f(self.nu[0])
 
 
@@ -123,19 +132,27 @@ def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None
                    basis="f" if diagnosed else "kappa", draws=tuple(y), draws_log_prior=log_prior)
 
 
-def _nested(a: Model, b: Model) -> bool:
-    """Model a is a special case of model b."""
-    return b.law in NESTS[a.law] and (a.offset_setup is None or a.offset_setup == b.offset_setup)
+def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
+    """What the laws' stacking weights support (:data:`WEIGHT_RULE`), in sentences: the law, or the laws the
+    data do not separate; and that f is not constant whenever the constant law carries little weight."""
+    supported = WEIGHT_RULE.supported(weights)
+    by_name = {str(r.get("law", r["model"])): r for r in ranking}
 
+    def w(name: str) -> str:
+        r = by_name[name]
+        gap = "" if float(r["d_elpd"]) == 0.0 else f", {float(r['d_elpd']):.1f} +- {float(r['d_se']):.1f} behind"
+        return f"{name} (weight {weights[name]:.2f}{gap})"
 
-def choose(ranking: Sequence[dict[str, object]], models: dict[str, Model]) -> Model | None:
-    """The simplest model not decisively worse than the top one that all such models contain, else None."""
-    contenders = [models[str(r["model"])] for r in ranking
-                  if not decisive(float(r["d_elpd"]), float(r["d_se"]), r.get("n_tests"))]
-    for m in sorted(contenders, key=lambda m: len(m.params)):
-        if all(_nested(m, other) for other in contenders):
-            return m
-    return None
+    if len(supported) == 1:
+        out = [f"friction law: {w(supported[0])}, the law that carries the weight"]
+    else:
+        out = ["friction law: the data do not separate " + ", ".join(w(n) for n in supported)]
+    if "constant" not in supported and weights.get("constant", 1.0) < WEIGHT_RULE.little:
+        out.append(f"f is not constant: the constant law carries {weights['constant']:.2f} of the weight")
+    elif "constant" in supported and len(supported) > 1:
+        out.append(f"no dependence of f on V or p is resolved: a constant f carries {weights['constant']:.2f} of "
+                   "the weight, and the laws beside it predict the tests as well")
+    return out
 
 
 def _summ(x: np.ndarray) -> dict[str, float]:
@@ -160,6 +177,10 @@ def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np
     if "c" in col:
         out["c_per_p_ref"] = col["c"]
         out["df_dp_per_MPa"] = col["c"] / fit.p_ref * 1e6 * (col.get("a", col.get("d")) * g)
+    for setup in fit.model.cal_setups:
+        out[f"calibration_{setup}"] = col[f"cal_{setup}"]
+    for setup in fit.model.freed:
+        out[f"offset_{setup}"] = col[f"free_{setup}"]
     if "delta" in col:
         out[f"offset_{fit.model.offset_setup}"] = col["delta"]
     out["scatter_rel"] = col["r"]
@@ -175,10 +196,11 @@ def stationary_flags(tests: Sequence[RecordPosterior], law: str, offsets: Sequen
     are in its model (``offset_diagnosed``; ``explained_by_causes`` when it is no longer decisive)."""
     data = _law_data(tests, diagnosed=False)
     kbar, p_ref = float(np.mean(data.kappa)), float(np.mean(data.p))
-    base = loo(Fit(Model(law), data, kbar=kbar, p_ref=p_ref, seed=seed + 77), seed=seed + 77)
+    cal = tuple(setups[1:])
+    base = loo(Fit(Model(law, None, cal), data, kbar=kbar, p_ref=p_ref, seed=seed + 77), seed=seed + 77)
     with_offset = {}
     for k, s in enumerate(offsets):
-        fit = Fit(Model(law, s), data, kbar=kbar, p_ref=p_ref, seed=seed + 78 + k)
+        fit = Fit(Model(law, s, cal), data, kbar=kbar, p_ref=p_ref, seed=seed + 78 + k)
         with_offset[s] = (loo(fit, seed=seed + 78 + k), _summ(fit.draws[:, -2]))
     flags = setup_flags(base, with_offset, setups, tallies, quantity="kappa")
     for f in flags:
@@ -191,6 +213,65 @@ def stationary_flags(tests: Sequence[RecordPosterior], law: str, offsets: Sequen
                                + ("the causes named account for the stationary departure" if s not in already
                                   else "the causes named do not account for it"))
     return flags
+
+
+class _Laws:
+    """The law fits of one campaign analysis: the comparison (fits, LOO, ranking, weights) and the flags."""
+
+    def __init__(self, ca: CampaignAnalysis, data: LawData, kbar: float, p_ref: float, seed: int,
+                 say: Callable[[str], None], t0: float) -> None:
+        self.ca, self.data, self.kbar, self.p_ref, self.seed, self.say, self.t0 = ca, data, kbar, p_ref, seed, say, t0
+        self.k = 0
+
+    def fit(self, m: Model) -> tuple[Fit, Elpd]:
+        self.say(f"friction law model {self.k + 1} ({m.name}): fit and leave-one-test-out; "
+                 f"{time.perf_counter() - self.t0:.0f} s so far")
+        fit = Fit(m, self.data, kbar=self.kbar, p_ref=self.p_ref, seed=self.seed + 1000 * self.k)
+        e = loo(fit, seed=self.seed + 1000 * self.k)
+        self.k += 1
+        self.ca.fits[m.name] = fit
+        return fit, e
+
+    def compare(self, cal: tuple[str, ...], freed: tuple[str, ...]) -> dict[str, Elpd]:
+        """Every law with calibration offsets (and the ``freed`` set-ups' levels left out): ranking and weights."""
+        elpds = {}
+        for law in LAWS:
+            m = Model(law, None, cal, freed)
+            elpds[m.name] = self.fit(m)[1]
+        self.ca.ranking = rank(list(elpds.values()))
+        self.ca.weights = {Model(k.split(" + ")[0]).law: w
+                           for k, w in stacking_weights({n: e.pointwise for n, e in elpds.items()}).items()}
+        self.ca.law_models = {m.split(" + ")[0]: m for m in elpds}
+        for r in self.ca.ranking:
+            r["law"] = str(r["model"]).split(" + ")[0]
+            r["weight"] = self.ca.weights[r["law"]]
+        self.base = elpds
+        return elpds
+
+    def flag(self, law: str, offsets: Sequence[str], cal: tuple[str, ...], setups: Sequence[str],
+             tallies: dict[str, dict[str, object]]) -> tuple[dict[str, tuple[Elpd, dict[str, float]]], list[str]]:
+        """Set-ups off the shared law beyond their calibration, the most decisive first, each tested with the
+        ones found before left out (one set-up pulling the law makes the others look off). Returns the
+        first round's offsets (every candidate set-up) and the set-ups flagged."""
+        base = self.base[Model(law, None, cal).name]
+        freed: list[str] = []
+        first: dict[str, tuple[Elpd, dict[str, float]]] = {}
+        while True:
+            trial = {}
+            for s in offsets:
+                if s not in freed:
+                    fit, e = self.fit(Model(law, s, cal, tuple(freed)))
+                    trial[s] = (e, _summ(fit.draws[:, -2]))
+            first = first or trial
+            flags = setup_flags(base, trial, setups, tallies, quantity=self.data.basis) if trial else []
+            if not flags:
+                return first, freed
+            top = max(flags, key=lambda f: float(f["d_elpd"]))
+            self.ca.flagged.append(top)
+            freed.append(str(top["setup"]))
+            base = trial[str(top["setup"])][0]
+            if len(setups) == 2:  # with two set-ups one offset is all that can be told
+                return first, freed
 
 
 def analyse(results: Sequence[RecordResult], records_dir: str | Path, *, seed: int = 20161,
@@ -229,33 +310,31 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     kbar, p_ref = float(np.mean(data.kappa)), float(np.mean(data.p))
     setups = sorted(set(data.setups))
     offsets = [setups[-1]] if len(setups) == 2 else (setups if len(setups) > 2 else [])
-    models = {m.name: m for m in [Model(law) for law in LAWS] + [Model(law, s) for s in offsets for law in LAWS]}
-    elpds: dict[str, Elpd] = {}
-    for k, (name, m) in enumerate(models.items()):
-        done = time.perf_counter() - t0
-        eta = f", about {done / k * (len(models) - k):.0f} s left" if k else ""
-        say(f"friction law {k + 1} of {len(models)} ({name}): fit and leave-one-test-out; {done:.0f} s so far{eta}")
-        fit = Fit(m, data, kbar=kbar, p_ref=p_ref, seed=seed + 1000 * k)
-        ca.fits[name] = fit
-        elpds[name] = loo(fit, seed=seed + 1000 * k)
-    ca.ranking = rank(list(elpds.values()))
-    chosen = choose(ca.ranking, models)
-    if chosen is None:
-        top_laws = {models[str(r["model"])].law for r in ca.ranking
-                    if not decisive(float(r["d_elpd"]), float(r["d_se"]), r.get("n_tests"))}
-        ca.sentences.append("friction law: the data do not separate " + ", ".join(sorted(top_laws))
-                            + " (none is decisively better: dELPD > 4 and > t(0.975, tests - 1) SE)")
-        law_for_flags = models[str(ca.ranking[0]["model"])].law
+    cal = tuple(setups[1:])  # every set-up but the first: a calibration offset (laws.CALIBRATION_SD)
+    laws = _Laws(ca, data, kbar, p_ref, seed, say, t0)
+    elpds = laws.compare(cal, ())
+    law_for_flags = max(ca.weights, key=ca.weights.get)
+    first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies)
+    if freed:  # the laws again, the flagged set-ups' levels left out (a free offset each): never fitted by them
+        elpds = laws.compare(cal, tuple(freed))
+        law_for_flags = max(ca.weights, key=ca.weights.get)
+        ca.sentences.append(f"the friction law is compared with the level of set-up {', '.join(freed)} left out: it "
+                            "departs from the shared law beyond its calibration (3 %), a finding for diagnose to "
+                            "explain, not a part of any law")
+    ca.sentences += verdict(ca.weights, ca.ranking)
+    supported = WEIGHT_RULE.supported(ca.weights)
+    if len(supported) == 1:
+        ca.best, ca.chosen = supported[0], ca.law_models[supported[0]]
     else:
-        ca.chosen, ca.best = chosen.name, chosen.law
-        law_for_flags = chosen.law
+        say("the expected information of one more test at each set-up and speed")
+        ca.next_tests = rank_next_tests({law: ca.fits[m] for law, m in ca.law_models.items()}, ca.weights, seed=seed)
+        tip = advice(ca.next_tests, ca.weights)
+        if tip:
+            ca.sentences.append(tip)
     prior0 = load_priors(tests[0].prior_file)["nu"]
     pm, psd = float(prior0.ppf(0.5)), float(np.std(prior0.rvs(np.random.default_rng(seed), 20000)))
-    with_offset = {s: (elpds[Model(law_for_flags, s).name],
-                       _summ(ca.fits[Model(law_for_flags, s).name].draws[:, -2])) for s in offsets}
-    ca.flagged = setup_flags(elpds[law_for_flags], with_offset, setups, tallies, quantity=data.basis)
     if data.basis == "f" and offsets:
-        ca.flagged += stationary_flags(tests, law_for_flags, offsets, setups, tallies, with_offset,
+        ca.flagged += stationary_flags(tests, law_for_flags, offsets, setups, tallies, first,
                                        {str(f["setup"]) for f in ca.flagged}, seed=seed)
     primary = [f for f in ca.flagged if f["basis"] == data.basis]
     flagged_setups = {str(f["setup"]) for f in primary}
@@ -265,7 +344,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     if len(setups) == 2 and primary and "named_by_causes" in primary[0]:
         trusted = [t for t in tests if t.setup != primary[0]["named_by_causes"]]
     ca.nu = campaign_nu(trusted, pm, psd)
-    name = ca.chosen or str(ca.ranking[0]["model"])
+    name = ca.chosen or ca.law_models[max(ca.weights, key=ca.weights.get)]
     ca.law_draws = f_law_draws(ca.fits[name], ca.nu, seed=seed)
     ca.law_posterior = {k: _summ(v) for k, v in ca.law_draws.items()}
     chosen_elpd = elpds[name]

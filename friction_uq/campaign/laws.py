@@ -13,8 +13,18 @@ friction) no longer biases:
 * ``pressure``:           y = a (1 + c (p - p_ref) / p_ref)
 * ``pressure+velocity``:  y = [d + (s - d) exp(-V / v_c)] (1 + c (p - p_ref) / p_ref)
 
-with p_ref the campaign's mean pressure. Each may carry a multiplicative offset (1 + delta) on one
-set-up (``set-up offset``: that set-up does not follow the shared law). A test's y is uncertain by
+with p_ref the campaign's mean pressure. Every set-up but the first carries a calibration offset
+(1 + cal_s) with a normal prior of sd :data:`CALIBRATION_SD`: what the bars' and gauges' calibrations
+allow (below), not a free parameter, so that a law cannot fit a difference between set-ups (which
+is what a second internal output bar is there to measure, eq. 15-16) by an offset. A model used to
+*flag* a set-up also carries a free multiplicative offset (1 + delta) on one set-up (delta ~
+N(0, 0.3)): a set-up that departs from the shared law by more than its calibration allows is a
+finding for ``diagnose`` to explain, never part of a law.
+
+Calibration (:data:`CALIBRATION_SD` = 3 %): kappa is read from F_eo/F_io, two bars' forces, each
+E A epsilon: a bar's modulus (~1 %), its section (~1 %: 0.5 % on a diameter) and its gauge's
+calibration (~1 %) on each of the two bars, sqrt(6) x 1 % = 2.4 %, rounded up to 3 % for the
+wave speeds and the gauges' positions. A test's y is uncertain by
 its own posterior, by the measured V and p through the law's slopes (errors in variables,
 linearised: (dy/dV sd_V)^2 + (dy/dp sd_p)^2), and by a between-test scatter r (relative,
 half-normal(0.1) prior) that the per-test posteriors do not explain. Given the test's stored draws
@@ -23,7 +33,8 @@ each draw divided by its prior (bilby's hyper-likelihood from stored samples; :m
 It keeps the shape of a skewed posterior, which a normal of the draws' mean and sd does not: the
 long upper tail of a test whose f is weakly fixed would pull that mean up and inflate that sd.
 Without draws the test's likelihood is the normal N(y; law, sqrt(sd_y^2 + law_var)).
-Priors: a, d, s uniform on (0, 5); v_c log-uniform on (0.3, 300) m/s; c ~ N(0, 1); delta ~ N(0, 0.3).
+Priors: a, d, s uniform on (0, 5); v_c log-uniform on (0.3, 300) m/s; c ~ N(0, 1); cal_s ~ N(0, 0.03);
+delta ~ N(0, 0.3).
 
 Sampled with emcee; leave-one-test-out ELPD by PSIS-LOO (ArviZ), with an exact refit for every
 test whose Pareto k exceeds 0.7.
@@ -52,6 +63,10 @@ LAW_PARAMS = {"constant": ("a",), "velocity": ("d", "s", "log_vc"), "pressure": 
               "pressure+velocity": ("d", "s", "log_vc", "c")}
 LOG_VC_RANGE = (np.log(0.3), np.log(300.0))
 PARETO_K_MAX = 0.7
+#: Prior sd of a set-up's calibration offset (module docstring).
+CALIBRATION_SD = 0.03
+#: Prior sd of a free set-up offset (flag models only).
+FREE_OFFSET_SD = 0.3
 #: an exact leave-one-out refit's chain: it starts from the full fit's walkers, so it burns in less
 REFIT = {"nwalkers": 32, "nsteps": 700, "burn": 200}
 
@@ -114,18 +129,41 @@ class LawData:
 
 @dataclass(frozen=True)
 class Model:
-    """A law, optionally with a multiplicative offset on one set-up."""
+    """A law, with calibration offsets on the set-ups ``calibrated`` and optionally a free offset on one
+    set-up (``offset_setup``; module docstring)."""
 
     law: str
     offset_setup: str | None = None
+    calibrated: tuple[str, ...] = ()
+    #: set-ups flagged already: their level is left out of the law (a free offset, ``free_<set-up>``)
+    freed: tuple[str, ...] = ()
 
     @property
     def name(self) -> str:
-        return self.law if self.offset_setup is None else f"{self.law} + offset {self.offset_setup}"
+        free = self.freed + ((self.offset_setup,) if self.offset_setup else ())
+        return self.law + "".join(f" + offset {s}" for s in free)
+
+    @property
+    def cal_setups(self) -> tuple[str, ...]:
+        """The set-ups with a calibration offset (a set-up with a free offset needs none)."""
+        return tuple(s for s in self.calibrated if s != self.offset_setup and s not in self.freed)
 
     @property
     def params(self) -> tuple[str, ...]:
-        return LAW_PARAMS[self.law] + (("delta",) if self.offset_setup else ()) + ("r",)
+        return (LAW_PARAMS[self.law] + tuple(f"cal_{s}" for s in self.cal_setups)
+                + tuple(f"free_{s}" for s in self.freed) + (("delta",) if self.offset_setup else ()) + ("r",))
+
+    def setup_scale(self, theta: dict[str, np.ndarray], setups: Sequence[str]) -> np.ndarray | float:
+        """(1 + cal_s)(1 + free_s)(1 + delta) of each test's set-up: (W, n), or 1.0 without offsets."""
+        scale: np.ndarray | float = 1.0
+        for s in self.cal_setups + self.freed:
+            on = np.array([x == s for x in setups])
+            key = f"cal_{s}" if s in self.cal_setups else f"free_{s}"
+            scale = scale * np.where(on[None, :], 1.0 + theta[key], 1.0)
+        if self.offset_setup is not None:
+            on = np.array([x == self.offset_setup for x in setups])
+            scale = scale * np.where(on[None, :], 1.0 + theta["delta"], 1.0)
+        return scale
 
 
 def law_mean(law: str, theta: dict[str, np.ndarray], V: np.ndarray, p_rel: np.ndarray) -> np.ndarray:
@@ -167,9 +205,8 @@ class Fit:
         hV, hp = 1e-3 * np.maximum(d.V, 1.0), 1e-3
         dV = (law_mean(self.model.law, th, d.V + hV, p_rel) - law_mean(self.model.law, th, d.V - hV, p_rel)) / (2 * hV)
         dp = (law_mean(self.model.law, th, d.V, p_rel + hp) - law_mean(self.model.law, th, d.V, p_rel - hp)) / (2 * hp)
-        if self.model.offset_setup is not None:
-            on = np.array([s == self.model.offset_setup for s in d.setups])
-            scale = np.where(on[None, :], 1.0 + th["delta"], 1.0)
+        if self.model.offset_setup is not None or self.model.cal_setups or self.model.freed:
+            scale = self.model.setup_scale(th, d.setups)
             mean, dV, dp = mean * scale, dV * scale, dp * scale
         var = (dV * d.V_sd) ** 2 + (dp * d.p_sd / self.p_ref) ** 2 + (th["r"] * mean) ** 2
         if kernels is None:
@@ -190,8 +227,10 @@ class Fit:
                 lp += np.where((v > LOG_VC_RANGE[0]) & (v < LOG_VC_RANGE[1]), 0.0, -np.inf)
             elif name == "c":
                 lp += -0.5 * v**2
-            elif name == "delta":
-                lp += np.where(v > -1, -0.5 * (v / 0.3) ** 2, -np.inf)
+            elif name == "delta" or name.startswith("free_"):
+                lp += np.where(v > -1, -0.5 * (v / FREE_OFFSET_SD) ** 2, -np.inf)
+            elif name.startswith("cal_"):
+                lp += np.where(v > -1, -0.5 * (v / CALIBRATION_SD) ** 2, -np.inf)
             elif name == "r":
                 lp += np.where(v >= 0, -0.5 * (v / 0.1) ** 2, -np.inf)
         return lp
@@ -206,7 +245,7 @@ class Fit:
 
     def _start(self, rng: np.random.Generator, nwalkers: int) -> np.ndarray:
         guess = {"a": 1.0, "d": 0.8, "s": 1.3, "log_vc": np.log(8.0), "c": 0.0, "delta": 0.0, "r": 0.02}
-        x0 = np.array([guess[p] for p in self.model.params])
+        x0 = np.array([guess.get(p, 0.0) for p in self.model.params])
         best = x0
         # a few rounds of random search from the guess: a start inside the support, near the mode
         for width in (0.3, 0.1, 0.03, 0.01):

@@ -1,13 +1,17 @@
 """The campaign's outputs: ``campaign.json`` (schema below), ``campaign.nc`` and the text summary.
 
-``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 1``): ``records`` (each
+``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 2``; version 1 had no weights, and its set-up offsets were free): ``records`` (each
 record's path, set-up, test id, ``status`` done | skipped | failed, the refusal ``message``,
-seconds), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
+seconds, the ``causes`` its diagnosis named or null), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
 scatter ``sigma`` with 90 % intervals, each test's effective sample size, the Monte Carlo variance
-of the hyper-log-likelihood, or ``refused`` with the reason), ``friction_law`` (``best``: one of
-constant, velocity, pressure, pressure+velocity or null; ``chosen_model``; ``ranking``: every
-model with ELPD, dELPD and its SE against the top; ``posterior`` of the chosen (else top) model's
-parameters in f units; ``models``: the same for every model; ``nu`` the campaign's nu),
+of the hyper-log-likelihood, or ``refused`` with the reason), ``friction_law`` (``best``: the law that
+carries the stacking weight (one of constant, velocity, pressure, pressure+velocity) or null;
+``chosen_model``; ``weights``: each law's stacking weight; ``supported``: the fewest laws carrying 90 %
+of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and its weight;
+``posterior`` of the best (else heaviest) law's parameters in f units; ``models``: the same for every
+model; ``meanings``: each parameter in words with its unit; ``next_tests``: when the laws are not separated,
+each candidate test (set-up, V, p) with the expected information it brings on which law holds, most
+informative first (:mod:`.next_test`); ``nu`` the campaign's nu),
 ``wall_seconds`` (``records``: the records' tasks, ``analysis``: the campaign's own analysis; added by
 ``run_campaign``), ``flagged`` (set-ups and tests; a set-up's entry says the ``basis`` its offset was measured on:
 the law's, or, for a diagnosed campaign, also ``kappa`` of the stationary analysis with
@@ -27,30 +31,47 @@ import numpy as np
 
 from .. import __version__
 from .._atomic import atomic_path
-from .analysis import CampaignAnalysis, f_law_draws
+from .analysis import WEIGHT_RULE, CampaignAnalysis, f_law_draws
 from .job import RecordResult
 
 SCHEMA = "friction-uq/campaign"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+
+
+#: The law parameters' meanings and units, as the JSON's ``friction_law.meanings`` and the sentences give them.
+MEANINGS = {
+    "f": "f (-)",
+    "f_ref": "f at the campaign's mean wall pressure (-)",
+    "f_s": "f at rest, V -> 0 (-)",
+    "f_d": "f at high sliding speed (-)",
+    "v_c": "speed over which f falls from f_s toward f_d (m/s)",
+    "c_per_p_ref": "relative change of f per mean wall pressure of pressure (-)",
+    "df_dp_per_MPa": "change of f per MPa of wall pressure (1/MPa)",
+    "scatter_rel": "test-to-test scatter of f beyond each test's own uncertainty (relative)",
+}
+
+
+def parameter_words(name: str) -> str:
+    """A law parameter in words with its unit ('calibration_B': set-up B's calibration offset, relative)."""
+    if name in MEANINGS:
+        return MEANINGS[name]
+    if name.startswith("calibration_"):
+        return f"set-up {name[12:]}'s calibration offset (relative)"
+    if name.startswith("offset_"):
+        return f"set-up {name[7:]}'s free offset (relative)"
+    return name
 
 
 def statements(ca: CampaignAnalysis) -> list[str]:
     """The campaign's conclusions in sentences (what the terminal and the report's first page say)."""
     out = []
-    for name, p in ca.pooled.items():
-        if p.refused:
-            out.append(p.refused)
-        else:
-            out.append(f"pooled {name} of the stationary analysis: population mean {p.mu['q50']:.4g} [{p.mu['q05']:.4g}, {p.mu['q95']:.4g}], "
-                       f"between-test scatter {p.sigma['q50']:.2g} [{p.sigma['q05']:.2g}, {p.sigma['q95']:.2g}] "
-                       f"(90 %; {len(p.tests)} tests, smallest ESS {min(p.ess.values()):.0f}, "
-                       f"MC variance {p.mc_variance:.2g})")
-    if ca.best:
-        post = ca.law_posterior
-        parts = [f"{k} {v['q50']:.3g} [{v['q05']:.3g}, {v['q95']:.3g}]" for k, v in post.items()]
-        basis = "" if ca.law_data.basis == "kappa" else f", fitted to {ca.law_data.meaning}"
-        out.append(f"friction law: {ca.best} (model {ca.chosen}{basis}); " + ", ".join(parts))
     out.extend(ca.sentences)
+    if ca.law_posterior:
+        name = ca.chosen or ca.law_models[max(ca.weights, key=ca.weights.get)]
+        parts = [f"{parameter_words(k)} {v['q50']:.3g} [{v['q05']:.3g}, {v['q95']:.3g}]"
+                 for k, v in ca.law_posterior.items()]
+        basis = "" if ca.law_data.basis == "kappa" else f", fitted to {ca.law_data.meaning}"
+        out.append(f"{name} law{basis} (median [90 %]): " + "; ".join(parts))
     for f in ca.flagged:
         if "setup" in f:
             off = f["offset"]
@@ -65,6 +86,15 @@ def statements(ca: CampaignAnalysis) -> list[str]:
         else:
             out.append(f"flagged: test {f['test']} lies {f['below_median_by']:.1f} below the others' leave-one-out "
                        "log density under the chosen law")
+    for name, p in ca.pooled.items():  # after the law: what the tests share, whatever f depends on
+        if p.refused:
+            out.append(p.refused)
+        else:
+            out.append(f"pooled {name} of the stationary analysis: population mean {p.mu['q50']:.4g} "
+                       f"[{p.mu['q05']:.4g}, {p.mu['q95']:.4g}], between-test scatter {p.sigma['q50']:.2g} "
+                       f"[{p.sigma['q05']:.2g}, {p.sigma['q95']:.2g}] (90 %; {len(p.tests)} tests, smallest ESS "
+                       f"{min(p.ess.values()):.0f}, Monte Carlo variance of the pooled log-likelihood "
+                       f"{p.mc_variance:.2g})")
     return out
 
 
@@ -75,7 +105,8 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
         "schema": SCHEMA, "schema_version": SCHEMA_VERSION, "friction_uq_version": __version__, "seed": seed,
         "settings": settings, "counts": counts,
         "records": [{"path": r.path, "campaign": r.campaign, "test_id": r.test_id, "status": r.status,
-                     "message": r.message, "seconds": r.seconds, "converged": r.converged, "notes": r.notes}
+                     "message": r.message, "seconds": r.seconds, "converged": r.converged, "notes": r.notes,
+                     "causes": r.causes}
                     for r in results],
     }
     if ca is None:
@@ -90,7 +121,11 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
     doc |= {
         "pooled": {k: p.to_json() for k, p in ca.pooled.items()},
         "friction_law": {"best": ca.best, "chosen_model": ca.chosen, "ranking": ca.ranking,
+                         "weights": ca.weights, "supported": WEIGHT_RULE.supported(ca.weights) if ca.weights else [],
                          "posterior": ca.law_posterior, "models": models,
+                         "meanings": {k: parameter_words(k) for m in models.values() for k in m},
+                         "next_tests": [{"setup": c.setup, "V": c.V, "p": c.p, "information_nats": c.information}
+                                        for c in ca.next_tests],
                          "nu": {"mean": ca.nu[0], "sd": ca.nu[1]},
                          "fitted_to": None if ca.law_data is None else ca.law_data.meaning},
         "flagged": ca.flagged,

@@ -144,6 +144,10 @@ def open_client(*, workers: int, scheduler: str | None, timeout: float = CONNECT
     import dask
     from dask.distributed import Client, LocalCluster
 
+    from .._logfile import reroute
+
+    reroute()  # dask.distributed set up its own log handlers when imported: its messages go to the log file
+
     if scheduler:
         try:
             return Client(scheduler, timeout=f"{timeout}s")

@@ -18,14 +18,37 @@ from .style import RC, figure
 CampaignAnalysis = Any
 
 
-def _text_page(title: str, lines: list[str]):
-    fig, ax = figure(title)
+def _wrapped(lines: list[str], width: int = 150) -> str:
+    return "\n".join(textwrap.fill(line, width) for line in lines)
+
+
+def _summary_page(ca: CampaignAnalysis, doc: dict[str, Any]):
+    """The verdict in sentences, then every test in a table: set-up, test, V, p, f with its interval, causes."""
+    fig, ax = figure(f"Campaign: {doc['counts']['done'] + doc['counts']['skipped']} tests analysed, "
+                     f"{doc['counts']['failed']} refused")
     ax.axis("off")
-    wrapped = []
-    for line in lines:
-        wrapped.extend(textwrap.wrap(line, 125, subsequent_indent="    ") or [""])
-    ax.text(0.0, 1.0, "\n".join(wrapped[:60]), va="top", ha="left", family="monospace", fontsize=8,
-            transform=ax.transAxes)
+    ax.text(0.0, 1.0, _wrapped(doc["statements"][:12]), va="top", ha="left", fontsize=9, transform=ax.transAxes)
+    causes = {(r["campaign"], r["test_id"]): r.get("causes") for r in doc["records"]}
+    rows = []
+    for t in ca.tests:
+        f = t.f_model if t.f_model is not None else t.f
+        q = np.quantile(f, [0.05, 0.5, 0.95])
+        named = causes.get((t.setup, t.label.split(" ")[-1]))
+        rows.append([t.setup, t.label.split(" ")[-1], f"{t.V['mean']:.2f}", f"{np.median(t.p_mean) * 1e-6:.0f}",
+                     f"{q[1]:.4f} [{q[0]:.4f}, {q[2]:.4f}]", "not diagnosed" if named is None else
+                     (", ".join(named) or "none")])
+    for r in doc["records"]:
+        if r["status"] == "failed":
+            rows.append([str(r["campaign"] or "-"), str(r["test_id"] or "-"), "", "", "refused", textwrap.shorten(
+                str(r["message"] or ""), 60)])
+    if rows:
+        head = ["set-up", "test", "V (m/s)", "p_mean (MPa)", "f, median [90 %]", "causes named (diagnose)"]
+        tab = ax.table(cellText=rows[:28], colLabels=head, loc="lower center", cellLoc="left",
+                       colWidths=[0.07, 0.1, 0.08, 0.1, 0.2, 0.45], bbox=[0.0, 0.0, 1.0, min(0.55, 0.03 * (len(rows) + 1))])
+        tab.auto_set_font_size(False)
+        tab.set_fontsize(8)
+    fig.text(0.01, 0.01, "f: under each test's diagnosed model where diagnose ran, else the stationary analysis "
+             "(eq. 17 with the hoop gauge).", fontsize=8)
     return fig
 
 
@@ -56,7 +79,7 @@ def _forest(ca: CampaignAnalysis):
 
 def _law_page(ca: CampaignAnalysis):
     d = ca.law_data
-    name = ca.chosen or str(ca.ranking[0]["model"])
+    name = ca.chosen or ca.law_models[max(ca.weights, key=ca.weights.get)]
     nu = ca.nu[0]
     head = f"f at the campaign's nu = {nu:.3f}" if d.basis == "kappa" else d.meaning
     fig, axes = figure(f"{head} against V and p (median, 90 %); band: {name} (90 %)", nrows=1, ncols=2)
@@ -85,18 +108,62 @@ def _law_page(ca: CampaignAnalysis):
 
 
 def _comparison_page(ca: CampaignAnalysis):
-    fig, ax = figure("Friction laws: leave-one-test-out ELPD (higher is better), +- SE")
-    r = ca.ranking
+    """The laws' stacking weights as bars, each with its dELPD +- SE behind the best; the next-test advice."""
+    fig, axes = figure("Friction laws: which the data support (stacking weights) and which test would tell them apart",
+                       nrows=1, ncols=2)
+    ax = axes[0]
+    r = sorted(ca.ranking, key=lambda m: -float(m["weight"]))
     y = np.arange(len(r))[::-1]
-    ax.errorbar([m["elpd"] for m in r], y, xerr=[m["se"] for m in r], fmt="o", color="k", capsize=3,
-                label="ELPD +- SE")
-    top = r[0]["elpd"]
-    ax.errorbar([top - m["d_elpd"] for m in r[1:]], y[1:] - 0.2, xerr=[m["d_se"] for m in r[1:]], fmt="^",
-                color="C3", capsize=3, label="difference to the top +- its SE")
-    ax.set_yticks(y, [f"{m['model']}  (dELPD {m['d_elpd']:.1f} +- {m['d_se']:.1f})" for m in r])
-    ax.set_xlabel("ELPD (leave one test out)")
-    ax.legend(fontsize=8)
-    fig.subplots_adjust(left=0.35)
+    ax.barh(y, [float(m["weight"]) for m in r], color=["C0" if float(m["weight"]) >= 0.1 else "0.7" for m in r])
+    ax.set_yticks(y, [f"{m.get('law', m['model'])}\n(dELPD {float(m['d_elpd']):.1f} +- {float(m['d_se']):.1f})"
+                      for m in r])
+    ax.set_xlim(0, 1)
+    ax.set_xlabel("stacking weight (0-1): the share of the campaign's predictions each law carries")
+    ax.set_title("blue: 0.1 or more of the weight; grey: the data speak against it", loc="left", fontsize=9)
+    ax = axes[1]
+    if ca.next_tests:
+        for k, setup in enumerate(sorted({c.setup for c in ca.next_tests})):
+            pts = sorted((c.V, c.information) for c in ca.next_tests if c.setup == setup)
+            ax.plot([v for v, _ in pts], [i for _, i in pts], "o-", color=f"C{k}", label=f"set-up {setup}")
+        best = ca.next_tests[0]
+        ax.annotate(f"next: set-up {best.setup} at {best.V:.1f} m/s", (best.V, best.information),
+                    textcoords="offset points", xytext=(5, 8), fontsize=9)
+        ax.set_xlabel("sliding speed V of the new test (m/s)")
+        ax.set_ylabel("expected information on which law holds (nats)")
+        ax.legend(fontsize=8)
+    else:
+        ax.axis("off")
+        ax.text(0.0, 0.9, "One law carries the weight: no further test is needed to choose it.", fontsize=10,
+                transform=ax.transAxes)
+    fig.subplots_adjust(left=0.17)
+    return fig
+
+
+def _flag_page(ca: CampaignAnalysis):
+    """Set-ups and tests off the shared law, in a table, with the notes below."""
+    fig, ax = figure("Flags: set-ups and tests that do not follow the shared law")
+    ax.axis("off")
+    rows, notes = [], []
+    for f in ca.flagged:
+        if "setup" in f:
+            o = f["offset"]
+            rows.append([f"set-up {f['setup']}", "kappa (stationary)" if f.get("basis") == "kappa" else "f (diagnosed)",
+                         f"{o['q50'] * 100:+.1f} % [{o['q05'] * 100:+.1f}, {o['q95'] * 100:+.1f}]",
+                         f"{f['d_elpd']:.1f} +- {f['d_se']:.1f}"])
+            notes += [str(f[k]) for k in ("note", "note_diagnosed", "note_causes") if k in f]
+            notes += [str(c) for c in f["causes"].values()]
+        else:
+            rows.append([f"test {f['test']}", "under the law", f"{f['below_median_by']:.1f} below the median", ""])
+    if rows:
+        tab = ax.table(cellText=rows, colLabels=["what", "measured on", "offset from the law, median [90 %]",
+                                                  "evidence (dELPD +- SE)"], loc="upper left", cellLoc="left",
+                       bbox=[0.0, max(0.45, 1.0 - 0.06 * (len(rows) + 1)), 1.0, min(0.5, 0.06 * (len(rows) + 1))])
+        tab.auto_set_font_size(False)
+        tab.set_fontsize(9)
+        ax.text(0.0, 0.42, _wrapped(notes[:14]), va="top", fontsize=9, transform=ax.transAxes)
+    else:
+        ax.text(0.0, 0.9, "Nothing flagged: every set-up and test follows the shared law within its calibration "
+                "(3 %).", fontsize=10, transform=ax.transAxes)
     return fig
 
 
@@ -106,28 +173,12 @@ def write_campaign_report(ca: CampaignAnalysis, doc: dict[str, Any], path: str |
     from matplotlib.backends.backend_pdf import PdfPages
 
     out = Path(path)
-    records = [f"{Path(r['path']).name:<22} {r['campaign']!s:<6} {r['test_id']!s:<8} {r['status']:<8} "
-               f"{r['message'] or ''}" for r in doc["records"]]
     with plt.rc_context(RC):
-        pages = [_text_page("Campaign summary", doc["statements"] + [""] + records)]
+        pages = [_summary_page(ca, doc)]
         if ca.tests:
             pages.append(_forest(ca))
         if ca.law_data is not None and ca.ranking:
-            pages += [_law_page(ca), _comparison_page(ca)]
-            flag_lines = [f"{'what':<12} {'on':<6} {'offset / gap':<28} {'dELPD':>7} {'SE':>5}"]
-            for f in ca.flagged:
-                if "setup" in f:
-                    o = f["offset"]
-                    flag_lines.append(f"set-up {f['setup']:<5} {f.get('basis', ca.law_data.basis):<6} "
-                                      f"{o['q50'] * 100:+6.1f} % [{o['q05'] * 100:+.1f}, {o['q95'] * 100:+.1f}]"
-                                      f"{'':<6} {f['d_elpd']:>7.1f} {f['d_se']:>5.1f}")
-                    flag_lines += ["    " + str(f[k]) for k in ("note", "note_diagnosed", "note_causes") if k in f]
-                    flag_lines += ["    " + str(c) for c in f["causes"].values()]
-                else:
-                    flag_lines.append(f"test {f['test']:<7} {f['below_median_by']:>6.1f} below median")
-            if not ca.flagged:
-                flag_lines.append("nothing flagged: every set-up and test follows the shared law")
-            pages.append(_text_page("Flags: set-ups and tests off the shared law", flag_lines))
+            pages += [_law_page(ca), _comparison_page(ca), _flag_page(ca)]
         with atomic_path(out) as tmp, PdfPages(tmp) as pdf:
             for fig in pages:
                 pdf.savefig(fig)

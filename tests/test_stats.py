@@ -65,3 +65,31 @@ def test_same_seed_same_bits():
     a = exact_draws(NORMAL.logpdf, MU, S, 2 * S, rng=np.random.default_rng(7))
     b = exact_draws(NORMAL.logpdf, MU, S, 2 * S, rng=np.random.default_rng(7))
     assert np.array_equal(a.z_adjusted, b.z_adjusted)
+
+
+def test_stacking_weights_go_to_the_model_that_predicts_better_and_are_shared_by_equals():
+    from friction_uq.stats import WeightRule, stacking_weights
+
+    rng = np.random.default_rng(0)
+    a = rng.normal(-1.0, 0.3, 12)
+    w = stacking_weights({"a": a, "b": a - 0.3 + rng.normal(0, 0.05, 12), "a_twin": a.copy()})
+    assert w["b"] < 0.01 and w["a"] + w["a_twin"] == pytest.approx(1.0, abs=1e-4)
+    # without the bootstrap the optimum is ArviZ's stacking
+    from friction_uq.stats.weights import arviz_stacking
+
+    pts = {"a": a, "b": a - 0.05 + rng.normal(0, 0.2, 12), "c": a + rng.normal(0, 0.3, 12)}
+    ours, theirs = stacking_weights(pts, bootstrap=0), arviz_stacking(pts)
+    assert all(ours[k] == pytest.approx(theirs[k], abs=0.02) for k in pts), (ours, theirs)
+
+
+def test_bootstrapped_stacking_shares_the_weight_of_a_near_tie_and_keeps_a_clear_lead():
+    from friction_uq.stats import WeightRule, stacking_weights
+
+    rng = np.random.default_rng(3)
+    base = rng.normal(-1.0, 0.5, 10)
+    d = np.r_[np.full(5, 0.5), np.full(5, -0.45)]  # a ahead by 0.25 +- 1.5 nats: a tie
+    tie = stacking_weights({"a": base + d, "b": base}, seed=1)
+    assert 0.2 < tie["a"] < 0.8 and len(WeightRule().supported(tie)) == 2
+    assert tie == stacking_weights({"a": base + d, "b": base}, seed=1)  # same seed, same weights
+    far = stacking_weights({"a": base + 2.0, "b": base}, seed=1)  # 20 nats ahead on every point
+    assert far["a"] > 0.99 and WeightRule().supported(far) == ["a"]

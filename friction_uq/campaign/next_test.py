@@ -1,0 +1,93 @@
+"""Which test to run next: the expected information one more test brings on which law holds.
+
+For a campaign whose laws are not separated, each candidate test (a set-up of the campaign at a
+striker speed giving a sliding speed V within the tested range, its wall pressure p read from the
+set-up's own (V, p) line) is scored by the mutual information between the law K and the test's
+outcome y (Lindley 1956; for telling models apart, Box and Hill 1967):
+
+    I(K; y) = H(sum_k w_k p_k(y)) - sum_k w_k H(p_k(y)),
+
+with w_k the laws' stacking weights (renormalised over the laws still in play) and p_k the law's
+posterior predictive of the new test's value: the law's draws at (V, p) for that set-up (with its
+calibration offset), widened by the law's test-to-test scatter and by a test's own uncertainty (the
+median of the campaign's), each taken as normal. H of the mixture is a Monte Carlo average of
+-log density (seeded). I is in nats, at most the entropy of the weights (log 2 for two laws equally
+weighted): a test where the laws predict the same value brings nothing, one where their predictions
+do not overlap settles the question.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import logsumexp
+
+from .laws import Fit, law_mean
+
+#: Laws with at least this stacking weight are still in play.
+IN_PLAY = 0.05
+#: Sliding speeds tried per set-up, over the campaign's tested range.
+GRID = 9
+
+
+@dataclass(frozen=True)
+class Candidate:
+    setup: str
+    V: float
+    p: float
+    information: float  # nats
+
+
+def _predictive(fit: Fit, setup: str, V: float, p: float, test_sd: float) -> tuple[float, float]:
+    """Mean and variance of the law's predictive of one new test (in the fit's units, y = kappa / kappa_bar)."""
+    x = fit.draws[:: max(1, len(fit.draws) // 400)]
+    th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
+    y = law_mean(fit.model.law, th, np.array([V]), np.array([(p - fit.p_ref) / fit.p_ref]))
+    y = (y * fit.model.setup_scale(th, [setup]))[:, 0]
+    var = float(np.var(y) + np.mean((th["r"][:, 0] * y) ** 2) + test_sd**2)
+    return float(np.mean(y)), var
+
+
+def information(means: np.ndarray, variances: np.ndarray, weights: np.ndarray, rng: np.random.Generator,
+                n: int = 4000) -> float:
+    """I(K; y) for a mixture of normals (module docstring), by Monte Carlo over the mixture."""
+    w = weights / weights.sum()
+    k = rng.choice(len(w), size=n, p=w)
+    y = rng.normal(means[k], np.sqrt(variances[k]))
+    log_comp = -0.5 * (y[:, None] - means[None, :]) ** 2 / variances[None, :] - 0.5 * np.log(2 * np.pi * variances)
+    h_mix = -float(np.mean(logsumexp(log_comp + np.log(w)[None, :], axis=1)))
+    h_each = float(np.sum(w * 0.5 * np.log(2 * np.pi * np.e * variances)))
+    return max(0.0, h_mix - h_each)
+
+
+def rank_next_tests(fits: dict[str, Fit], weights: dict[str, float], *, seed: int) -> list[Candidate]:
+    """Every candidate test, the most informative first; empty when fewer than two laws are in play."""
+    play = [k for k, w in weights.items() if w >= IN_PLAY and k in fits]
+    if len(play) < 2:
+        return []
+    w = np.array([weights[k] for k in play])
+    data = fits[play[0]].data
+    test_sd = float(np.median(data.kappa_sd)) / fits[play[0]].kbar
+    rng = np.random.default_rng(seed)
+    out = []
+    for setup in sorted(set(data.setups)):
+        on = np.array([s == setup for s in data.setups])
+        coef = np.polyfit(data.V[on], data.p[on], 1) if on.sum() > 1 else np.array([0.0, data.p[on][0]])
+        for V in np.linspace(data.V.min(), data.V.max(), GRID):
+            p = float(np.polyval(coef, V))
+            pred = [_predictive(fits[k], setup, float(V), p, test_sd) for k in play]
+            m, v = np.array([a for a, _ in pred]), np.array([b for _, b in pred])
+            out.append(Candidate(setup, float(V), p, information(m, v, w, rng)))
+    return sorted(out, key=lambda c: -c.information)
+
+
+def advice(cands: list[Candidate], weights: dict[str, float]) -> str | None:
+    """One sentence for the summary, or None when the laws are separated already."""
+    if not cands:
+        return None
+    best = cands[0]
+    play = [k for k, w in weights.items() if w >= IN_PLAY]
+    return (f"the most informative next test: set-up {best.setup} at a sliding speed of {best.V:.1f} m/s "
+            f"(wall pressure about {best.p * 1e-6:.0f} MPa): it is expected to bring {best.information:.2f} nats "
+            f"on which of {', '.join(play)} holds (the least informative candidate: {cands[-1].information:.2f})")

@@ -1,0 +1,33 @@
+"""The expected information of one more test on which law holds (friction_uq.campaign.next_test)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from friction_uq.campaign.next_test import Candidate, advice, information
+
+
+def test_laws_that_predict_alike_gain_nothing_and_laws_far_apart_gain_the_weights_entropy():
+    rng = np.random.default_rng(0)
+    w = np.array([0.5, 0.5])
+    same = information(np.array([1.0, 1.0]), np.array([0.01, 0.01]), w, rng)
+    apart = information(np.array([1.0, 2.0]), np.array([1e-4, 1e-4]), w, rng)
+    assert same == pytest.approx(0.0, abs=0.02)
+    assert apart == pytest.approx(math.log(2.0), abs=0.02)  # a test that settles the question
+    # unequal weights: at most their entropy
+    w2 = np.array([0.9, 0.1])
+    assert information(np.array([1.0, 2.0]), np.array([1e-4, 1e-4]), w2, rng) == pytest.approx(
+        -(0.9 * math.log(0.9) + 0.1 * math.log(0.1)), abs=0.02)
+    # in between: partly overlapping predictions bring part of it, more as they separate
+    mid = [information(np.array([1.0, 1.0 + d]), np.array([0.01, 0.01]), w, rng) for d in (0.05, 0.1, 0.2)]
+    assert 0.0 < mid[0] < mid[1] < mid[2] < math.log(2.0)
+
+
+def test_the_advice_names_the_best_candidate():
+    cands = [Candidate("B", 12.0, 1.4e8, 0.41), Candidate("A", 6.0, 5e7, 0.02)]
+    text = advice(cands, {"velocity": 0.5, "pressure": 0.45, "constant": 0.05})
+    assert text.startswith("the most informative next test: set-up B at a sliding speed of 12.0 m/s")
+    assert "0.41 nats" in text and advice([], {}) is None
