@@ -166,7 +166,7 @@ def test_default_prior_path_lists_available_materials(tmp_path):
     write(tmp_path, GOOD, "A.toml")
     write(tmp_path, GOOD, "B.toml")
     assert default_prior_path("A", directory=tmp_path) == tmp_path / "A.toml"
-    with pytest.raises(PriorError, match=r"no prior file for material 'PBX9501'; available: A, B"):
+    with pytest.raises(PriorError, match=r"no prior file for material 'PBX9501'; materials: A, B; write one with 'friction-uq priors PBX9501"):
         default_prior_path("PBX9501", directory=tmp_path)
     assert default_prior_path("I1") == PRIORS_DIR / "I1.toml"
 
