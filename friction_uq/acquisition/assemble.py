@@ -80,16 +80,20 @@ def _time_base(setup: Setup, file: Path, table_time: np.ndarray | None, trace: T
         n = len(t)
         if n < 2:
             raise ScopeFileError(f"{file}: the time column has {n} value(s); a record needs many samples")
-        dt = (t[-1] - t[0]) / (n - 1)
+        step = np.diff(t)
+        dt = float(np.median(step))
         if not dt > 0:
             raise ScopeFileError(f"{file}: the time column {ts.column!r} does not increase (from {t[0]:g} to {t[-1]:g} s)")
-        resid = np.abs(t - (t[0] + np.arange(n) * dt))
-        bad = np.flatnonzero(resid > TIME_JITTER * dt)
+        bad = np.flatnonzero(np.abs(step - dt) > TIME_JITTER * dt)  # a jump between two rows
+        if not bad.size:  # or a slow drift: the times against one even step
+            bad = np.flatnonzero(np.abs(t - (t[0] + np.arange(n) * dt)) > TIME_JITTER * dt) - 1
         if bad.size:
-            i = int(bad[0])
+            i = int(bad[0]) + 1
             raise ScopeFileError(f"{file}: line {first_line + i}: the time column {ts.column!r} is not evenly spaced "
-                                 f"(it reads {t[i]:.9g} s where a step of {dt:.6g} s gives {t[0] + i * dt:.9g} s): a "
-                                 "gap, a second segment or a time column in another unit (see [time] units)")
+                                 f"(it reads {t[i]:.9g} s where a step of {dt:.6g} s from the row before gives "
+                                 f"{t[i - 1] + dt:.9g} s): a gap, a second segment or a time column in another unit "
+                                 "(see [time] units)")
+        dt = (t[-1] - t[0]) / (n - 1)
         rate = float(f"{1.0 / dt:.9g}")  # the rate to 9 digits: the printed times' rounding is not a rate
         return float(t[0]), 1.0 / rate
     if trace.dt is None:
@@ -243,9 +247,13 @@ def _read_back_and_check(tmp: str, setup: Setup, chans: list[Channel], check: bo
     except RecordError as exc:
         raise _translate(exc, setup, chans) from None
     refusals, warnings = import_findings(rec, setup)
-    if refusals and check:
-        raise ScopeFileError(f"{setup.path}: {refusals[0]} (friction-uq import --no-check writes the record anyway)")
-    return tuple(refusals + warnings)
+    said = []
+    for channel, text in refusals:
+        c = next((c for c in chans if c.setup.gauge == channel), None)
+        said.append(f"{c.file}: column {c.label} ([channels.{channel}]): {text}" if c else f"{setup.path}: {text}")
+    if said and check:
+        raise ScopeFileError(f"{said[0]} (friction-uq import --no-check writes the record anyway)")
+    return tuple(said + warnings)
 
 
 def describe(outcome: ImportOutcome) -> list[str]:

@@ -99,11 +99,16 @@ def _header(path: Path, head: list[str], start: int, delim: str | None, wanted: 
         low = [c.lower() for c in f]
         if f and all(w in f or w.lower() in low for w in wanted):
             return i, f
-    if wanted:
-        above = next((i for i in range(start - 1, -1, -1) if head[i].strip()), None)
-        seen = f"; line {above + 1} has: {', '.join(_fields(head[above], delim)) or '(nothing)'}" if above is not None else ""
-        raise ScopeFileError(f"{path}: no header line above the data (line {start + 1}) names column "
-                             f"{next(w for w in wanted)!r}{seen}")
+    if wanted:  # name the first missing column against the line that names most of them
+        lines = [(sum(w.lower() in [c.lower() for c in _fields(head[i], delim)] for w in wanted), i)
+                 for i in range(start - 1, max(-1, start - 60), -1) if head[i].strip()]
+        if not lines:
+            raise ScopeFileError(f"{path}: no header line above the data (line {start + 1}); name the columns by "
+                                 "number (column = 2)")
+        _, best = max(lines, key=lambda x: x[0])
+        f = _fields(head[best], delim)
+        miss = next(w for w in wanted if w.lower() not in [c.lower() for c in f])
+        raise ScopeFileError(f"{path}: column {miss!r} not found; the header line {best + 1} has: {', '.join(f)}")
     for i in range(start - 1, max(-1, start - 60), -1):  # for messages only: the nearest non-numeric line
         if head[i].strip():
             return i, _fields(head[i], delim)

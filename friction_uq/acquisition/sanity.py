@@ -27,7 +27,16 @@ def _fix(g: GaugeFinding, setup: Setup) -> str:
     return ""
 
 
-def import_findings(record: Record, setup: Setup) -> tuple[list[str], list[str]]:
-    """(refusals, warnings) as sentences, each fault with the fix in ``setup``'s terms."""
+def import_findings(record: Record, setup: Setup) -> tuple[list[tuple[str, str]], list[str]]:
+    """(refusals as (channel or "", sentence), warnings); each fault with the fix in ``setup``'s terms.
+
+    A sentence about one channel leaves out its ``/signals/<channel>`` (the caller names the file and column).
+    """
     faults, notes = record_gauge_check(record)
-    return [g.sentence + _fix(g, setup) for g in faults], [g.sentence for g in notes if g.kind != "ok"]
+    out = []
+    for g in faults:
+        text = g.sentence + _fix(g, setup)
+        if g.channel:
+            text = text.removeprefix(f"/signals/{g.channel}").removeprefix(":").strip()
+        out.append((g.channel, text))
+    return out, [g.sentence for g in notes if g.kind != "ok"]
