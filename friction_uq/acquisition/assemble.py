@@ -85,15 +85,18 @@ def _time_base(setup: Setup, file: Path, table_time: np.ndarray | None, trace: T
         if not dt > 0:
             raise ScopeFileError(f"{file}: the time column {ts.column!r} does not increase (from {t[0]:g} to {t[-1]:g} s)")
         bad = np.flatnonzero(np.abs(step - dt) > TIME_JITTER * dt)  # a jump between two rows
-        if not bad.size:  # or a slow drift: the times against one even step
-            bad = np.flatnonzero(np.abs(t - (t[0] + np.arange(n) * dt)) > TIME_JITTER * dt) - 1
         if bad.size:
             i = int(bad[0]) + 1
             raise ScopeFileError(f"{file}: line {first_line + i}: the time column {ts.column!r} is not evenly spaced "
                                  f"(it reads {t[i]:.9g} s where a step of {dt:.6g} s from the row before gives "
                                  f"{t[i - 1] + dt:.9g} s): a gap, a second segment or a time column in another unit "
                                  "(see [time] units)")
-        dt = (t[-1] - t[0]) / (n - 1)
+        dt = (t[-1] - t[0]) / (n - 1)  # the mean step: the printed times' rounding averages out
+        bad = np.flatnonzero(np.abs(t - (t[0] + np.arange(n) * dt)) > TIME_JITTER * dt)  # or a slow drift
+        if bad.size:
+            i = int(bad[0])
+            raise ScopeFileError(f"{file}: line {first_line + i}: the time column {ts.column!r} drifts from an even "
+                                 f"step of {dt:.6g} s (it reads {t[i]:.9g} s, the step gives {t[0] + i * dt:.9g} s)")
         rate = float(f"{1.0 / dt:.9g}")  # the rate to 9 digits: the printed times' rounding is not a rate
         return float(t[0]), 1.0 / rate
     if trace.dt is None:
