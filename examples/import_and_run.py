@@ -45,18 +45,16 @@ def main(out: Path) -> Path:
     dt = res.datatree()
     print(az.summary(dt, var_names=["f", "nu", "kappa"], ci_prob=0.9, ci_kind="eti", round_to="none"))
 
-    post, prior = dt["posterior"], dt["prior"]
+    post = dt["posterior"]
     f_draws, nu_draws = post["f"].values.ravel(), post["nu"].values.ravel()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(7.0, 2.8), layout="constrained")
     ax1.plot(nu_draws, f_draws, ".", ms=1.5, alpha=0.3, color="C0", rasterized=True)
     ax1.set(xlabel=r"Poisson ratio $\nu$", ylabel="friction coefficient $f$", title="(a) joint posterior")
     bins = np.linspace(*np.quantile(f_draws, [0.001, 0.999]), 60)
-    ax2.hist(f_draws, bins=bins, density=True, color="C0", alpha=0.6, label="posterior")
-    ax2.hist(prior["f"].values.ravel(), bins=bins, density=True, histtype="step", color="0.4", label="prior")
+    ax2.hist(f_draws, bins=bins, density=True, color="C0", alpha=0.6)
     for q in (f["q05"], f["q95"]):
         ax2.axvline(q, color="k", lw=0.8, ls="--")
     ax2.set(xlabel="friction coefficient $f$", ylabel="density", title="(b) $f$, 90 % interval dashed")
-    ax2.legend(frameon=False, fontsize=8)
     fig.suptitle(f"test {res.test_id}: f = {f['q50']:.3f} [{f['q05']:.3f}, {f['q95']:.3f}]", fontsize=10)
     path = out / "A-03_f_nu.pdf"
     fig.savefig(path)
