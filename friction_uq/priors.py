@@ -397,7 +397,7 @@ def default_prior_path(material: str, *, directory: str | Path | None = None) ->
     path = folder / f"{material}.toml"
     if not path.is_file():
         known = prior_files(folder)
-        listed = "; ".join(f"{m} (nu alternatives: {', '.join(a)})" if a else m for m, a in known.items())
+        listed = ", ".join(f"{m} (nu alternatives: {', '.join(a)})" if a else m for m, a in known.items())
         raise _fail(
             path, "material",
             f"no prior file for material {material!r}; materials: {listed or 'none'}; write one with "

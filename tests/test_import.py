@@ -282,3 +282,15 @@ def test_a_sound_record_passes_inspect_quietly(capsys):
 def test_template_prints(capsys):
     assert main(["import", "--template"]) == 0
     assert tomllib.loads(capsys.readouterr().out)["channels"]["input_bar"]["bridge"] == "half"
+
+
+def test_bundled_scope_example_is_the_bundled_record(tmp_path, capsys):
+    """data/scope/ (docs/import.md's example) imports into a record that analyses as data/A/A-03.h5."""
+    scope = ROOT / "data" / "scope"
+    out = tmp_path / "A-03.h5"
+    assert main(["import", str(scope / "A-03_scope.csv"), "--setup", str(scope / "SETUP.toml"), "-o", str(out)]) == 0
+    assert "WARNING" not in capsys.readouterr().out
+    with h5py.File(out) as fh:
+        assert fh["signals/input_bar"].attrs["sign_applied"] == -1
+        assert fh["signals/input_bar"].attrs["strain_per_volt"] == pytest.approx(2e-4)  # from the bridge
+    assert_same_analysis(RECORD, out)
