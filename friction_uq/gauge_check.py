@@ -128,6 +128,11 @@ def incident_plateau(forces: Forces) -> float:
     return float(np.mean(e[ok & (e >= 0.5 * peak)])) if peak > 0 else float("nan")
 
 
+def _off(a: float) -> str:
+    """'k times too large' or 'k times too small' for a channel that multiplied by ``a`` would agree."""
+    return f"{1 / a:.3g} times too large" if a < 1 else f"{a:.3g} times too small"
+
+
 def scale_findings(forces: Forces, apparatus: Apparatus, *, striker_velocity: float | None = None) -> list[GaugeFinding]:
     """A channel whose scale contradicts the others' (a gauge factor, gain or strain_per_volt off), named.
 
@@ -165,8 +170,8 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *, striker_velocity: fl
             SCALE_FACTOR):
         v_s = 2.0 * apparatus.input_bar.wave_speed * incident_plateau(forces)
         return [GaugeFinding("", "scale", (
-            f"either /signals/input_bar looks {1 / ok['input_bar']:.3g} times too large or /signals/internal_output_bar "
-            f"{1 / ok['internal_output_bar']:.3g} times: {evidence}; the input gauge's incident wave stands for a "
+            f"either /signals/input_bar looks {_off(ok['input_bar'])} or /signals/internal_output_bar "
+            f"{_off(ok['internal_output_bar'])}: {evidence}; the input gauge's incident wave stands for a "
             f"striker at {v_s:.3g} m/s (eq. 14): if that is not the speed fired, the input gauge is the one off "
             "(record the striker's speed as striker_velocity and the check names the channel)"))]
     if len(ok) != 1:
@@ -175,7 +180,7 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *, striker_velocity: fl
     if abs(math.log(a)) < math.log(SCALE_FACTOR):
         return []
     return [GaugeFinding(channel, "scale", (
-        f"/signals/{channel} looks {1 / a:.3g} times too large: {evidence}; multiplying that channel by {a:.3g} "
+        f"/signals/{channel} looks {_off(a)}: {evidence}; multiplying that channel by {a:.3g} "
         "restores both (check its strain_per_volt, gauge factor, amplifier gain or units)"))]
 
 
@@ -200,8 +205,55 @@ def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFi
     if faults:
         return faults, []
     faults = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
+    if "tube_hoop" in forces.channels:
+        faults += hoop_findings(forces, record.apparatus, forces.channels["tube_hoop"].noise.sd)
     if faults:
         return faults, []
     s = force_balance(forces)
     return [], found or [GaugeFinding("", "ok", (
         f"signs agree and the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5)"))]
+
+
+#: Largest hoop-gauge kernel factor: a uniform band as long as the sample, read at its middle (docs/physics.md
+#: section 6: 0.77 of Lame for the paper's tube; 0.8 leaves room for another tube).
+HOOP_KERNEL_MAX = 0.8
+#: nu / (1 - nu) the hoop gauge may imply at most (nu < 0.5 gives < 1), with room for the kernel's spread.
+HOOP_K_MAX = 1.5
+
+
+def hoop_findings(forces: Forces, apparatus: Apparatus, hoop_noise_sd: float) -> list[GaugeFinding]:
+    """The tube's hoop gauge against the forces: it must read a swelling, and no more than nu < 0.5 allows.
+
+    Over the loading the wall pressure is nu / (1 - nu) times the axial stress (eq. 8), and the gauge
+    reads at most :data:`HOOP_KERNEL_MAX` of Lame's strain for it (docs/physics.md section 6). A
+    mean hoop strain of the wrong sign beyond 3 noise standard errors is a reversed gauge; one that
+    implies nu / (1 - nu) above :data:`HOOP_K_MAX` with the gauge at its most sensitive is a scale off
+    by a factor (a gauge too small by a factor cannot be told from a weak wall pressure, and is not
+    named).
+    """
+    if forces.hoop is None:
+        return []
+    m = loading_mask(forces)
+    n = int(m.sum())
+    if n < 8:
+        return []
+    h = float(np.mean(forces.hoop[m]))  # compression positive: a swelling tube reads negative
+    se = hoop_noise_sd / math.sqrt(n) * 10.0  # a generous allowance for correlated noise
+    if h > 3.0 * se:
+        return [GaugeFinding("tube_hoop", "reversed", (
+            f"/signals/tube_hoop reads the tube contracting through the loading (mean {h * 1e6:+.1f} microstrain "
+            "compression-positive while the sample is pushed): the gauge looks reversed (a swelling tube reads "
+            "positive, elongation positive)"))]
+    s = apparatus.sample
+    sigma = float(np.mean(forces.F_io[m] + 0.5 * forces.F_eo[m])) / s.area
+    lame = apparatus.tube.lame_hoop_strain_per_pressure
+    if sigma <= 0:
+        return []
+    k = -h / (lame * HOOP_KERNEL_MAX * sigma)
+    if k > HOOP_K_MAX:
+        return [GaugeFinding("tube_hoop", "scale", (
+            f"/signals/tube_hoop reads {-h * 1e6:.0f} microstrain of swelling where the sample's axial stress "
+            f"({sigma / 1e6:.0f} MPa over the loading) gives at most {lame * HOOP_KERNEL_MAX * sigma * 1e6:.0f} for any "
+            f"nu < 0.5 (eq. 8, the tube's Lame factor): it reads at least {k:.3g} times too much; check its "
+            "strain_per_volt, gauge factor, amplifier gain or units"))]
+    return []

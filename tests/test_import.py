@@ -170,6 +170,36 @@ def test_lecroy_traces_one_per_channel(tmp_path):
     assert b.f == pytest.approx(a.f, rel=1e-3)
 
 
+def _isf(path: Path, volts: np.ndarray, dt: float, t0: float, name: str) -> Path:
+    """A Tektronix ISF waveform (text preamble, 16-bit big-endian curve), written by hand."""
+    ymult = float(np.max(np.abs(volts))) / 30000.0
+    raw = np.round(volts / ymult).astype(">i2")
+    nbytes = str(2 * raw.size)
+    head = (f':WFMPRE:BYT_NR 2;BIT_NR 16;ENCDG BIN;BN_FMT RI;BYT_OR MSB;WFID "{name}, DC coupling, 2.0E-2 V/div";'
+            f'NR_PT {raw.size};PT_FMT Y;XUNIT "s";XINCR {dt:.6E};XZERO {t0:.6E};PT_OFF 0;YUNIT "V";'
+            f'YMULT {ymult:.6E};YOFF 0.0E+0;YZERO 0.0E+0;:CURVE #{len(nbytes)}{nbytes}')
+    path.write_bytes(head.encode() + raw.tobytes() + b"\n")
+    return path
+
+
+def test_tektronix_isf_one_per_channel(tmp_path):
+    pytest.importorskip("RigolWFM")
+    strains, rate, t0 = gauge_signals(RECORD)
+    files = [_isf(tmp_path / f"TEK000{i + 1}.ISF", eps / SPV[g], 1.0 / rate, t0, f"Ch{i + 1}")
+             for i, (g, eps) in enumerate(strains.items())]
+    doc = setup_doc(files={g: f.name for g, f in zip(strains, files)})
+    del doc["time"]
+    for c in doc["channels"].values():
+        c["column"] = 1
+    import_scope_files(files, parse_setup(doc, path=tmp_path / "SETUP.toml"), tmp_path / "r.h5")
+    imp, orig = read_record(tmp_path / "r.h5"), read_record(RECORD)
+    assert imp.sample_rate == pytest.approx(rate, rel=1e-9) and imp.t0 == pytest.approx(t0, abs=1e-12)
+    for g in strains:  # 16-bit samples: within one step of the scope's scale
+        step = np.abs(orig.strain(g)).max() / 30000
+        assert np.max(np.abs(imp.strain(g) - orig.strain(g))) <= 0.51 * step
+    assert identify(prepare(imp), nu=0.4).f == pytest.approx(identify(prepare(orig), nu=0.4).f, rel=1e-3)
+
+
 # ---- bad input: one sentence naming the file, the line or column, exit 2, nothing written ----------
 
 
@@ -249,11 +279,13 @@ def test_sample_rate_instead_of_a_time_column(tmp_path):
     ({"spv": {**SPV, "internal_output_bar": 2e-3}}, "internal_output_bar", "times too large"),
     ({"spv": {**SPV, "external_output_bar": 1e-3}}, "external_output_bar", "times too large"),
     ({"spv": {**SPV, "input_bar": 2e-3}}, "input_bar", "times what the striker's 9.9 m/s gives"),
+    ({"signs": {"tube_hoop": -1}}, "tube_hoop", "reads the tube contracting through the loading"),
+    ({"spv": {**SPV, "tube_hoop": 5e-4}}, "tube_hoop", "times too much"),
 ])
 def test_a_gauge_contradicting_the_others_is_named(tmp_path, scope_csv, capsys, fault, channel, words):
     err = _refused(tmp_path, [scope_csv], setup_doc(**fault), capsys)
     assert f"scope.csv: column '{COLUMNS[channel]}'" in err and f"[channels.{channel}]" in err and words in err
-    if "times" in words:  # the factor found is the one put in (within the balance's few %)
+    if "times too large" in words or "striker" in words:  # the factor found is the one put in (within a few %)
         assert 8.5 < float(re.search(r"(\d+\.?\d*) times", err).group(1)) < 11.5
     # written anyway on request, inspect names it too
     setup = tmp_path / "SETUP.toml"
@@ -262,6 +294,16 @@ def test_a_gauge_contradicting_the_others_is_named(tmp_path, scope_csv, capsys, 
     assert main(["inspect", str(tmp_path / "w.h5")]) == 0
     out = capsys.readouterr().out
     assert "GAUGE FAULT" in out and channel in out.split("GAUGE FAULT", 1)[1]
+
+
+def test_input_scale_without_the_striker_speed_names_both_candidates(tmp_path, scope_csv, capsys):
+    doc = setup_doc(spv={**SPV, "input_bar": 2e-3})
+    del doc["record"]["striker_velocity"]
+    err = _refused(tmp_path, [scope_csv], doc, capsys)
+    assert "either /signals/input_bar looks" in err and "or /signals/internal_output_bar" in err
+    assert "either /signals/input_bar looks 10" in err and "times too large or /signals/internal_output_bar 11" in err
+    v_s = float(re.search(r"stands for a striker at (\d+) m/s", err).group(1))
+    assert 90 < v_s < 110  # ten times the 9.9 m/s fired: the input gauge is the one off
 
 
 def test_swapped_output_channels_are_named(tmp_path, scope_csv, capsys):

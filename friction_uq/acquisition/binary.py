@@ -140,7 +140,7 @@ def read_rigolwfm(path: Path, columns: list[str | int]) -> dict[str | int, Trace
             raise ScopeFileError(f"{path}: no channel {col!r} with data; the file has {have}")
         c = hits[0]
         t = np.asarray(c.times, dtype=np.float64)
-        dt = float(t[1] - t[0]) if len(t) > 1 else None
+        dt = _rate_digits((t[-1] - t[0]) / (len(t) - 1), 9) if len(t) > 1 else None
         out[col] = Trace(np.asarray(c.volts, dtype=np.float64), c.name, float(t[0]), dt)
     return out
 
