@@ -25,6 +25,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--setup", type=Path, metavar="SETUP.toml", help="what the files hold and the apparatus")
     s.add_argument("-o", "--output", type=Path, help="record to write (test.h5)")
     s.add_argument("--template", action="store_true", help="print a commented SETUP.toml (the paper's set-up) and exit")
+    s.add_argument("--show", action="store_true",
+                   help="print what each FILE holds (layout, columns or channels, first values) and exit: for SETUP.toml")
     s.add_argument("--no-check", action="store_true",
                    help="write the record even when a gauge's sign or scale contradicts the others (warnings only)")
 
@@ -35,6 +37,19 @@ def run(args: argparse.Namespace, parser: argparse.ArgumentParser, output_check)
         from .acquisition.template import TEMPLATE
 
         print(TEMPLATE, end="")
+        return 0
+    if args.show:
+        if not args.files:
+            parser.error("import --show needs FILE: friction-uq import scope.csv --show")
+        from .acquisition.binary import BINARY_SUFFIXES, describe_binary
+        from .acquisition.delimited import describe_text
+        from .errors import ScopeFileError
+
+        for f in args.files:
+            if not f.is_file():
+                raise ScopeFileError(f"{f}: {'is a directory' if f.is_dir() else 'file not found'}")
+            lines = describe_binary(f) if f.suffix.lower() in BINARY_SUFFIXES else describe_text(f)
+            print("\n".join(lines))
         return 0
     missing = [n for n, v in (("FILE", args.files), ("--setup", args.setup), ("-o", args.output)) if not v]
     if missing:

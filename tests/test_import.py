@@ -336,3 +336,21 @@ def test_bundled_scope_example_is_the_bundled_record(tmp_path, capsys):
         assert fh["signals/input_bar"].attrs["sign_applied"] == -1
         assert fh["signals/input_bar"].attrs["strain_per_volt"] == pytest.approx(2e-4)  # from the bridge
     assert_same_analysis(RECORD, out)
+
+
+def test_show_says_what_a_file_holds(capsys):
+    """import --show: the layout, the lines above the data and each column, to write SETUP.toml from."""
+    assert main(["import", str(ROOT / "data" / "scope" / "A-03_scope.csv"), "--show"]) == 0
+    out = capsys.readouterr().out
+    assert "comma-separated, decimal mark '.'; 7 line(s) before the data, data from line 8, 6500 rows" in out
+    assert "line 6: Time, CH1, CH2, CH3, CH4" in out and "column names from line 6" in out
+    assert "'Time'" in out and "(evenly increasing: a time column?)" in out.split("'CH1'")[0]
+
+
+def test_show_lists_tdms_channels(tmp_path, capsys):
+    nptdms = pytest.importorskip("nptdms")
+    path = tmp_path / "shot.tdms"
+    with nptdms.TdmsWriter(str(path)) as w:
+        w.write_segment([nptdms.ChannelObject("scope", "CH1", np.zeros(100), properties={"wf_increment": 2e-7})])
+    assert main(["import", str(path), "--show"]) == 0
+    assert '"scope/CH1"  100 samples, every 2e-07 s from 0 s' in capsys.readouterr().out

@@ -153,3 +153,38 @@ def read_binary(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
     if s in LECROY_SUFFIXES:
         return read_lecroy(path, columns)
     return read_rigolwfm(path, columns)
+
+
+def describe_binary(path: Path) -> list[str]:
+    """What a binary scope file holds, for writing SETUP.toml: its channels, lengths and time bases."""
+    s = path.suffix.lower()
+    if s in TDMS_SUFFIXES:
+        _size(path)
+        nptdms = _need("nptdms", path)
+        try:
+            f = nptdms.TdmsFile.read(str(path))  # type: ignore[attr-defined]
+        except Exception as exc:
+            raise ScopeFileError(f"{path}: not a readable TDMS file ({type(exc).__name__}: {exc})") from None
+        out = [f"{path}: NI TDMS; column = \"group/channel\""]
+        for g in f.groups():
+            for c in g.channels():
+                dt = c.properties.get("wf_increment")
+                tb = f", every {dt:.6g} s from {c.properties.get('wf_start_offset', 0.0):.6g} s" if dt else ", no time base"
+                out.append(f"  \"{g.name}/{c.name}\"  {len(c)} samples{tb}")
+        return out
+    traces = read_lecroy(path, [1]) if s in LECROY_SUFFIXES else None
+    if traces is not None:
+        t = traces[1]
+        return [f"{path}: LeCroy trace, column = 1", f"  {t.label}: {len(t.values)} samples every {t.dt:.6g} s from {t.t0:.6g} s"]
+    _need("RigolWFM", path)
+    import RigolWFM.wfm as wfm  # type: ignore[import-not-found]
+
+    try:
+        w = wfm.Wfm.from_file(str(path), "auto")
+    except Exception as exc:
+        raise ScopeFileError(f"{path}: not a waveform file RigolWFM can read ({type(exc).__name__}: {exc})") from None
+    out = [f"{path}: {w.header_name} waveform; column = the channel number"]
+    for c in w.channels:
+        if getattr(c, "volts", None) is not None and len(c.volts):
+            out.append(f"  {c.channel_number} ({c.name}): {len(c.volts)} samples")
+    return out

@@ -203,3 +203,37 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
         raise (err or ScopeFileError(f"{p}: cannot be read as a table from line {start + 1}: {exc}")) from None
     cols = {w: np.ascontiguousarray(data[:, uniq.index(i)]) for w, i in zip(wanted, idx)}
     return TextTable(p, cols, dict(zip(wanted, labels)), start + 1, None if hline is None else hline + 1, delim, dec)
+
+
+def describe_text(path: str | Path) -> list[str]:
+    """What a text export holds, for writing SETUP.toml: its layout, the header's columns, a first row."""
+    p = Path(path)
+    text = _text(p)
+    if "\n" not in text[: 1 << 16] and "\r" in text[: 1 << 16]:
+        text = text.replace("\r", "\n")
+    head = text[: 1 << 18].split("\n")[:_HEAD_LINES]
+    tail = [ln for ln in text[-(1 << 15):].split("\n")[1:] if ln.strip()][-_TAIL_LINES:] or \
+        [ln for ln in head if ln.strip()][-_TAIL_LINES:]
+    if not tail:
+        raise ScopeFileError(f"{p}: is empty")
+    delim, dec, ncols = _dialect(p, tail)
+    start = _data_start(p, head, delim, dec, ncols)
+    above = [i for i in range(start - 1, max(-1, start - 60), -1) if head[i].strip()][:3]
+    named = [i for i in above if len(f := _fields(head[i], delim)) >= ncols and len(set(f)) == len(f)]
+    hline = named[0] if named else None
+    header = _fields(head[hline], delim) if hline is not None else []
+    table = read_delimited(p, list(range(1, ncols + 1)))
+    n = len(table.columns[1])
+    first = [table.columns[i][0] for i in range(1, ncols + 1)]
+    out = [f"{p}: {table.dialect}; {start} line(s) before the data, data from line {start + 1}, {n} rows"]
+    out += [f"  line {i + 1}: {', '.join(_fields(head[i], delim))}" for i in reversed(above)]
+    out.append(f"  column names from line {hline + 1}" if hline is not None else "  no header line: name columns by number")
+    for i in range(ncols):
+        name = header[i] if i < len(header) else ""
+        col = table.columns[i + 1]
+        step = np.diff(col[: min(n, 1000)])
+        even = " (evenly increasing: a time column?)" if n > 2 and np.all(step > 0) and np.ptp(step) < 0.01 * step.mean() \
+            else ""
+        out.append(f"  column {i + 1:>2}  {name!r:<16} first {first[i]:<14.6g} min {col.min():<12.4g} max {col.max():<12.4g}"
+                   f"{even}")
+    return out
