@@ -354,3 +354,21 @@ def test_show_lists_tdms_channels(tmp_path, capsys):
         w.write_segment([nptdms.ChannelObject("scope", "CH1", np.zeros(100), properties={"wf_increment": 2e-7})])
     assert main(["import", str(path), "--show"]) == 0
     assert '"scope/CH1"  100 samples, every 2e-07 s from 0 s' in capsys.readouterr().out
+
+
+def test_windows_tsv_in_microseconds_and_millivolts(tmp_path):
+    """Tab-separated, decimal commas, CRLF line ends, a Latin-1 'µs' in the units row, time in
+    microseconds, one channel in millivolts: the layout of a European PC's export."""
+    strains, rate, t0 = gauge_signals(RECORD)
+    n = len(strains["input_bar"])
+    volts = {COLUMNS[g]: e / SPV[g] for g, e in strains.items()}
+    volts["CH2"] = volts["CH2"] * 1e3  # millivolts
+    rows = np.column_stack([(t0 + np.arange(n) / rate) * 1e6, *volts.values()])
+    body = "\r\n".join("\t".join(f"{v:.9e}" for v in r) for r in rows).replace(".", ",")
+    text = "Oscilloscope\tPicoScope 4424\r\n\r\nZeit\tCH1\tCH2\tCH3\tCH4\r\n(µs)\t(V)\t(mV)\t(V)\t(V)\r\n" + body + "\r\n"
+    path = tmp_path / "shot.txt"
+    path.write_bytes(text.encode("latin-1"))
+    doc = setup_doc(time={"column": "Zeit", "units": "us"})
+    doc["channels"]["internal_output_bar"]["units"] = "mV"
+    import_scope_files([path], parse_setup(doc, path=tmp_path / "SETUP.toml"), tmp_path / "r.h5")
+    assert_same_analysis(RECORD, tmp_path / "r.h5")
