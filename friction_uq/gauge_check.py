@@ -133,7 +133,8 @@ def _off(a: float) -> str:
     return f"{1 / a:.3g} times too large" if a < 1 else f"{a:.3g} times too small"
 
 
-def scale_findings(forces: Forces, apparatus: Apparatus, *, striker_velocity: float | None = None) -> list[GaugeFinding]:
+def scale_findings(forces: Forces, apparatus: Apparatus, *,
+                   striker_velocity: float | None = None) -> list[GaugeFinding]:
     """A channel whose scale contradicts the others' (a gauge factor, gain or strain_per_volt off), named.
 
     The force balance (eq. 5) says a scale is off; which channel is found from a second relation each
@@ -253,7 +254,8 @@ def hoop_findings(forces: Forces, apparatus: Apparatus, hoop_noise_sd: float) ->
     if k > HOOP_K_MAX:
         return [GaugeFinding("tube_hoop", "scale", (
             f"/signals/tube_hoop reads {-h * 1e6:.0f} microstrain of swelling where the sample's axial stress "
-            f"({sigma / 1e6:.0f} MPa over the loading) gives at most {lame * HOOP_KERNEL_MAX * sigma * 1e6:.0f} for any "
+            f"({sigma / 1e6:.0f} MPa over the loading) gives at most "
+            f"{lame * HOOP_KERNEL_MAX * sigma * 1e6:.0f} for any "
             f"nu < 0.5 (eq. 8, the tube's Lame factor): it reads at least {k:.3g} times too much; check its "
             "strain_per_volt, gauge factor, amplifier gain or units"))]
     return []

@@ -26,7 +26,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("-o", "--output", type=Path, help="record to write (test.h5)")
     s.add_argument("--template", action="store_true", help="print a commented SETUP.toml (the paper's set-up) and exit")
     s.add_argument("--show", action="store_true",
-                   help="print what each FILE holds (layout, columns or channels, first values) and exit: for SETUP.toml")
+                   help="print what each FILE holds (layout, columns or channels, first values) and exit: "
+                   "what SETUP.toml refers to")
     s.add_argument("--no-check", action="store_true",
                    help="write the record even when a gauge's sign or scale contradicts the others (warnings only)")
 

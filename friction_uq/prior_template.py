@@ -77,7 +77,8 @@ def tight_text(material: str, nu: float, sd: float) -> str:
     return (_head(material, f"{material} sensitivity: nu measured, {nu:g} +- {tight:.3g}",
                   "Sensitivity alternative: how f would tighten if nu were measured (e.g. by ultrasonic wave speeds).")
             + _COMMON_F + "\n"
-            + "[nu]\n# nu known to a third of the lab's uncertainty (at least 0.005), as a dedicated measurement would give.\n"
+            + "[nu]\n# nu known to a third of the lab's uncertainty (at least 0.005), as a dedicated measurement\n"
+            + "# would give.\n"
             + f'distribution = "truncnormal"\nmean = {nu:g}\nsd = {tight:.3g}\nlower = 0.0\nupper = 0.5\n'
             + f'note = "nu measured: truncated normal sd {tight:.3g}"\n\n'
             + _COMMON_HOOP)

@@ -365,7 +365,8 @@ def test_windows_tsv_in_microseconds_and_millivolts(tmp_path):
     volts["CH2"] = volts["CH2"] * 1e3  # millivolts
     rows = np.column_stack([(t0 + np.arange(n) / rate) * 1e6, *volts.values()])
     body = "\r\n".join("\t".join(f"{v:.9e}" for v in r) for r in rows).replace(".", ",")
-    text = "Oscilloscope\tPicoScope 4424\r\n\r\nZeit\tCH1\tCH2\tCH3\tCH4\r\n(µs)\t(V)\t(mV)\t(V)\t(V)\r\n" + body + "\r\n"
+    head = "Oscilloscope\tPicoScope 4424\r\n\r\nZeit\tCH1\tCH2\tCH3\tCH4\r\n(µs)\t(V)\t(mV)\t(V)\t(V)\r\n"
+    text = head + body + "\r\n"
     path = tmp_path / "shot.txt"
     path.write_bytes(text.encode("latin-1"))
     doc = setup_doc(time={"column": "Zeit", "units": "us"})

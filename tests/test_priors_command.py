@@ -37,7 +37,8 @@ def test_new_material_files_encode_the_estimate(tmp_path, capsys):
     nu = default["nu"].frozen()
     # a normal of mean 0.35, sd 0.03 truncated to (0, 0.5): its moments are those of the untruncated one here
     assert nu.mean() == pytest.approx(0.35, abs=1e-6) and nu.std() == pytest.approx(0.03, rel=1e-3)
-    assert default.material == "PMMA" and default["f"].frozen().median() == pytest.approx(stats.halfnorm(scale=0.3).median())
+    assert default.material == "PMMA"
+    assert default["f"].frozen().median() == pytest.approx(stats.halfnorm(scale=0.3).median())
     tight = load_priors(tmp_path / "PMMA-nu-tight.toml")["nu"].frozen()
     wide = load_priors(tmp_path / "PMMA-nu-wide.toml")["nu"]
     assert tight.std() == pytest.approx(0.01, rel=1e-3) and wide.support == (0.15, 0.4)

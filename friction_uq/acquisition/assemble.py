@@ -69,7 +69,8 @@ def _file_of(setup: Setup, ch: ChannelSetup, files: Sequence[Path]) -> Path:
     return hits[0]
 
 
-def _time_base(setup: Setup, file: Path, table_time: np.ndarray | None, trace: Trace, first_line: int) -> tuple[float, float]:
+def _time_base(setup: Setup, file: Path, table_time: np.ndarray | None, trace: Trace,
+               first_line: int) -> tuple[float, float]:
     """(t0, dt) of a channel: from the time column, from [time] sample_rate, or from the file's own time base."""
     ts = setup.time
     if ts is not None and ts.sample_rate is not None:
@@ -83,7 +84,8 @@ def _time_base(setup: Setup, file: Path, table_time: np.ndarray | None, trace: T
         step = np.diff(t)
         dt = float(np.median(step))
         if not dt > 0:
-            raise ScopeFileError(f"{file}: the time column {ts.column!r} does not increase (from {t[0]:g} to {t[-1]:g} s)")
+            raise ScopeFileError(f"{file}: the time column {ts.column!r} does not increase "
+                                 f"(from {t[0]:g} to {t[-1]:g} s)")
         bad = np.flatnonzero(np.abs(step - dt) > TIME_JITTER * dt)  # a jump between two rows
         if bad.size:
             i = int(bad[0]) + 1

@@ -169,13 +169,15 @@ def describe_binary(path: Path) -> list[str]:
         for g in f.groups():
             for c in g.channels():
                 dt = c.properties.get("wf_increment")
-                tb = f", every {dt:.6g} s from {c.properties.get('wf_start_offset', 0.0):.6g} s" if dt else ", no time base"
+                start = c.properties.get("wf_start_offset", 0.0)
+                tb = f", every {dt:.6g} s from {start:.6g} s" if dt else ", no time base"
                 out.append(f"  \"{g.name}/{c.name}\"  {len(c)} samples{tb}")
         return out
     traces = read_lecroy(path, [1]) if s in LECROY_SUFFIXES else None
     if traces is not None:
         t = traces[1]
-        return [f"{path}: LeCroy trace, column = 1", f"  {t.label}: {len(t.values)} samples every {t.dt:.6g} s from {t.t0:.6g} s"]
+        return [f"{path}: LeCroy trace, column = 1",
+                f"  {t.label}: {len(t.values)} samples every {t.dt:.6g} s from {t.t0:.6g} s"]
     _need("RigolWFM", path)
     import RigolWFM.wfm as wfm  # type: ignore[import-not-found]
 

@@ -79,7 +79,8 @@ def _dialect(path: Path, tail: list[str]) -> tuple[str | None, str, int]:
             best = (delim, dec, n)
     if best is None:
         raise ScopeFileError(f"{path}: its last lines are not rows of numbers in any of the usual layouts (comma, "
-                             "semicolon, tab or space separated; decimal point or comma): is it an oscilloscope export?")
+                             "semicolon, tab or space separated; decimal point or comma): is it an oscilloscope "
+                             "export?")
     return best
 
 
@@ -92,7 +93,8 @@ def _data_start(path: Path, head: list[str], delim: str | None, dec: str, ncols:
                          "more metadata lines than an oscilloscope writes, or a column that is not numeric")
 
 
-def _header(path: Path, head: list[str], start: int, delim: str | None, wanted: list[str]) -> tuple[int | None, list[str]]:
+def _header(path: Path, head: list[str], start: int, delim: str | None,
+            wanted: list[str]) -> tuple[int | None, list[str]]:
     """(index, fields) of the nearest line above the data naming every wanted column (case-insensitively)."""
     for i in range(start - 1, max(-1, start - 60), -1):
         f = _fields(head[i], delim)
@@ -152,6 +154,9 @@ def _text(path: Path) -> str:
         raw = path.read_bytes()
     except OSError as exc:
         raise ScopeFileError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    if raw.startswith(b"\x89HDF\r\n\x1a\n"):
+        raise ScopeFileError(f"{path}: is an HDF5 file (a test record already?), not an oscilloscope export; "
+                             "friction-uq inspect reads records")
     if b"\x00" in raw[:65536]:
         raise ScopeFileError(f"{path}: is a binary file, not a text export; give a TDMS file the extension .tdms, a "
                              "LeCroy trace .trc, a Tektronix or Rigol waveform .wfm/.isf/.bin")
@@ -227,13 +232,14 @@ def describe_text(path: str | Path) -> list[str]:
     first = [table.columns[i][0] for i in range(1, ncols + 1)]
     out = [f"{p}: {table.dialect}; {start} line(s) before the data, data from line {start + 1}, {n} rows"]
     out += [f"  line {i + 1}: {', '.join(_fields(head[i], delim))}" for i in reversed(above)]
-    out.append(f"  column names from line {hline + 1}" if hline is not None else "  no header line: name columns by number")
+    out.append(f"  column names from line {hline + 1}" if hline is not None
+               else "  no header line: name columns by number")
     for i in range(ncols):
         name = header[i] if i < len(header) else ""
         col = table.columns[i + 1]
         step = np.diff(col[: min(n, 1000)])
-        even = " (evenly increasing: a time column?)" if n > 2 and np.all(step > 0) and np.ptp(step) < 0.01 * step.mean() \
-            else ""
-        out.append(f"  column {i + 1:>2}  {name!r:<16} first {first[i]:<14.6g} min {col.min():<12.4g} max {col.max():<12.4g}"
-                   f"{even}")
+        timelike = n > 2 and np.all(step > 0) and np.ptp(step) < 0.01 * step.mean()
+        even = " (evenly increasing: a time column?)" if timelike else ""
+        out.append(f"  column {i + 1:>2}  {name!r:<16} first {first[i]:<14.6g} min {col.min():<12.4g} "
+                   f"max {col.max():<12.4g}{even}")
     return out
