@@ -373,3 +373,12 @@ def test_windows_tsv_in_microseconds_and_millivolts(tmp_path):
     doc["channels"]["internal_output_bar"]["units"] = "mV"
     import_scope_files([path], parse_setup(doc, path=tmp_path / "SETUP.toml"), tmp_path / "r.h5")
     assert_same_analysis(RECORD, tmp_path / "r.h5")
+
+
+def test_bundled_scope_csv_is_a_fresh_export_of_the_bundled_record():
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "make_scope_example.py"), "--check"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and "identical to a fresh export" in r.stdout, r.stdout + r.stderr
