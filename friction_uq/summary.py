@@ -90,7 +90,10 @@ def gauge_check_lines(record: Record) -> list[str]:
     """The gauge check of ``inspect``: a gauge whose sign or scale contradicts the others, with the evidence."""
     from .gauge_check import record_gauge_check
 
-    faults, notes = record_gauge_check(record)
+    try:
+        faults, notes = record_gauge_check(record)
+    except ValueError as exc:  # a record the force computation cannot take (the summary above still stands)
+        return [f"gauges      not checked: {exc}"]
     lines = [f"GAUGE FAULT {g.sentence}" for g in faults]
     lines += [("gauges      " if g.kind == "ok" else "gauge note  ") + g.sentence for g in notes]
     return lines
