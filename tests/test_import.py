@@ -20,6 +20,7 @@ from friction_uq.acquisition import TEMPLATE, import_scope_files, parse_setup
 from friction_uq.acquisition.scope_export import export_record, gauge_signals, write_scope_csv
 from friction_uq.analysis import identify, prepare
 from friction_uq.cli import main
+from friction_uq.errors import SetupError
 from friction_uq.record import read_record
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -382,3 +383,27 @@ def test_bundled_scope_csv_is_a_fresh_export_of_the_bundled_record():
     r = subprocess.run([sys.executable, str(ROOT / "scripts" / "make_scope_example.py"), "--check"],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and "identical to a fresh export" in r.stdout, r.stdout + r.stderr
+
+
+def test_channels_already_in_strain_and_microstrain(tmp_path):
+    """An amplifier that outputs strain: units strain and microstrain, stored as given (sign applied)."""
+    strains, rate, t0 = gauge_signals(RECORD)
+    cols = {"CH1": -strains["input_bar"], "CH2": strains["internal_output_bar"] * 1e6,
+            "CH3": strains["external_output_bar"] * 1e6, "CH4": strains["tube_hoop"]}
+    n = len(cols["CH1"])
+    csv = write_scope_csv(tmp_path / "strain.csv", t0 + np.arange(n) / rate, cols, preamble=("Amplifier,strain out",))
+    doc = setup_doc()
+    units = {"input_bar": "strain", "internal_output_bar": "microstrain", "external_output_bar": "microstrain",
+             "tube_hoop": "strain"}
+    for g, c in doc["channels"].items():
+        del c["strain_per_volt"]
+        c["units"] = units[g]
+    doc["channels"]["input_bar"]["sign"] = -1
+    import_scope_files([csv], parse_setup(doc, path=tmp_path / "SETUP.toml"), tmp_path / "r.h5")
+    with h5py.File(tmp_path / "r.h5") as fh:
+        assert fh["signals/internal_output_bar"].attrs["units"] == "microstrain"
+        assert "strain_per_volt" not in fh["signals/input_bar"].attrs
+    assert_same_analysis(RECORD, tmp_path / "r.h5")
+    doc["channels"]["tube_hoop"]["strain_per_volt"] = 1e-4
+    with pytest.raises(SetupError, match=r"\[channels.tube_hoop\] strain_per_volt: applies to channels in V or mV"):
+        parse_setup(doc, path=tmp_path / "SETUP.toml")
