@@ -2,7 +2,7 @@
 
 Frozen dataclasses with the derived quantities the analysis needs (areas, densities from
 rho = E / c^2, impedances Z = A E / c, the Lame hoop factor), and :func:`paper_apparatus`, the
-set-up of Durand et al. 2016 (physics.md section 1).
+set-up of Durand et al. 2016 (docs/physics.md section 1).
 """
 
 from __future__ import annotations
@@ -75,7 +75,7 @@ class Tube:
     def lame_hoop_strain_per_pressure(self) -> float:
         """Outer-surface hoop strain per unit bore pressure, 2 a^2 / (E (b^2 - a^2)) (1/Pa).
 
-        Lame, long open tube (physics.md section 6): 2.10 microstrain per MPa for the paper's tube.
+        Lame, long open tube (docs/physics.md section 6): 2.10 microstrain per MPa for the paper's tube.
         """
         a = self.inner_diameter / 2.0
         b = self.outer_diameter / 2.0
@@ -146,7 +146,7 @@ class Apparatus:
 
 
 def paper_apparatus() -> Apparatus:
-    """The set-up of Durand et al. 2016 (physics.md section 1 table, spec example)."""
+    """The set-up of Durand et al. 2016 (docs/physics.md section 1 table, spec example)."""
     return Apparatus(
         striker=Bar("striker", 166e9, 4555.0, 0.02, 1.05, poisson_ratio=0.29),
         input_bar=Bar("input_bar", 166e9, 4555.0, 0.02, 2.5, gauge_distance=1.22, poisson_ratio=0.29),

@@ -15,7 +15,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from . import __version__
+from . import __version__, import_command, priors_command
 from .errors import ConfigError, FrictionUQError, OutputError, os_error_text
 
 EXIT_BAD_INPUT = 2
@@ -177,6 +177,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-o", "--output", type=Path, help="figure file (PDF or PNG)")
 
     _add_campaign_parser(sub)
+    import_command.add_parser(sub)
+    priors_command.add_parser(sub)
 
     run_help = ("run", "joint posterior of f and nu, uncertainty propagation, PDF report",
                 "The main job: sample the posterior of f and nu for one record and write "
@@ -283,6 +285,10 @@ def _dispatch(args: argparse.Namespace) -> int:
         return 0
     if args.command == "campaign":
         return _campaign(args)
+    if args.command == "import":
+        return import_command.run(args, build_parser(), _output_file)
+    if args.command == "priors":
+        return priors_command.run(args)
     if args.command in ("run", "diagnose"):
         from .run import run_file
 

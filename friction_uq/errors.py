@@ -42,6 +42,14 @@ class ConfigError(FrictionUQError):
     """A simulation configuration file is malformed."""
 
 
+class SetupError(FrictionUQError):
+    """An import set-up file (SETUP.toml) is malformed: unknown table or key, missing value, wrong unit."""
+
+
+class ScopeFileError(FrictionUQError):
+    """An oscilloscope export cannot be imported: missing column, non-numeric cell, unequal lengths, ..."""
+
+
 class SamplingError(FrictionUQError):
     """The sampler could not produce a usable posterior."""
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .forces import Forces
-from .record import Apparatus
+from .record import Apparatus, Record
 from .signals import ar1_mean_sd
 
 #: Largest |S - 1| of a sound record's force balance over the loading.
@@ -108,3 +108,154 @@ def _swapped_balance(forces: Forces, apparatus: Apparatus, m: np.ndarray) -> flo
     F_io = forces.F_eo[m] / k_eo * k_io
     F_eo = forces.F_io[m] / k_io * k_eo
     return float(np.mean(F_io + F_eo) / np.mean(forces.F_i[m]))
+
+
+#: A channel scale within this factor of the others' is not named (the balance's own spread is a few %).
+SCALE_FACTOR = 1.5
+#: Largest |log| departure of the ends' velocity ratio (eq. 6) that a corrected scale may leave.
+VELOCITY_LOG_TOL = math.log(1.25)
+#: Incident plateau against the striker's speed (eq. 14) within this factor: the input gauge is sound.
+STRIKER_LOG_TOL = math.log(1.15)
+
+
+def incident_plateau(forces: Forces) -> float:
+    """Mean incident strain (compression positive) where it exceeds half its peak; nan without one."""
+    e = forces.eps_incident
+    ok = np.isfinite(e)
+    if not ok.any():
+        return float("nan")
+    peak = float(np.max(e[ok]))
+    return float(np.mean(e[ok & (e >= 0.5 * peak)])) if peak > 0 else float("nan")
+
+
+def _off(a: float) -> str:
+    """'k times too large' or 'k times too small' for a channel that multiplied by ``a`` would agree."""
+    return f"{1 / a:.3g} times too large" if a < 1 else f"{a:.3g} times too small"
+
+
+def scale_findings(forces: Forces, apparatus: Apparatus, *,
+                   striker_velocity: float | None = None) -> list[GaugeFinding]:
+    """A channel whose scale contradicts the others' (a gauge factor, gain or strain_per_volt off), named.
+
+    The force balance (eq. 5) says a scale is off; which channel is found from a second relation each
+    candidate enters differently: the ends' velocities (eq. 6: V_io = V_i in the stationary state) take
+    the input and internal output gauges but not the external one, and the incident wave's plateau
+    against the striker's speed (eq. 14: eps_i = V_s / (2 c)) takes the input gauge alone. The
+    channel is named when it alone, rescaled, satisfies both relations, and its factor is beyond
+    :data:`SCALE_FACTOR` (an error of a gauge factor or a unit, not the few % a gain drifts).
+    """
+    m = loading_mask(forces)
+    if m.sum() < 8:
+        return []
+    Fi, Fio, Feo = (float(np.mean(x[m])) for x in (forces.F_i, forces.F_io, forces.F_eo))
+    Vi, Vio = float(np.mean(forces.V_i[m])), float(np.mean(forces.V_io[m]))
+    if not (Fi > 0 and Fio > 0 and Feo > 0 and Vi > 0 and Vio > 0):
+        return []  # signs are the reversed-gauge check's business
+    s, r = (Fio + Feo) / Fi, Vio / Vi
+    cands = {"input_bar": (s, r / s), "internal_output_bar": ((Fi - Feo) / Fio, r * (Fi - Feo) / Fio),
+             "external_output_bar": ((Fi - Fio) / Feo, r)}
+    ok = {c: a for c, (a, rr) in cands.items() if a > 0 and rr > 0 and abs(math.log(rr)) < VELOCITY_LOG_TOL}
+    evidence = (f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5) and the "
+                f"sample's ends move at {r:.2f} times each other's speed (eq. 6)")
+    q = float("nan")
+    if striker_velocity:
+        q = incident_plateau(forces) / (striker_velocity / (2.0 * apparatus.input_bar.wave_speed))
+        if abs(math.log(q)) > math.log(SCALE_FACTOR):
+            return [GaugeFinding("input_bar", "scale", (
+                f"/signals/input_bar reads an incident wave {q:.3g} times what the striker's {striker_velocity:g} m/s "
+                "gives (eq. 14): its scale (strain_per_volt, gauge factor, gain or units) looks off by that factor"))]
+        if abs(math.log(q)) < STRIKER_LOG_TOL:
+            ok.pop("input_bar", None)
+            evidence += f", while the incident wave matches the striker's speed within {abs(q - 1) * 100:.0f} %"
+    if set(ok) == {"input_bar", "internal_output_bar"} and min(abs(math.log(a)) for a in ok.values()) > math.log(
+            SCALE_FACTOR):
+        v_s = 2.0 * apparatus.input_bar.wave_speed * incident_plateau(forces)
+        return [GaugeFinding("", "scale", (
+            f"either /signals/input_bar looks {_off(ok['input_bar'])} or /signals/internal_output_bar "
+            f"{_off(ok['internal_output_bar'])}: {evidence}; the input gauge's incident wave stands for a "
+            f"striker at {v_s:.3g} m/s (eq. 14): if that is not the speed fired, the input gauge is the one off "
+            "(record the striker's speed as striker_velocity and the check names the channel)"))]
+    if len(ok) != 1:
+        return []
+    ((channel, a),) = ok.items()
+    if abs(math.log(a)) < math.log(SCALE_FACTOR):
+        return []
+    return [GaugeFinding(channel, "scale", (
+        f"/signals/{channel} looks {_off(a)}: {evidence}; multiplying that channel by {a:.3g} "
+        "restores both (check its strain_per_volt, gauge factor, amplifier gain or units)"))]
+
+
+def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFinding]]:
+    """(faults, notes) of a record's gauges, for ``inspect`` and ``import``.
+
+    Faults: a gauge wired the other way round, two output channels swapped, a channel's scale off
+    by a factor (:func:`scale_findings`), or no incident wave to check against; notes: a force
+    balance a few percent off (:func:`gauge_findings`), which the analysis reports itself.
+    """
+    from .errors import SignalError
+    from .forces import compute_forces
+
+    try:
+        forces = compute_forces(record)
+    except SignalError as exc:
+        text = str(exc).removeprefix(f"{record.path}: ")
+        kind = "reversed" if "looks reversed" in text else "signal"
+        return [GaugeFinding("input_bar" if text.startswith("/signals/input_bar") else "", kind, text)], []
+    found = gauge_findings(forces, record.apparatus)
+    faults = [g for g in found if g.kind in ("reversed", "swapped")]
+    if faults:
+        return faults, []
+    faults = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
+    if "tube_hoop" in forces.channels:
+        faults += hoop_findings(forces, record.apparatus, forces.channels["tube_hoop"].noise.sd)
+    if faults:
+        return faults, []
+    s = force_balance(forces)
+    return [], found or [GaugeFinding("", "ok", (
+        f"signs agree and the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5)"))]
+
+
+#: Largest hoop-gauge kernel factor: a uniform band as long as the sample, read at its middle (docs/physics.md
+#: section 6: 0.77 of Lame for the paper's tube; 0.8 leaves room for another tube).
+HOOP_KERNEL_MAX = 0.8
+#: nu / (1 - nu) the hoop gauge may imply at most (nu < 0.5 gives < 1), with room for the kernel's spread.
+HOOP_K_MAX = 1.5
+
+
+def hoop_findings(forces: Forces, apparatus: Apparatus, hoop_noise_sd: float) -> list[GaugeFinding]:
+    """The tube's hoop gauge against the forces: it must read a swelling, and no more than nu < 0.5 allows.
+
+    Over the loading the wall pressure is nu / (1 - nu) times the axial stress (eq. 8), and the gauge
+    reads at most :data:`HOOP_KERNEL_MAX` of Lame's strain for it (docs/physics.md section 6). A
+    mean hoop strain of the wrong sign beyond 3 noise standard errors is a reversed gauge; one that
+    implies nu / (1 - nu) above :data:`HOOP_K_MAX` with the gauge at its most sensitive is a scale off
+    by a factor (a gauge too small by a factor cannot be told from a weak wall pressure, and is not
+    named).
+    """
+    if forces.hoop is None:
+        return []
+    m = loading_mask(forces)
+    n = int(m.sum())
+    if n < 8:
+        return []
+    h = float(np.mean(forces.hoop[m]))  # compression positive: a swelling tube reads negative
+    se = hoop_noise_sd / math.sqrt(n) * 10.0  # a generous allowance for correlated noise
+    if h > 3.0 * se:
+        return [GaugeFinding("tube_hoop", "reversed", (
+            f"/signals/tube_hoop reads the tube contracting through the loading (mean {h * 1e6:+.1f} microstrain "
+            "compression-positive while the sample is pushed): the gauge looks reversed (a swelling tube reads "
+            "positive, elongation positive)"))]
+    s = apparatus.sample
+    sigma = float(np.mean(forces.F_io[m] + 0.5 * forces.F_eo[m])) / s.area
+    lame = apparatus.tube.lame_hoop_strain_per_pressure
+    if sigma <= 0:
+        return []
+    k = -h / (lame * HOOP_KERNEL_MAX * sigma)
+    if k > HOOP_K_MAX:
+        return [GaugeFinding("tube_hoop", "scale", (
+            f"/signals/tube_hoop reads {-h * 1e6:.0f} microstrain of swelling where the sample's axial stress "
+            f"({sigma / 1e6:.0f} MPa over the loading) gives at most "
+            f"{lame * HOOP_KERNEL_MAX * sigma * 1e6:.0f} for any "
+            f"nu < 0.5 (eq. 8, the tube's Lame factor): it reads at least {k:.3g} times too much; check its "
+            "strain_per_volt, gauge factor, amplifier gain or units"))]
+    return []

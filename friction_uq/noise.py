@@ -1,6 +1,6 @@
 """Gauge noise for synthetic and simulated records: stationary AR(1), alone or with a white part.
 
-The AR(1) process of the package's noise model (physics.md, the likelihood's noise):
+The AR(1) process of the package's noise model (docs/physics.md, the likelihood's noise):
 
     e_0 ~ N(0, sd^2),   e_k = rho e_{k-1} + w_k,   w_k ~ N(0, sd^2 (1 - rho^2)),
 

@@ -1,7 +1,7 @@
 """Prior distributions of the friction analysis, read from a TOML file per sample material.
 
-A prior file (``<material>.toml``; the package ships ``friction_uq/prior_files/``) holds one table
-per parameter::
+A prior file (``<material>.toml``; friction-uq ships those of the repository's ``priors/`` folder)
+holds one table per parameter (docs/priors.md describes the format)::
 
     material = "I1"
     description = "one line for reports"
@@ -80,8 +80,21 @@ DISTRIBUTIONS: Mapping[str, tuple[str, ...]] = {
 #: Smallest probability mass the untruncated normal may put inside [lower, upper].
 MIN_MASS = 1e-9
 
-#: Folder of the prior files shipped inside the package (package data, found from any folder).
-PRIORS_DIR = Path(__file__).resolve().parent / "prior_files"
+
+
+def _priors_dir() -> Path:
+    """The prior files: ``friction_uq/prior_files`` in an installed wheel, ``priors/`` in a checkout.
+
+    The repository keeps one copy, its top-level ``priors/``; the wheel ships it as package data
+    under ``friction_uq/prior_files`` (setup.py maps the folder).
+    """
+    here = Path(__file__).resolve().parent
+    shipped = here / "prior_files"
+    return shipped if shipped.is_dir() else here.parent / "priors"
+
+
+#: Folder of the prior files that come with friction-uq (found from any folder).
+PRIORS_DIR = _priors_dir()
 #: Largest prior file read (bytes): a prior file is a few dozen lines.
 MAX_PRIOR_BYTES = 1_000_000
 
@@ -383,10 +396,32 @@ def default_prior_path(material: str, *, directory: str | Path | None = None) ->
     folder = Path(directory) if directory is not None else PRIORS_DIR
     path = folder / f"{material}.toml"
     if not path.is_file():
-        known = sorted(p.stem for p in folder.glob("*.toml")) if folder.is_dir() else []
+        known = prior_files(folder)
+        listed = ", ".join(f"{m} (nu alternatives: {', '.join(a)})" if a else m for m, a in known.items())
         raise _fail(
             path, "material",
-            f"no prior file for material {material!r}; available: {', '.join(known) or 'none'}; "
-            "write one (see friction_uq.priors) or pass a prior file explicitly",
+            f"no prior file for material {material!r}; materials: {listed or 'none'}; write one with "
+            f"'friction-uq priors {material} --nu ESTIMATE --nu-sd UNCERTAINTY' and pass it with --priors "
+            f"{material}.toml (docs/priors.md)",
         )
     return path
+
+
+#: Infix of a nu alternative's file name: ``<material>-nu-<label>.toml``.
+ALTERNATIVE_INFIX = "-nu-"
+
+
+def prior_files(directory: str | Path | None = None) -> dict[str, list[str]]:
+    """Materials with a prior file in ``directory`` (default :data:`PRIORS_DIR`) -> their nu alternatives.
+
+    ``I1.toml`` is the material I1; ``I1-nu-wide.toml`` is not a material but an alternative nu
+    prior of I1, which a run compares with the default one.
+    """
+    folder = Path(directory) if directory is not None else PRIORS_DIR
+    stems = sorted(p.stem for p in folder.glob("*.toml")) if folder.is_dir() else []
+    out: dict[str, list[str]] = {s: [] for s in stems if ALTERNATIVE_INFIX not in s}
+    for s in stems:
+        base, sep, _ = s.partition(ALTERNATIVE_INFIX)
+        if sep:
+            out.setdefault(base, []).append(s)
+    return out

@@ -81,7 +81,22 @@ def inspect_text(record: Record) -> str:
     if a.plug:
         out.append(f"plug        length {a.plug.length * 1e3:g} mm, E {a.plug.young_modulus / 1e9:g} GPa")
     out.append(f"pulse       2 L_striker / c = {a.pulse_duration * 1e6:.1f} us")
+    out.append("")
+    out.extend(gauge_check_lines(record))
     return "\n".join(out)
+
+
+def gauge_check_lines(record: Record) -> list[str]:
+    """The gauge check of ``inspect``: a gauge whose sign or scale contradicts the others, with the evidence."""
+    from .gauge_check import record_gauge_check
+
+    try:
+        faults, notes = record_gauge_check(record)
+    except ValueError as exc:  # a record the force computation cannot take (the summary above still stands)
+        return [f"gauges      not checked: {exc}"]
+    lines = [f"GAUGE FAULT {g.sentence}" for g in faults]
+    lines += [("gauges      " if g.kind == "ok" else "gauge note  ") + g.sentence for g in notes]
+    return lines
 
 
 def identification_table(record: Record, ident: Identification) -> str:

@@ -5,7 +5,7 @@ of amplitude V_s / (2 C_i) (eq. 14); the two output forces follow the same trape
 stationary levels (eq. 15-16), the input force is their sum (eq. 5), so the reflected wave is
 F_i / (A_i E_i) - eps_i (eq. 2) and the ends of the sample move together in the plateau (eq. 6).
 The hoop gauge reads the Lame strain of the eq. 20 wall pressure, seen through the tube kernel
-(physics.md section 6) as the sample slides past it, plus the Poisson widening of the tube under
+(docs/physics.md section 6) as the sample slides past it, plus the Poisson widening of the tube under
 the axial friction load it carries at the gauge: the closed-form model's own prediction
 (:class:`friction_uq.models.closed_form.HoopPrediction`) on the true histories. Noise is white plus AR(1), with offsets.
 

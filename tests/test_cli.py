@@ -10,7 +10,7 @@ from friction_uq import __version__
 from friction_uq.cli import build_parser, main
 from friction_uq.synthetic import ClosedFormTest, write_closed_form_record
 
-SUBCOMMANDS = ["inspect", "analyze", "design", "simulate", "run", "compare", "diagnose", "campaign"]
+SUBCOMMANDS = ["inspect", "analyze", "design", "simulate", "run", "compare", "diagnose", "campaign", "import", "priors"]
 
 
 @pytest.fixture(scope="module")

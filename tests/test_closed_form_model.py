@@ -1,5 +1,5 @@
 """The closed form as a forward model (friction_uq.models.closed_form): ratio against eq. 17 and
-Table 1 of physics.md; the likelihood over the model against numbers frozen before the model was
+Table 1 of docs/physics.md; the likelihood over the model against numbers frozen before the model was
 taken out of the likelihood."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from friction_uq.models import ClosedFormModel
 from friction_uq.record import paper_apparatus
 from test_sbc import closed_form_data, record_data
 
-#: Table 1 of physics.md (V_s = 10 m/s, nu = 0.4): f -> F_eo / F_io.
+#: Table 1 of docs/physics.md (V_s = 10 m/s, nu = 0.4): f -> F_eo / F_io.
 TABLE_1_RATIO = {0.01: 0.0270, 0.05: 0.1426, 0.10: 0.3056, 0.20: 0.7046, 0.50: 2.7937}
 
 

@@ -1,6 +1,6 @@
 """Tests of friction_uq.dispersion: Pochhammer-Chree first mode, phase velocity, wave transport.
 
-Reference values come from physics.md section 7 (table, Rayleigh-Love statement, cut-off
+Reference values come from docs/physics.md section 7 (table, Rayleigh-Love statement, cut-off
 f a / c0 = 0.2619, "about five times earlier in frequency") and from closed-form formulas
 (Rayleigh-Love, thin-shell membrane theory, analytic shifted Gaussian), never from the module's
 own output.
@@ -18,7 +18,7 @@ from hypothesis.extra.numpy import arrays
 
 from friction_uq import dispersion as disp
 
-# physics.md section 7: c/c0 of the first longitudinal mode of a solid bar against d/Lambda.
+# docs/physics.md section 7: c/c0 of the first longitudinal mode of a solid bar against d/Lambda.
 D_OVER_LAMBDA = (0.2, 0.4, 0.6, 0.8, 1.0, 1.5, 2.0)
 TABLE = {
     0.29: (0.9911, 0.9564, 0.8730, 0.7656, 0.6893, 0.6088, 0.5861),
@@ -26,7 +26,7 @@ TABLE = {
 }
 TABLE_CASES = [(nu, dl, ref) for nu, refs in TABLE.items() for dl, ref in zip(D_OVER_LAMBDA, refs, strict=True)]
 
-# physics.md section 1 (striker and input bar, steel) and the round-trip set-up of the brief.
+# docs/physics.md section 1 (striker and input bar, steel) and the round-trip set-up of the brief.
 STEEL_C0 = 4555.0
 STEEL_D = 0.02
 NU = 0.29
@@ -34,7 +34,7 @@ DT = 2e-7
 
 
 def rayleigh_love(d_over_lambda: float, nu: float) -> float:
-    """c/c0 ~ 1 - nu^2 pi^2 (a/Lambda)^2 (physics.md section 7)."""
+    """c/c0 ~ 1 - nu^2 pi^2 (a/Lambda)^2 (docs/physics.md section 7)."""
     return 1.0 - nu**2 * math.pi**2 * (d_over_lambda / 2.0) ** 2
 
 
@@ -147,7 +147,7 @@ def test_hollow_phase_velocity_decreases_with_frequency() -> None:
 
 
 def test_hollow_bar_disperses_earlier_than_the_10_mm_bar() -> None:
-    # physics.md sections 1 and 7: external output bar 40/30 mm steel, internal output bar 10 mm aluminium
+    # docs/physics.md sections 1 and 7: external output bar 40/30 mm steel, internal output bar 10 mm aluminium
     hollow = dict(c0=5162.0, diameter=0.04, inner_diameter=0.03, nu=0.29)
     solid = dict(c0=5092.0, diameter=0.01, nu=0.33)
     f = np.linspace(5e3, disp.first_mode_cutoff(**hollow), 20)

@@ -1,5 +1,5 @@
 """Likelihood: AR(1) algebra against dense Gaussians, effective variance against quadrature, hoop
-prediction against physics.md numbers and direct quadrature of eq. 20."""
+prediction against docs/physics.md numbers and direct quadrature of eq. 20."""
 
 from __future__ import annotations
 
@@ -170,10 +170,10 @@ def _hoop_data(f, nu, z_gauge, *, width=0.0):
 
 
 def test_uniform_pressure_band_matches_physics_md_numbers():
-    """f -> 0: uniform p over a 10 mm band reads 0.77, 0.52, 0.14, ~0 of Lame at 0, 5, 10, 15 mm (physics.md 6).
+    """f -> 0: uniform p over a 10 mm band reads 0.77, 0.52, 0.14, ~0 of Lame at 0, 5, 10, 15 mm (docs/physics.md 6).
 
     Those are the exact axisymmetric solution's values; the kernel reproduces it within 2.4 % of the
-    peak (physics.md), which is the tolerance. Against the kernel's closed-form band integral
+    peak (docs/physics.md), which is the tolerance. Against the kernel's closed-form band integral
     (physics.tube.band_response) the 16-node Gauss-Legendre quadrature agrees to 2e-5 (K has a kink in its 2nd derivative).
     """
     z = np.array([0.0, 5e-3, 10e-3, 15e-3, -5e-3] + [0.0] * 8)
@@ -222,7 +222,7 @@ def test_axial_poisson_term_beyond_the_output_face():
     expected = tb.poisson_ratio * np.mean(d.F_eo) / (tb.young_modulus * tb.area)
     assert off[0] - on[0] == pytest.approx(expected, rel=1e-9)  # swelling: more negative
     assert on[1] == pytest.approx(off[1], abs=1e-15)  # input side carries no axial load
-    # physics.md: ~ +19 microstrain for 5 kN
+    # docs/physics.md: ~ +19 microstrain for 5 kN
     assert expected * 5000.0 / np.mean(d.F_eo) == pytest.approx(19e-6, abs=1e-6)
 
 

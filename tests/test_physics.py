@@ -1,4 +1,4 @@
-"""Physics functions against the reference values of physics.md (independent of the code)."""
+"""Physics functions against the reference values of docs/physics.md (independent of the code)."""
 
 import math
 
@@ -7,7 +7,7 @@ import pytest
 from friction_uq.physics import bars, cell, design, tube
 from friction_uq.record import paper_apparatus
 
-# physics.md section 4, Table 1: V_s = 10 m/s, nu = 0.4 (computed independently of this code)
+# docs/physics.md section 4, Table 1: V_s = 10 m/s, nu = 0.4 (computed independently of this code)
 TABLE = [
     # f, F_io (N), F_eo (N), F_eo/F_io, p_mean (MPa), V (m/s)
     (0.01, 10201, 276, 0.0270, 87.76, 9.072),
@@ -57,7 +57,7 @@ def test_eq17_inverts_the_table(f, F_io, F_eo, ratio, p_mean, V):
 
 
 def test_paper_reading_gives_the_papers_f():
-    # physics.md section 3: F_eo/F_io ~ 0.14 -> f ~ 0.131 (nu 0.2), ~ 0.049 (nu 0.4)
+    # docs/physics.md section 3: F_eo/F_io ~ 0.14 -> f ~ 0.131 (nu 0.2), ~ 0.049 (nu 0.4)
     assert float(cell.friction_from_ratio(0.14, 0.2, radius=R, length=L)) == pytest.approx(0.131, abs=5e-4)
     assert float(cell.friction_from_ratio(0.14, 0.4, radius=R, length=L)) == pytest.approx(0.049, abs=5e-4)
 
@@ -81,7 +81,7 @@ def test_incident_strain_eq14():
 
 def test_lame_and_hoop_kernel_reference_values():
     t = paper_apparatus().tube
-    # physics.md section 6: 2.10 microstrain per MPa for this tube
+    # docs/physics.md section 6: 2.10 microstrain per MPa for this tube
     assert t.lame_hoop_strain_per_pressure * 1e12 == pytest.approx(2.10, abs=0.005)
     # kernel integrates to one
     import numpy as np
@@ -92,13 +92,13 @@ def test_lame_and_hoop_kernel_reference_values():
     got = tube.band_response([0.0, 0.005, 0.010, 0.015], band_length=0.010)
     for g, ref in zip(got, [0.77, 0.52, 0.14, 0.0]):
         assert g == pytest.approx(ref, abs=0.024 * 0.77)
-    # C_t = 1.71 (physics.md section 6)
+    # C_t = 1.71 (docs/physics.md section 6)
     assert tube.bore_compliance_factor(inner_radius=0.005, outer_radius=0.012, poisson_ratio=0.29) == pytest.approx(
         1.71, abs=0.005
     )
 
 
 def test_gap_threshold_one_mpa_per_micrometre():
-    # physics.md section 6: sigma* = E_s g / (nu R), 1 MPa per micrometre here
+    # docs/physics.md section 6: sigma* = E_s g / (nu R), 1 MPa per micrometre here
     assert 2e9 * 1e-6 / (0.4 * R) / 1e6 == pytest.approx(1.0)
     assert math.isclose(float(cell.beta(0.4, radius=R, length=L)), 8.0 / 3.0)

@@ -52,7 +52,7 @@ def test_default_nu_prior_is_about_0_4_within_a_few_hundredths():
 
 
 def test_default_f_prior_covers_literature_range():
-    """Literature values 0.05-0.5 (physics.md section 4) all keep substantial prior mass."""
+    """Literature values 0.05-0.5 (docs/physics.md section 4) all keep substantial prior mass."""
     f = load_priors(default_prior_path("I1"))["f"]
     assert f.ppf(np.array([0.5]))[0] == pytest.approx(0.3 * stats.halfnorm.ppf(0.5), rel=1e-12)
     assert float(f.frozen().cdf(0.05)) < 0.2 and float(f.frozen().sf(0.5)) > 0.05
@@ -166,7 +166,7 @@ def test_default_prior_path_lists_available_materials(tmp_path):
     write(tmp_path, GOOD, "A.toml")
     write(tmp_path, GOOD, "B.toml")
     assert default_prior_path("A", directory=tmp_path) == tmp_path / "A.toml"
-    with pytest.raises(PriorError, match=r"no prior file for material 'PBX9501'; available: A, B"):
+    with pytest.raises(PriorError, match=r"no prior file for material 'PBX9501'; materials: A, B; write one with 'friction-uq priors PBX9501"):
         default_prior_path("PBX9501", directory=tmp_path)
     assert default_prior_path("I1") == PRIORS_DIR / "I1.toml"
 

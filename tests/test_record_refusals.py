@@ -1,4 +1,4 @@
-"""The record contract (shared/spec/test-h5.md) at the reading boundary: issue 2, item 3.
+"""The record contract (docs/record-format.md) at the reading boundary: issue 2, item 3.
 
 Every malformed variant is generated here from a fresh copy of the good record (h5py edits of
 attributes, datasets and groups; byte-level truncation or overwriting), never checked in. Each must

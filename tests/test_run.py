@@ -58,7 +58,7 @@ def test_analysis_settings_are_in_the_provenance(paper_run):
 
 
 def test_the_papers_case_contains_0049(paper_run):
-    """physics.md: F_eo/F_io ~ 0.14 gives f ~ 0.049 with nu = 0.4; the 90 % interval must contain it."""
+    """docs/physics.md: F_eo/F_io ~ 0.14 gives f ~ 0.049 with nu = 0.4; the 90 % interval must contain it."""
     _, out, _ = paper_run
     f = json.loads((out / "paper_P-01.json").read_text())["f"]
     assert f["q05"] <= 0.049 <= f["q95"]

@@ -1,6 +1,6 @@
 """Simulation-based calibration: 90 % credible intervals of kappa and f must cover the truth ~90 %.
 
-Synthetic stationary phases are built from the closed forms of physics.md section 4 (eq. 15-16 at
+Synthetic stationary phases are built from the closed forms of docs/physics.md section 4 (eq. 15-16 at
 V_s = 10 m/s with the paper's bars: F_io, F_eo = (e - 1) F_io, V, slip = V t) and the model's own
 noise: AR(1) on each force (strain sd 3e-6 -> sd_io = A E sd = 17 N on the aluminium bar, 338 N on
 the steel tube bar; rho 0.5) and, with the hoop term, on the hoop gauge (sd 2e-6, rho 0.5). The
@@ -171,7 +171,7 @@ def coverage(replicas: list[Replica]) -> tuple[float, float]:
 
 
 def test_closed_form_data_reproduces_table1_levels():
-    """The builder's noise-free levels are those of physics.md Table 1 (f = 0.05: 10097 N, 1440 N)."""
+    """The builder's noise-free levels are those of docs/physics.md Table 1 (f = 0.05: 10097 N, 1440 N)."""
     d = closed_form_data(0.05, 0.4, seed=0, strain_sd=(1e-12, 1e-12, 1e-12))
     assert np.mean(d.F_io) == pytest.approx(10097, abs=0.5)
     assert np.mean(d.F_eo) == pytest.approx(1440, abs=0.5)

@@ -1,4 +1,4 @@
-"""Validation of the simulator against independent references (physics.md), not its own output."""
+"""Validation of the simulator against independent references (docs/physics.md), not its own output."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from friction_uq.record import paper_apparatus, read_record, read_truth
 from friction_uq.simulate import ChannelSpec, SimulationConfig, run_model, simulate, simulate_to_file
 from friction_uq.simulate.hoop import hoop_strain
 
-# physics.md section 4, Table 1 (V_s = 10 m/s, nu = 0.4): f -> (F_io N, F_eo N, V m/s), literal values
+# docs/physics.md section 4, Table 1 (V_s = 10 m/s, nu = 0.4): f -> (F_io N, F_eo N, V m/s), literal values
 TABLE_1 = {
     0.01: (10201.0, 276.0, 9.072),
     0.05: (10097.0, 1440.0, 8.926),
@@ -114,7 +114,7 @@ def test_gauges_carry_the_interface_forces_after_the_travel_times() -> None:
 
 @pytest.mark.parametrize("distance, expected", [(0.0, 0.77), (0.005, 0.52), (0.010, 0.14), (0.015, 0.0)])
 def test_hoop_gauge_reads_physics_md_band_values(distance: float, expected: float) -> None:
-    """A uniform 10 mm band, point gauge: 0.77, 0.52, 0.14, ~0 of the Lame strain (physics.md section 6,
+    """A uniform 10 mm band, point gauge: 0.77, 0.52, 0.14, ~0 of the Lame strain (docs/physics.md section 6,
     exact elastic solution; the kernel is fitted to it within 2.4 % of the peak, hence abs=0.02)."""
     tube = replace(paper_apparatus().tube, gauge_offset=distance, gauge_width=0.0)
     p = np.full((1, 40), 50e6)

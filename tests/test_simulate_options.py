@@ -1,4 +1,4 @@
-"""Each physics option moves the records the way physics.md section 5 says (one test per option)."""
+"""Each physics option moves the records the way docs/physics.md section 5 says (one test per option)."""
 
 from __future__ import annotations
 
@@ -89,7 +89,7 @@ def test_radial_gap_delays_the_hoop_strain_and_lowers_the_ratio() -> None:
     assert onset(gap) > onset(ref) + 2e-6
     f_gap = apparent_f(gap)
     assert f_gap < 0.95 * 0.05
-    # physics.md section 6: (F_i - F*) = (F_io - F*) exp(f beta), F* = pi R^2 E g / (nu R)
+    # docs/physics.md section 6: (F_i - F*) = (F_io - F*) exp(f beta), F* = pi R^2 E g / (nu R)
     m = window(gap)
     f_star = math.pi * R**2 * 2e9 * 10e-6 / (NU * R)
     fi, fio = gap.force_input[m].mean(), gap.force_internal[m].mean()
@@ -99,7 +99,7 @@ def test_radial_gap_delays_the_hoop_strain_and_lowers_the_ratio() -> None:
 
 def test_tube_compliance_lowers_the_wall_pressure_as_section_6_says() -> None:
     rigid, soft = run_model(config()), run_model(config(tube_compliance=True))
-    d_rigid, d_soft = 1 - NU, (1 - NU) + 2e9 * 1.71 / 200e9  # C_t = 1.71 (physics.md section 6)
+    d_rigid, d_soft = 1 - NU, (1 - NU) + 2e9 * 1.71 / 200e9  # C_t = 1.71 (docs/physics.md section 6)
     f_rigid, f_soft = apparent_f(rigid), apparent_f(soft)
     assert f_soft / f_rigid == pytest.approx(d_rigid / d_soft, rel=0.003)
 
@@ -167,4 +167,4 @@ def test_hoop_axial_term_adds_the_poisson_swelling_of_the_tube_load() -> None:
     tube = paper_apparatus().tube
     bound = tube.poisson_ratio * plain.force_external[m] / (tube.young_modulus * tube.area)  # all friction upstream
     assert np.all(extra > 0.1 * bound) and np.all(extra < bound)
-    assert np.max(bound) == pytest.approx(26e-6, rel=0.05)  # physics.md: ~19 microstrain per 5 kN
+    assert np.max(bound) == pytest.approx(26e-6, rel=0.05)  # docs/physics.md: ~19 microstrain per 5 kN

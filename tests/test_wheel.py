@@ -67,12 +67,17 @@ def _run_from_elsewhere(bindir: Path, tmp: Path, *extra: str) -> dict:
 
 
 def test_wheel_contains_the_prior_files(wheel):
+    """The repository keeps one copy of the prior files, its top-level priors/; the wheel ships it in the package."""
     import zipfile
 
-    names = zipfile.ZipFile(wheel).namelist()
-    for f in ("I1.toml", "I1-nu-wide.toml", "I1-nu-tight.toml"):
-        assert f"friction_uq/prior_files/{f}" in names
+    z = zipfile.ZipFile(wheel)
+    names = z.namelist()
+    shipped = sorted((ROOT / "priors").glob("*.toml"))
+    assert [f.name for f in shipped] == ["I1-nu-tight.toml", "I1-nu-wide.toml", "I1.toml"]
+    for f in shipped:
+        assert z.read(f"friction_uq/prior_files/{f.name}") == f.read_bytes()
     assert not [n for n in names if n.startswith("priors/")]
+    assert not (ROOT / "friction_uq" / "prior_files").exists()  # no second copy in the checkout
 
 
 def test_installed_wheel_runs_from_another_folder(wheel, tmp_path):

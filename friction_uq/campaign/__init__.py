@@ -99,3 +99,8 @@ __all__ = [
     "make_tasks", "read_header", "read_result", "record_seed", "run_campaign", "run_record", "run_tasks",
     "summary_text",
 ]
+
+
+from ..api import make_callable  # noqa: E402
+
+make_callable(__name__, "campaign")  # friction_uq.campaign(...) is the interface's function even once this package is loaded

@@ -6,7 +6,7 @@ of kappa against V alone, p_mean alone, and both together (weights 1/sd^2 of eac
 posterior). In one set-up V and p_mean both scale with the striker speed, so a trend against
 either is confounded; a second campaign with another impedance ratio puts the tests at other
 (V, p) pairs, and the joint fit then separates a velocity effect from a pressure effect
-(physics.md section 5). Fits on kappa do not depend on the nu prior; f's scale does.
+(docs/physics.md section 5). Fits on kappa do not depend on the nu prior; f's scale does.
 """
 
 from __future__ import annotations
@@ -126,6 +126,6 @@ def comparison_table(c: Comparison) -> str:
         lines.append(f"fit kappa ~ {name}: " + "; ".join(parts) + f"; chi2/dof {fit.chi2_dof:.2f} ({fit.n} tests)")
     if len(c.campaigns) < 2 and "V" in c.fits:
         lines.append("one campaign: V and p_mean rise together with the striker speed, so a trend cannot be "
-                     "assigned to one of them (physics.md section 5)")
+                     "assigned to one of them (docs/physics.md section 5)")
     return "\n".join(lines)
 

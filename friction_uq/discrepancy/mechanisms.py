@@ -1,4 +1,4 @@
-"""The catalogue of mechanisms: what the paper's model leaves out (physics.md section 5), each an
+"""The catalogue of mechanisms: what the paper's model leaves out (docs/physics.md section 5), each an
 extension of the baseline simulator with named parameters.
 
 Every entry declares its parameters (:class:`~friction_uq.models.Parameter`: name, unit, physical

@@ -10,7 +10,7 @@ tol_t from :func:`~.whole_record.tolerance_sd`: 1 % of the signal on the output 
 accuracy of a bar gauge's calibration and of the bar's E and c), 2 % on the reflected wave (the
 incident less a small difference, which carries the plug's impact, the least certain part of any
 model of the test), 3 % on the tube hoop gauge (the fit error of its influence function,
-physics.md section 6), and 0.2 us times the local slope (the timing of a front). On e' two standardised figures are formed:
+docs/physics.md section 6), and 0.2 us times the local slope (the timing of a front). On e' two standardised figures are formed:
 
 * the level z = mean(e') / se, se^2 the variance of an AR(1) mean (long-run variance), of the
   offset error of the pre-pulse mean and of the phase mean of the prediction over the posterior

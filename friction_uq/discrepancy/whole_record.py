@@ -42,7 +42,7 @@ PHASES = ("rise", "stationary", "unloading")
 LEAD = 10e-6
 #: Model tolerance per channel, relative to the signal: a bar gauge's calibration and the bar's E
 #: and c are rarely better than 1 %; the tube's influence function is fitted to 2.4 % of its peak
-#: (physics.md section 6). The misfit decision forgives residuals within it; the whole-record
+#: (docs/physics.md section 6). The misfit decision forgives residuals within it; the whole-record
 #: likelihood adds it to the noise.
 TOLERANCE = {"input_bar": 0.01, "internal_output_bar": 0.01, "external_output_bar": 0.01, "tube_hoop": 0.03}
 #: Timing tolerance (s): a wave's arrival is known to about a sample (the bars' wave speeds to

@@ -1,4 +1,4 @@
-"""Frequency-domain wave transport along elastic bars (physics.md sections 2 and 7).
+"""Frequency-domain wave transport along elastic bars (docs/physics.md sections 2 and 7).
 
 Everything that moves a strain wave along a bar goes through this package: the transport of the
 gauge signals to the bar ends that touch the cell (section 2), the dispersion correction of those

@@ -1,7 +1,7 @@
 """The hollow bar's first mode: Love's estimate of its phase velocity and its cut-off.
 
 An approximation valid well below the tube's ring frequency c0 / (2 pi r_m); used for the
-external output bar (physics.md section 7).
+external output bar (docs/physics.md section 7).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Phase velocity of a bar's first longitudinal mode against frequency, and its cut-off.
 
 Solid bar: the exact first mode of :mod:`.pochhammer`; hollow bar: Love's estimate of
-:mod:`.hollow` (physics.md section 7).
+:mod:`.hollow` (docs/physics.md section 7).
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def phase_velocity(
 
     Hollow bar (``inner_diameter > 0``): **approximation**, Love's estimate with the square of the
     radius replaced by r_i^2 + r_o^2 (lateral inertia with the section's polar radius of gyration;
-    physics.md section 7),
+    docs/physics.md section 7),
 
         c/c0 = 1 - nu^2 pi^2 (r_i^2 + r_o^2) / Lambda^2,   Lambda = c / f,
 
@@ -96,7 +96,7 @@ def first_mode_cutoff(*, c0: float, diameter: float, nu: float, inner_diameter: 
 
     Solid bar: d/Lambda = 0.6 (``CUTOFF_D_OVER_LAMBDA``) converted to frequency with the exact
     first-mode curve, f_c = 0.6 (c_p / c0) c0 / d; for nu = 0.29 this is f a / c0 = 0.2619
-    (physics.md section 7).
+    (docs/physics.md section 7).
 
     Hollow bar: the lower of two limits. (1) The same rule with the Love estimate of
     ``phase_velocity``: d_eq/Lambda = 0.6 with the equivalent diameter d_eq = 2 sqrt(r_i^2 + r_o^2)

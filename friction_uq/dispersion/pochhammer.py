@@ -2,7 +2,7 @@
 
 ``pochhammer_phase_velocity_ratio`` solves the frequency equation for c/c0 by root bracketing
 along the first-mode branch; ``phase_velocity_curve`` is the cached table (d/Lambda, c/c0) of
-that branch for one Poisson ratio, for interpolation (physics.md section 7).
+that branch for one Poisson ratio, for interpolation (docs/physics.md section 7).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from ._checks import check_nu
 #: Upper end of the tabulated first-mode curve, d/Lambda (dimensionless).
 CURVE_MAX_D_OVER_LAMBDA = 2.5
 
-#: d/Lambda beyond which the first-mode correction is not trusted (physics.md section 7:
+#: d/Lambda beyond which the first-mode correction is not trusted (docs/physics.md section 7:
 #: f a / c0 = 0.2619 at d/Lambda = 0.6 for a solid bar with nu = 0.29).
 CUTOFF_D_OVER_LAMBDA = 0.6
 
@@ -152,7 +152,7 @@ def pochhammer_phase_velocity_ratio(d_over_lambda: ArrayLike, nu: float) -> np.n
     mode continuously from c/c0 = 1 at d/Lambda = 0 in steps of at most 0.005 in d/Lambda: at
     each step the root is the lowest sign change above a window just below the previous root (the
     first mode is the slowest longitudinal mode at each wavenumber; see ``_march_first_mode``).
-    Reproduces the table of physics.md section 7 to better than 1e-4.
+    Reproduces the table of docs/physics.md section 7 to better than 1e-4.
 
     Parameters
     ----------

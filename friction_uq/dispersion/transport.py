@@ -2,7 +2,7 @@
 
 ``delay`` is an exact fractional (sub-sample) delay by a phase ramp on the zero-padded FFT;
 ``propagate`` gives the wave as it reads a signed distance further along its direction of travel
-(physics.md sections 2 and 7).
+(docs/physics.md sections 2 and 7).
 """
 
 from __future__ import annotations

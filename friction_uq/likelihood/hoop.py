@@ -1,5 +1,5 @@
 """Hoop term of the likelihood: the tube gauge against the closed form's hoop prediction
-(:class:`friction_uq.models.closed_form.HoopPrediction`, physics.md section 6).
+(:class:`friction_uq.models.closed_form.HoopPrediction`, docs/physics.md section 6).
 
 Noise: the hoop channel's pre-pulse sd and AR(1) coefficient, exact AR(1) likelihood; the offset
 error of the baseline (``sd_offset_hoop`` of the data, 0 when absent) is integrated out.
@@ -38,7 +38,7 @@ from .ar1 import _LOG_2PI, _innovations, ar1_offset_correction, ar1_pointwise
 #: How the hoop reading enters the likelihood (HoopTerm).
 HOOP_MODES = ("level", "series")
 #: Relative standard deviation of the hoop model's error on the level: the kernel's fit of the
-#: exact tube solution (2.4 % of peak, physics.md section 6) and the local axial-force
+#: exact tube solution (2.4 % of peak, docs/physics.md section 6) and the local axial-force
 #: approximation of the Poisson term.
 HOOP_DISCREPANCY = 0.03
 

@@ -1,5 +1,5 @@
 """The closed form as a forward model: the force ratio (eq. 13, 17) and the tube hoop gauge (eq. 20
-through the tube kernel, physics.md section 6), for named parameter values.
+through the tube kernel, docs/physics.md section 6), for named parameter values.
 
 It is driven by what the stationary phase measured (a :class:`~friction_uq.window.StationaryData`):
 the internal output force F_io(t) and the slip of the sample; it predicts the external force
@@ -21,7 +21,7 @@ with Lame = 2 a^2 / (E_t (b^2 - a^2)); s the position from the sample's middle, 
 output side; z_g(t) = gauge_offset - slip(t) the gauge's position (the sample slides toward the
 output side, so the gauge moves toward the input face); K_w the tube kernel K averaged over the
 gauge's width (a strain gauge reads the mean strain under its grid; ``gauge_averaging=False`` gives
-the point gauge of physics.md section 6, ~0.4 % higher, well inside the kernel's own 2.4 % fit
+the point gauge of docs/physics.md section 6, ~0.4 % higher, well inside the kernel's own 2.4 % fit
 error; the simulator and the closed-form records average too); p(s, t) the eq. 20 wall pressure,
 written as p = nu/(1-nu) sigma(z) (eq. 8) with sigma(z) = F_io(t) e^{f beta (L - z)/L} / (pi R^2)
 from eq. 11-13 (z = s + L/2), identical to eq. 20 and regular at f = 0. F_io(t) is the observed
@@ -32,7 +32,7 @@ Axial Poisson term, sign choice: the tube rests on the external output bar at it
 friction puts the tube section at s in axial compression N(s) = friction force on the wall between
 the input face and s, N = F_io e^{fb (1/2 - s/L)} (e^{fb (s/L + 1/2)} - 1) for |s| < L/2, 0 on the
 input side, F_eo on the output side (fb = f beta). Axial compression widens the tube (physical hoop
-strain + nu_t N / (E_t A_t), the "+19 microstrain for 5 kN" of physics.md), the same direction as
+strain + nu_t N / (E_t A_t), the "+19 microstrain for 5 kN" of docs/physics.md), the same direction as
 the pressure term, so in the package's convention both terms enter with the minus sign above. The
 local N at the gauge is used (no Saint-Venant spreading), an approximation for a term ~4 % of the
 reading. g, the calibration factor, scales the whole reading.

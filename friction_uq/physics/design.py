@@ -21,7 +21,7 @@ def stationary_internal_force(
     f: ArrayLike, nu: ArrayLike, *, striker_velocity: float, z_input: float, z_internal: float,
     radius: float, length: float,
 ) -> np.ndarray:
-    """F_io = Z_i V_s / (e + Z_i / Z_io) (N). Eq. 15-16 (physics.md section 4).
+    """F_io = Z_i V_s / (e + Z_i / Z_io) (N). Eq. 15-16 (docs/physics.md section 4).
 
     >>> round(float(stationary_internal_force(0.05, 0.4, striker_velocity=10.0, z_input=11449.1,
     ...     z_internal=1122.88, radius=0.005, length=0.01)))

@@ -1,6 +1,6 @@
 """Read and write a confined friction test record (``test.h5``, format version 1).
 
-The contract is ``shared/spec/test-h5.md``. The package is the reading boundary of friction-uq:
+The contract is ``docs/record-format.md``. The package is the reading boundary of friction-uq:
 
 * :mod:`.contract`: the format's constants and the immutable :class:`Record` / :class:`Channel`;
 * :mod:`.reader`: :func:`read_record` checks every rule of the contract (a file that breaks one is

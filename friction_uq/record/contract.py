@@ -1,6 +1,6 @@
 """The ``test.h5`` contract (format version 1): its constants and the checked, immutable record.
 
-The contract is ``shared/spec/test-h5.md``. A :class:`Record` holds the gauge channels converted
+The contract is ``docs/record-format.md``. A :class:`Record` holds the gauge channels converted
 to strain, **positive in compression** (the sign is flipped once, by the reader), and the
 apparatus with its derived quantities.
 """

@@ -63,7 +63,7 @@ def hoop_unusable(p: Prepared) -> str | None:
     * the channel shows no pulse above its noise (a dead or disconnected gauge);
     * its window mean is not a swelling beyond 3 standard errors (noise of the mean and offset);
     * the tube differs from the one the influence function was fitted to (bore 10 mm, outer
-      24 mm, nu_t 0.29; physics.md section 6): the kernel would be wrong.
+      24 mm, nu_t 0.29; docs/physics.md section 6): the kernel would be wrong.
     """
     t = p.record.apparatus.tube
     if not (abs(t.inner_diameter - 0.010) < 1e-6 and abs(t.outer_diameter - 0.024) < 1e-6

@@ -1,7 +1,7 @@
 """Time-domain simulator of the confined friction test (striker, bars, plug, sample, tube, gauges).
 
 Writes synthetic ``test.h5`` records with the physics that the paper's closed-form model leaves
-out (physics.md section 5): friction laws, radial clearance and tube compliance, parasitic plug
+out (docs/physics.md section 5): friction laws, radial clearance and tube compliance, parasitic plug
 friction, gauge gain errors, bar dispersion, measurement noise.
 
 Modules: :mod:`.config` (TOML format and checks), :mod:`.friction` (registry of friction laws),

@@ -1,6 +1,6 @@
 """The [apparatus.PART] tables of a simulation configuration and the cross-checks between keys.
 
-Overrides use the record contract's attribute names (shared/spec/test-h5.md) plus the bars'
+Overrides use the record contract's attribute names (docs/record-format.md) plus the bars'
 optional ``poisson_ratio``; a part's other attributes keep :func:`.config.default_apparatus`'s
 values.
 """

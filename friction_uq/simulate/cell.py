@@ -7,7 +7,7 @@ the output bars):
   nodes (lumped masses rho A h, halves at the faces). Element stress sigma from the element
   strain eps = (u_e - u_{e+1}) / h by the zero-tension, gap-aware law of :func:`element_stress`:
   uniaxial (sigma = E eps, no wall pressure) until the sample's Poisson expansion closes the
-  radial clearance g at sigma* = E g / (nu R), then the wall pressure of physics.md section 6,
+  radial clearance g at sigma* = E g / (nu R), then the wall pressure of docs/physics.md section 6,
   p = (nu sigma - E g / R) / D with D = (1 - nu) + E C_t / E_t (D = 1 - nu for a rigid tube), and
   the matching axial stiffness E / (1 - 2 nu^2 / D) (the oedometric modulus
   M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) when g = 0 and the tube is rigid). With g = 0 and a rigid
@@ -70,7 +70,7 @@ def element_stress(eps: float, young: float, nu: float, den: float, egr: float, 
     """Axial stress (Pa) of a confined column element at axial strain ``eps`` (compression positive).
 
     sigma = E eps up to sigma* = E g / (nu R) (gap open), then (E eps - 2 nu E g / (R D)) /
-    (1 - 2 nu^2 / D) (wall contact, physics.md section 6); 0 in extension. ``den`` = D,
+    (1 - 2 nu^2 / D) (wall contact, docs/physics.md section 6); 0 in extension. ``den`` = D,
     ``egr`` = E g / R.
     """
     if eps <= 0.0:
@@ -90,7 +90,7 @@ def wall_pressure(sigma: float, nu: float, den: float, egr: float) -> float:
 
 @njit
 def end_face_relief(p: float, sigma: float, end_f: float, z: float, length: float, radius: float) -> float:
-    """Wall pressure (Pa) lowered near the sample's end faces by their friction (physics.md section 5).
+    """Wall pressure (Pa) lowered near the sample's end faces by their friction (docs/physics.md section 5).
 
     Shear on an end face (coefficient ``end_f``, at most end_f sigma) holds back the sample's radial
     expansion there; the relief decays into the sample over about one radius:

@@ -29,11 +29,11 @@ file and the key.
 
     [cell]
     gap = 0.0                   # radial clearance sample/tube, m, [0, 1e-4]
-    tube_compliance = false     # bore compliance C_t in the wall pressure (physics.md section 6)
+    tube_compliance = false     # bore compliance C_t in the wall pressure (docs/physics.md section 6)
     tube_density = 7850.0       # kg/m^3 (tube mass for its axial motion)
     hoop_beta = 192.0           # 1/m, decay rate of the hoop influence function (fitted for the paper's tube:
                                 # a = 5 mm, b = 12 mm, nu_t = 0.29; set it for another tube)
-    hoop_axial_term = true      # add nu_t x (axial tube force) / (E_t A_t) to the hoop strain (physics.md section 6)
+    hoop_axial_term = true      # add nu_t x (axial tube force) / (E_t A_t) to the hoop strain (docs/physics.md section 6)
     plug_friction_force = 0.0   # N, constant part of the plug/tube friction strength
     plug_friction_coefficient = 0.0   # plug/tube friction strength per newton of F_i, [0, 1]
     end_friction = 0.0          # friction coefficient of the sample's end faces (PTFE sheets), [0, 1]

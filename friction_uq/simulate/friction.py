@@ -4,10 +4,10 @@ A law gives the shear strength tau_max (Pa) of the sample/tube interface from th
 pressure p (Pa), the local sliding speed V (m/s) and the slip distance already travelled d (m).
 The cell kernel (:mod:`.cell`) applies it at every node as a Coulomb-type set-valued law: the
 interface sticks while the force needed to stick stays below tau_max times the node's wall area,
-and slides with tau = tau_max against the sliding direction otherwise (physics.md eq. 10 for the
+and slides with tau = tau_max against the sliding direction otherwise (docs/physics.md eq. 10 for the
 ``coulomb`` law).
 
-Laws (physics.md section 5):
+Laws (docs/physics.md section 5):
 
 ``coulomb``         tau = f p                                       (eq. 10)
 ``velocity``        tau = [f_d + (f_s - f_d) exp(-V / v_c)] p       (velocity weakening or strengthening)

@@ -1,6 +1,6 @@
 """Hoop gauge on the tube: wall pressure seen through the tube's influence function.
 
-Physical hoop strain at the outer surface (positive when the tube swells), physics.md section 6:
+Physical hoop strain at the outer surface (positive when the tube swells), docs/physics.md section 6:
 
     eps_theta(t) = [2 a^2 / (E_t (b^2 - a^2))] * sum_e p_e(t) * B_e(t)
                    (+ nu_t N(z_g, t) / (E_t A_t) with the optional axial term)

@@ -15,7 +15,7 @@ incident foot at the cell, t_r the rise time and T = 2 L_s / c_s the pulse lengt
 fall starts at t_c + T). The forces approach their stationary values exponentially: the soft sample
 (a spring of stiffness k = M A / L, M the confined modulus) is compressed through the two bar
 impedances, with time constant tau ~ 1 / (k_eff (1/Z_i + 1/(e Z_io))), e = exp(f beta), about
-30 us at f = 0.01 and 90 us at f = 0.5 for the paper's set-up (physics.md section 4: the paper's
+30 us at f = 0.01 and 90 us at f = 0.5 for the paper's set-up (docs/physics.md section 4: the paper's
 stationary phase came 300-400 us after the start of loading). In the last quarter of the plateau
 the forces are within 0.1 % of eq. 15-16 for f <= 0.5; the cell's fast transients (sample
 transit ~7 us, tube m_t / Z_eo ~5 us) are long over and the output bars' far-end reflections

@@ -1,0 +1,245 @@
+"""Oscilloscope exports as delimited text (CSV, TSV, semicolon or whitespace separated).
+
+Scopes differ in everything but the table of numbers: Keysight, Tektronix, Rigol, PicoScope and
+LabVIEW write a different number of metadata lines before the header row, some a units row after
+it, some a trailing delimiter; in some locales the delimiter is ``;`` and the decimal mark ``,``.
+So nothing is assumed: the delimiter and decimal mark are found from the file's last lines (which
+are data), the first data row is the first of several consecutive all-numeric rows of that shape,
+and the header row is the nearest line above the data that names the columns asked for. The body
+is then parsed in one pass by :func:`numpy.loadtxt`; a cell it cannot read is found again line by
+line, so the refusal names the line and the column.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ScopeFileError
+
+#: Largest text export read (bytes): 1 M samples x 8 columns of 16-character numbers is 140 MB.
+MAX_TEXT_BYTES = 2_000_000_000
+#: (delimiter, decimal mark) candidates in order of preference; None splits on whitespace.
+DIALECTS = (("\t", "."), ("\t", ","), (";", "."), (";", ","), (",", "."), (None, "."), (None, ","))
+_NAMES = {"\t": "tab", ";": "semicolon", ",": "comma", None: "whitespace"}
+_HEAD_LINES = 400
+_TAIL_LINES = 20
+_CONFIRM_ROWS = 3
+
+
+@dataclass(frozen=True)
+class TextTable:
+    """The columns asked for, with where they were found (for messages and provenance)."""
+
+    path: Path
+    columns: dict[str | int, np.ndarray]
+    labels: dict[str | int, str]
+    first_data_line: int
+    header_line: int | None
+    delimiter: str | None
+    decimal: str
+
+    @property
+    def dialect(self) -> str:
+        return f"{_NAMES[self.delimiter]}-separated, decimal mark {self.decimal!r}"
+
+
+def _fields(line: str, delim: str | None) -> list[str]:
+    parts = line.split(delim) if delim is not None else line.split()
+    parts = [p.strip().strip('"').strip() for p in parts]
+    while parts and parts[-1] == "":
+        parts.pop()
+    return parts
+
+
+def _number(cell: str, decimal: str) -> bool:
+    if decimal == ",":
+        cell = cell.replace(",", ".")
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
+def _numeric_row(line: str, delim: str | None, decimal: str) -> int:
+    """Number of fields if every field of ``line`` is a number, else 0."""
+    f = _fields(line, delim)
+    return len(f) if f and all(_number(c, decimal) for c in f) else 0
+
+
+def _dialect(path: Path, tail: list[str]) -> tuple[str | None, str, int]:
+    best: tuple[str | None, str, int] | None = None
+    for delim, dec in DIALECTS:
+        counts = {_numeric_row(line, delim, dec) for line in tail}
+        if len(counts) == 1 and (n := counts.pop()) > 0 and (best is None or n > best[2]):
+            best = (delim, dec, n)
+    if best is None:
+        raise ScopeFileError(f"{path}: its last lines are not rows of numbers in any of the usual layouts (comma, "
+                             "semicolon, tab or space separated; decimal point or comma): is it an oscilloscope "
+                             "export?")
+    return best
+
+
+def _data_start(path: Path, head: list[str], delim: str | None, dec: str, ncols: int) -> int:
+    ok = [_numeric_row(line, delim, dec) == ncols for line in head]
+    for i in range(len(head)):
+        if ok[i] and all(ok[i:i + _CONFIRM_ROWS]):
+            return i
+    raise ScopeFileError(f"{path}: no run of {_CONFIRM_ROWS} rows of {ncols} numbers in its first {len(head)} lines: "
+                         "more metadata lines than an oscilloscope writes, or a column that is not numeric")
+
+
+def _header(path: Path, head: list[str], start: int, delim: str | None,
+            wanted: list[str]) -> tuple[int | None, list[str]]:
+    """(index, fields) of the nearest line above the data naming every wanted column (case-insensitively)."""
+    for i in range(start - 1, max(-1, start - 60), -1):
+        f = _fields(head[i], delim)
+        low = [c.lower() for c in f]
+        if f and all(w in f or w.lower() in low for w in wanted):
+            return i, f
+    if wanted:  # name the first missing column against the line that names most of them
+        lines = [(sum(w.lower() in [c.lower() for c in _fields(head[i], delim)] for w in wanted), i)
+                 for i in range(start - 1, max(-1, start - 60), -1) if head[i].strip()]
+        if not lines:
+            raise ScopeFileError(f"{path}: no header line above the data (line {start + 1}); name the columns by "
+                                 "number (column = 2)")
+        _, best = max(lines, key=lambda x: x[0])
+        f = _fields(head[best], delim)
+        miss = next(w for w in wanted if w.lower() not in [c.lower() for c in f])
+        raise ScopeFileError(f"{path}: column {miss!r} not found; the header line {best + 1} has: {', '.join(f)}")
+    for i in range(start - 1, max(-1, start - 60), -1):  # for messages only: the nearest non-numeric line
+        if head[i].strip():
+            return i, _fields(head[i], delim)
+    return None, []
+
+
+def _index(path: Path, key: str | int, header: list[str], header_line: int | None, ncols: int) -> int:
+    if isinstance(key, int):
+        if key > ncols:
+            raise ScopeFileError(f"{path}: column {key} asked for, the data rows have {ncols} columns")
+        return key - 1
+    low = [c.lower() for c in header]
+    i = header.index(key) if key in header else low.index(key.lower())
+    if i >= ncols:
+        raise ScopeFileError(f"{path}: column {key!r} (number {i + 1} on the header line {header_line}) has no "
+                             f"numbers: the data rows have {ncols} columns")
+    return i
+
+
+def _locate_bad_cell(path: Path, lines: list[str], start: int, delim: str | None, dec: str,
+                     idx: list[int], labels: list[str], ncols: int) -> ScopeFileError | None:
+    for n, line in enumerate(lines[start:], start=start + 1):
+        if not line.strip():
+            continue
+        f = _fields(line, delim)
+        if len(f) <= max(idx):
+            return ScopeFileError(f"{path}: line {n} has {len(f)} fields where the data rows have {ncols} "
+                                  "(a truncated or damaged row)")
+        for i, label in zip(idx, labels):
+            if not _number(f[i], dec):
+                return ScopeFileError(f"{path}: line {n}, column {label}: {f[i]!r} is not a number")
+    return None
+
+
+def _text(path: Path) -> str:
+    try:
+        size = path.stat().st_size
+        if size > MAX_TEXT_BYTES:
+            raise ScopeFileError(f"{path}: {size / 1e9:.1f} GB, larger than the {MAX_TEXT_BYTES / 1e9:.0f} GB a text "
+                                 "export is read up to; export fewer samples or a binary format")
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ScopeFileError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    if raw.startswith(b"\x89HDF\r\n\x1a\n"):
+        raise ScopeFileError(f"{path}: is an HDF5 file (a test record already?), not an oscilloscope export; "
+                             "friction-uq inspect reads records")
+    if b"\x00" in raw[:65536]:
+        raise ScopeFileError(f"{path}: is a binary file, not a text export; give a TDMS file the extension .tdms, a "
+                             "LeCroy trace .trc, a Tektronix or Rigol waveform .wfm/.isf/.bin")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")  # scope software in Windows code pages (a 'µs' in a units row)
+
+
+def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
+    """The columns ``wanted`` (header names or 1-based numbers) of a delimited text export, as float64.
+
+    Raises
+    ------
+    ScopeFileError
+        Naming the file and the line or column: no data, a missing column, a cell that is not a
+        number, a short row.
+    """
+    p = Path(path)
+    text = _text(p)
+    if "\n" not in text[: 1 << 16] and "\r" in text[: 1 << 16]:
+        text = text.replace("\r", "\n")  # old Macintosh line ends
+    head = text[: 1 << 18].split("\n")[:_HEAD_LINES]
+    tail = [ln for ln in text[-(1 << 15):].split("\n")[1:] if ln.strip()][-_TAIL_LINES:]
+    if not tail:  # a short file: its tail is its head
+        tail = [ln for ln in head if ln.strip()][-_TAIL_LINES:]
+    if not tail:
+        raise ScopeFileError(f"{p}: is empty")
+    delim, dec, ncols = _dialect(p, tail)
+    start = _data_start(p, head, delim, dec, ncols)
+    names = [w for w in wanted if isinstance(w, str)]
+    hline, header = _header(p, head, start, delim, names)
+    idx = [_index(p, w, header, None if hline is None else hline + 1, ncols) for w in wanted]
+    labels = [repr(header[i]) if i < len(header) else f"{i + 1}" for i in idx]
+    labels = [f"{lab} (number {i + 1})" for lab, i in zip(labels, idx)]
+    # the body from the first data row, as one string (offset found without splitting the whole file)
+    offset = 0
+    for _ in range(start):
+        offset = text.index("\n", offset) + 1
+    body = text[offset:]
+    if dec == ",":
+        body = body.replace(",", ".")
+    uniq = sorted(set(idx))
+    try:
+        data = np.loadtxt(io.StringIO(body), delimiter=delim, usecols=uniq, dtype=np.float64, ndmin=2,
+                          quotechar='"', comments=None)
+    except ValueError as exc:
+        err = _locate_bad_cell(p, text.split("\n"), start, delim, dec, idx, labels, ncols)
+        raise (err or ScopeFileError(f"{p}: cannot be read as a table from line {start + 1}: {exc}")) from None
+    cols = {w: np.ascontiguousarray(data[:, uniq.index(i)]) for w, i in zip(wanted, idx)}
+    return TextTable(p, cols, dict(zip(wanted, labels)), start + 1, None if hline is None else hline + 1, delim, dec)
+
+
+def describe_text(path: str | Path) -> list[str]:
+    """What a text export holds, for writing SETUP.toml: its layout, the header's columns, a first row."""
+    p = Path(path)
+    text = _text(p)
+    if "\n" not in text[: 1 << 16] and "\r" in text[: 1 << 16]:
+        text = text.replace("\r", "\n")
+    head = text[: 1 << 18].split("\n")[:_HEAD_LINES]
+    tail = [ln for ln in text[-(1 << 15):].split("\n")[1:] if ln.strip()][-_TAIL_LINES:] or \
+        [ln for ln in head if ln.strip()][-_TAIL_LINES:]
+    if not tail:
+        raise ScopeFileError(f"{p}: is empty")
+    delim, dec, ncols = _dialect(p, tail)
+    start = _data_start(p, head, delim, dec, ncols)
+    above = [i for i in range(start - 1, max(-1, start - 60), -1) if head[i].strip()][:3]
+    named = [i for i in above if len(f := _fields(head[i], delim)) >= ncols and len(set(f)) == len(f)]
+    hline = named[0] if named else None
+    header = _fields(head[hline], delim) if hline is not None else []
+    table = read_delimited(p, list(range(1, ncols + 1)))
+    n = len(table.columns[1])
+    first = [table.columns[i][0] for i in range(1, ncols + 1)]
+    out = [f"{p}: {table.dialect}; {start} line(s) before the data, data from line {start + 1}, {n} rows"]
+    out += [f"  line {i + 1}: {', '.join(_fields(head[i], delim))}" for i in reversed(above)]
+    out.append(f"  column names from line {hline + 1}" if hline is not None
+               else "  no header line: name columns by number")
+    for i in range(ncols):
+        name = header[i] if i < len(header) else ""
+        col = table.columns[i + 1]
+        step = np.diff(col[: min(n, 1000)])
+        timelike = n > 2 and np.all(step > 0) and np.ptp(step) < 0.01 * step.mean()
+        even = " (evenly increasing: a time column?)" if timelike else ""
+        out.append(f"  column {i + 1:>2}  {name!r:<16} first {first[i]:<14.6g} min {col.min():<12.4g} "
+                   f"max {col.max():<12.4g}{even}")
+    return out

@@ -1,0 +1,82 @@
+"""``friction-uq priors``: list the materials that have prior files, or start the files of a new one.
+
+The parser and the command's body; :mod:`friction_uq.cli` registers them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+
+HELP = "list the materials with prior files, or write starting prior files for a new sample material"
+DESCRIPTION = (
+    "Without MATERIAL: the materials whose prior files come with friction-uq (and those in --out), each with its "
+    "alternative nu priors. With MATERIAL, --nu and --nu-sd: write MATERIAL.toml (the default priors) and "
+    "MATERIAL-nu-tight.toml, MATERIAL-nu-wide.toml (the alternatives a run compares) into --out, commented for "
+    "you to edit; then 'friction-uq run test.h5 --priors MATERIAL.toml'. Format: docs/priors.md."
+)
+
+
+def _material(text: str) -> str:
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.+-]*", text) or "-nu-" in text:
+        raise argparse.ArgumentTypeError(f"material {text!r} must be a name of letters, digits, '_', '.', '+', '-' "
+                                         "(as in the record's /apparatus/sample@material), without '-nu-'")
+    return text
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser("priors", help=HELP, description=DESCRIPTION)
+    s.add_argument("material", nargs="?", type=_material, help="sample material, as the record names it")
+    s.add_argument("--nu", type=float, help="your estimate of the sample's Poisson ratio, in (0, 0.5)")
+    s.add_argument("--nu-sd", type=float, help="its uncertainty (one standard deviation), e.g. 0.03")
+    s.add_argument("--source", default="", help="where the estimate comes from (written into the files)")
+    s.add_argument("--out", type=Path, default=Path("."), help="folder to write to (default: the current folder)")
+    s.add_argument("--force", action="store_true", help="replace files of the same names")
+
+
+def _listing(folder: Path) -> str:
+    from .priors import PRIORS_DIR, prior_files
+
+    folders = [(PRIORS_DIR, "come with friction-uq")]
+    if folder.resolve() != PRIORS_DIR.resolve() and prior_files(folder):
+        folders.append((folder, f"are in {folder}"))
+    lines = []
+    for where, label in folders:
+        lines.append(f"materials whose prior files {label} ({where}):")
+        for m, alts in prior_files(where).items():
+            lines.append(f"  {m:<16} nu alternatives: {', '.join(a.removeprefix(m + '-') for a in alts) or 'none'}")
+    lines.append("a new material: friction-uq priors MATERIAL --nu ESTIMATE --nu-sd UNCERTAINTY")
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ._atomic import write_bytes
+    from .errors import FrictionUQError, OutputError
+    from .prior_template import prior_texts
+    from .priors import parse_priors
+
+    if args.material is None:
+        print(_listing(args.out))
+        return 0
+    if args.nu is None or args.nu_sd is None:
+        raise FrictionUQError(f"priors {args.material}: give --nu (your estimate of the Poisson ratio) and --nu-sd "
+                              "(its uncertainty, one standard deviation)")
+    try:
+        texts = prior_texts(args.material, args.nu, args.nu_sd, args.source)
+    except ValueError as exc:
+        raise FrictionUQError(f"priors {args.material}: {exc}") from None
+    paths = {args.out / name: text for name, text in texts.items()}
+    if not args.force:
+        for p in paths:
+            if p.exists():
+                raise OutputError(f"{p}: exists; choose another --out or give --force to replace it")
+    import tomllib
+
+    for p, text in paths.items():
+        parse_priors(tomllib.loads(text), path=p)  # what is written reads back
+    for p, text in paths.items():
+        write_bytes(p, text.encode("utf-8"))
+        print(f"wrote {p}")
+    print(f"next: friction-uq run test.h5 --priors {args.out / (args.material + '.toml')}")
+    return 0

@@ -1,0 +1,63 @@
+"""The Python interface: lazy at import, the functions as the commands, a run's outputs read back."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import friction_uq as fu
+from friction_uq.errors import FrictionUQError
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_import_friction_uq_loads_no_scientific_stack():
+    code = "import sys, friction_uq; print(sorted(m for m in ('numpy', 'scipy', 'h5py', 'arviz') if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+
+
+def test_the_interface_is_listed_and_documented():
+    for name in ("run", "diagnose", "campaign", "read_result", "import_scope_files"):
+        assert name in fu.__all__ and callable(getattr(fu, name)) and getattr(fu, name).__doc__
+
+
+def test_run_and_campaign_stay_the_functions_once_their_subpackages_load():
+    import inspect
+
+    import friction_uq.campaign  # noqa: F401  (binds the subpackage's name on the package)
+    import friction_uq.run  # noqa: F401
+
+    assert callable(fu.run) and callable(fu.campaign)
+    assert "priors" in inspect.signature(fu.run).parameters
+    assert "workers" in inspect.signature(fu.campaign).parameters
+    with pytest.raises(FrictionUQError, match="file not found"):
+        fu.run(ROOT / "nope.h5", out_dir=ROOT / "reports" / "never")
+
+
+def test_read_result_reads_the_json_and_refuses_others(tmp_path):
+    doc = {"schema": "friction-uq/run-result", "schema_version": 2, "test_id": "A-03", "warnings": ["w"],
+           "f": {"mean": 0.05, "q05": 0.04, "q50": 0.05, "q95": 0.06, "model": "stationary"}}
+    (tmp_path / "A_A-03.json").write_text(json.dumps(doc))
+    res = fu.read_result(tmp_path / "A_A-03.nc")  # the stem, the .nc or the .json
+    assert res.f["q50"] == 0.05 and res.warnings == ["w"] and res.test_id == "A-03"
+    with pytest.raises(FrictionUQError, match=r"A_A-03.json: its netCDF file .* is missing"):
+        res.datatree()
+    (tmp_path / "x.json").write_text(json.dumps({"schema": "friction-uq/campaign"}))
+    with pytest.raises(FrictionUQError, match=r"x.json: not a run result"):
+        fu.read_result(tmp_path / "x.json")
+
+
+@pytest.mark.slow
+def test_example_imports_a_csv_runs_and_draws_a_figure(tmp_path):
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "import_and_run.py"), "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert (tmp_path / "A-03_f_nu.pdf").read_bytes()[:4] == b"%PDF"
+    res = fu.read_result(tmp_path / "A_A-03.json")
+    assert res.datatree()["posterior"]["f"].shape[0] >= 1
+    assert "f = " in r.stdout and "eti90" in r.stdout
