@@ -22,7 +22,7 @@ from ..priors import load_priors
 from .flags import outlier_tests, setup_flags, tally_causes
 from .job import RecordResult
 from ..stats import WeightRule, stacking_weights
-from .laws import LAWS, Elpd, Fit, LawData, Model, law_mean, loo, rank
+from .laws import LAW_PARAMS, LAWS, Elpd, Fit, LawData, Model, law_mean, loo, rank
 from .next_test import Candidate, advice, rank_next_tests
 from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin
 
@@ -130,6 +130,14 @@ def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None
                    np.array([t.V["mean"] for t in tests]), np.array([t.V["sd"] for t in tests]),
                    np.array([np.mean(t.p_mean) for t in tests]), np.array([np.std(t.p_mean) for t in tests]),
                    basis="f" if diagnosed else "kappa", draws=tuple(y), draws_log_prior=log_prior)
+
+
+def simplest_supported(weights: dict[str, float]) -> str:
+    """The law with the fewest parameters among those the weights support (the heaviest among equals): set-ups
+    are flagged under it, since a richer law can absorb a set-up's offset into the term it adds (a pressure term
+    fits a set-up whose bars put it at other pressures)."""
+    supported = WEIGHT_RULE.supported(weights)
+    return min(supported, key=lambda law: (len(LAW_PARAMS[law]), -weights[law]))
 
 
 def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
@@ -313,11 +321,11 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     cal = tuple(setups[1:])  # every set-up but the first: a calibration offset (laws.CALIBRATION_SD)
     laws = _Laws(ca, data, kbar, p_ref, seed, say, t0)
     elpds = laws.compare(cal, ())
-    law_for_flags = max(ca.weights, key=ca.weights.get)
+    law_for_flags = simplest_supported(ca.weights)
     first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies)
     if freed:  # the laws again, the flagged set-ups' levels left out (a free offset each): never fitted by them
         elpds = laws.compare(cal, tuple(freed))
-        law_for_flags = max(ca.weights, key=ca.weights.get)
+        law_for_flags = simplest_supported(ca.weights)
         ca.sentences.append(f"the friction law is compared with the level of set-up {', '.join(freed)} left out: it "
                             "departs from the shared law beyond its calibration (3 %), a finding for diagnose to "
                             "explain, not a part of any law")
