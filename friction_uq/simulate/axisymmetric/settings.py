@@ -1,0 +1,84 @@
+"""The ``[model]`` table of a simulation configuration: which simulator, and the axisymmetric one's settings.
+
+.. code-block:: toml
+
+    [model]
+    fidelity = "1d"               # "1d" (default: the 1-D simulator) | "axisymmetric" (plug, sample, tube in (r, z))
+    # the keys below are read by the axisymmetric model only
+    element_size = 0.25e-3        # m, target edge of the 4-node rings of every body, (0, 2e-3]
+    cfl = 0.8                     # time step as a fraction of the mesh's stability limit, (0, 1]
+    time_step = 0.0               # s; 0: cfl x the limit; else this step, refused when above the limit
+    hourglass = 0.05              # hourglass stiffness coefficient c_hg, [0, 0.5]
+    bulk_viscosity = 0.06         # linear bulk viscosity coefficient, [0, 1]
+    tube = true                   # false: no tube (verification: a free sample between two bars)
+    plug_insertion = 5e-3         # m, length of the plug inside the tube at the start, [0, plug length)
+    plug_clearance = 1e-5         # m, radial clearance plug/tube, [0, 1e-4]
+    plug_friction = 0.0           # Coulomb coefficient of the plug on the bore (on its own wall pressure), [0, 1]
+    sample_plasticity = "elastic" # "elastic" | "drucker_prager" (sigma_mises - alpha P < C, eq. 1)
+    cohesion = 25e6               # Pa, C of Drucker-Prager (the paper's I1)
+    dp_alpha = 0.64               # alpha of Drucker-Prager (the paper's I1)
+
+Every other table means the same for both simulators: friction law (sample/tube wall), ``[cell]``
+gap (sample/tube clearance), plug_friction_force / plug_friction_coefficient (a strength of the
+plug/tube contact independent of its pressure, spread over the plug's length inside the tube),
+end_friction (both end faces of the sample), tube_density; bars, loading, measurement and channels.
+Keys of the 1-D approximations that the axisymmetric model computes instead (``tube_compliance``,
+``hoop_beta``, ``hoop_axial_term``, ``[numerics]``) are read and ignored by it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from .._checks import Section
+
+FIDELITIES = ("1d", "axisymmetric")
+PLASTICITY = ("elastic", "drucker_prager")
+KEYS = ("fidelity", "element_size", "cfl", "time_step", "hourglass", "bulk_viscosity", "tube", "plug_insertion",
+        "plug_clearance", "plug_friction", "sample_plasticity", "cohesion", "dp_alpha")
+
+
+@dataclass(frozen=True)
+class ModelSettings:
+    """The ``[model]`` table (module docstring)."""
+
+    fidelity: str = "1d"
+    element_size: float = 0.25e-3
+    cfl: float = 0.8
+    time_step: float = 0.0
+    hourglass: float = 0.05
+    bulk_viscosity: float = 0.06
+    tube: bool = True
+    plug_insertion: float = 5e-3
+    plug_clearance: float = 1e-5
+    plug_friction: float = 0.0
+    sample_plasticity: str = "elastic"
+    cohesion: float = 25e6
+    dp_alpha: float = 0.64
+
+    @property
+    def axisymmetric(self) -> bool:
+        return self.fidelity == "axisymmetric"
+
+
+def parse_model(source: str, table: Any) -> ModelSettings:
+    """Read the ``[model]`` table (ConfigError naming the key when a value is refused)."""
+    d = ModelSettings()
+    s = Section(source, "model", table if isinstance(table, Mapping) else table, KEYS)
+    return ModelSettings(
+        fidelity=s.string("fidelity", d.fidelity, choices=FIDELITIES),
+        element_size=s.number("element_size", d.element_size, low=0.0, high=2e-3, low_open=True),
+        cfl=s.number("cfl", d.cfl, low=0.0, high=1.0, low_open=True),
+        time_step=s.number("time_step", d.time_step, low=0.0, high=1e-5),
+        hourglass=s.number("hourglass", d.hourglass, low=0.0, high=0.5),
+        bulk_viscosity=s.number("bulk_viscosity", d.bulk_viscosity, low=0.0, high=1.0),
+        tube=s.boolean("tube", d.tube),
+        plug_insertion=s.number("plug_insertion", d.plug_insertion, low=0.0, high=1.0),
+        plug_clearance=s.number("plug_clearance", d.plug_clearance, low=0.0, high=1e-4),
+        plug_friction=s.number("plug_friction", d.plug_friction, low=0.0, high=1.0),
+        sample_plasticity=s.string("sample_plasticity", d.sample_plasticity, choices=PLASTICITY),
+        cohesion=s.number("cohesion", d.cohesion, low=0.0, high=1e10, low_open=True),
+        dp_alpha=s.number("dp_alpha", d.dp_alpha, low=0.0, high=3.0),
+    )
