@@ -151,7 +151,7 @@ def _surfaces(mesh: Mesh, config: SimulationConfig, *, has_plug: bool, z_gauge: 
         tube_end=t_end, in_face=in_face, share_in=_shares(X[in_face, 0]), share_out=_shares(X[sample_out, 0]),
         share_tube=share_tube, hoop_nodes=hoop_nodes, hoop_w=hoop_w, hoop_radius=hoop_r, sample_rows=rows,
         body_nodes=body_nodes, offset_sample=(a - radius) - config.gap, offset_plug=0.0,
-        critical_step=critical_time_step(omega, bulk_viscosity=ms.bulk_viscosity),
+        critical_step=critical_time_step(omega, damping=ms.damping),
     )
 
 

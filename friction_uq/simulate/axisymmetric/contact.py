@@ -11,7 +11,8 @@ time step or adds compliance:
   negative g is closed by the normal impulse J = -g / (dt (1/m_s + (1-w)^2/m_j + w^2/m_j+1))
   (two Gauss-Seidel sweeps, J >= 0 in total). The wall pressure is p = J / (dt A_s), A_s the node's
   lateral area. The axial (tangential) impulse that would stop the relative sliding is then
-  limited to the strength tau_max(p, V, d) A_s dt of the simulator's friction law
+  limited to the strength tau_max(p, V, d) A_s dt of the simulator's friction law (V the sliding
+  speed at the end of the step, found with the impulse: implicit in V)
   (:func:`friction_uq.simulate.friction.shear_strength`), plus an optional strength independent of
   pressure (the parasitic plug friction of the 1-D model, per node).
 * **End-face pairs** (plug front face on the sample's input face): node k of one face meets node k
@@ -46,6 +47,26 @@ def find_segment(zm: np.ndarray, z: float) -> int:
         else:
             hi = mid
     return lo
+
+
+@njit
+def sliding_speed(rel: float, invm: float, law: int, fpar: np.ndarray, p: float, slip: float, area: float,
+                  extra: float, dt: float) -> float:
+    """Sliding speed V after the step of a node that slides: V = rel - S(V) invm, S the strength impulse.
+
+    Solved by bisection on [0, rel] (S(0) invm < rel when the node slides; S >= 0 at V = rel): the
+    friction law is taken at the end of the step, which keeps a velocity-weakening law from pumping
+    energy into the mesh's fastest modes, as its evaluation at the previous speed does.
+    """
+    lo, hi = 0.0, rel
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        g = mid - rel + (shear_strength(law, fpar, p, mid, slip) * area + extra) * dt * invm
+        if g > 0.0:
+            hi = mid
+        else:
+            lo = mid
+    return 0.5 * (lo + hi)
 
 
 @njit
@@ -104,14 +125,14 @@ def lateral_contact(slaves: np.ndarray, area: np.ndarray, masters: np.ndarray, X
             continue
         a, b, w = masters[j], masters[j + 1], wgt[i]
         p = j_normal[i] / (dt * area[i])
-        strength = (shear_strength(law, fpar, p, speed[i], slip[i]) * area[i] + extra_strength[i]) * dt
         rel = v[s, 1] - (1.0 - w) * v[a, 1] - w * v[b, 1]
         invm = 1.0 / mass[s] + (1.0 - w) ** 2 / mass[a] + w * w / mass[b]
         jt = rel / invm
-        if jt > strength:
-            jt = strength
-        elif jt < -strength:
-            jt = -strength
+        strength = (shear_strength(law, fpar, p, 0.0, slip[i]) * area[i] + extra_strength[i]) * dt
+        if abs(jt) > strength:  # sliding: the strength at the speed after the step (implicit in V)
+            speed_after = sliding_speed(abs(rel), invm, law, fpar, p, slip[i], area[i], extra_strength[i], dt)
+            strength = (shear_strength(law, fpar, p, speed_after, slip[i]) * area[i] + extra_strength[i]) * dt
+            jt = strength if rel > 0.0 else -strength
         v[s, 1] -= jt / mass[s]
         v[a, 1] += jt * (1.0 - w) / mass[a]
         v[b, 1] += jt * w / mass[b]

@@ -16,8 +16,11 @@ strain on the reference geometry: the sliding is a rigid axial translation, whic
 * **Hourglass control** (Flanagan-Belytschko, stiffness form): the bilinear mode h = (1, -1, 1, -1),
   orthogonal to the linear fields on a rectangle, is resisted by f_i = -k h_i (h . u) per direction,
   k = c_hg (lambda + 2 mu) V (1/dr^2 + 1/dz^2) / 4; its energy k (h.u)^2 / 2 is stored, not lost.
-* **Bulk viscosity** (linear, as explicit codes do): a pressure q = -c_b rho c_p l eps_vol_rate
-  (l = min(dr, dz)) damps ringing at the mesh scale and vanishes in a stationary state.
+* **Stiffness-proportional damping** (Rayleigh): a viscous stress D eps_rate (l / c_p) z, l = min(dr,
+  dz), gives the mesh's highest mode the damping ratio z and a mode of frequency omega the ratio
+  z omega / omega_max: it damps ringing at the mesh scale (and the node-level stick-slip a
+  velocity-weakening law feeds there, as the 1-D simulator's artificial viscosity does) and
+  vanishes in a stationary state (rigid sliding strains nothing).
 * **Drucker-Prager, perfectly plastic** (sample, optional): yield sigma_mises - alpha P = C
   (physics.md section 1: C = 25 MPa, alpha = 0.64 for I1). Return: the deviator is scaled back to
   the yield surface at constant pressure (no plastic dilatancy); below the apex (P < -C / alpha)
@@ -77,19 +80,19 @@ def hourglass_stiffness(mat: np.ndarray, geo: np.ndarray, c_hg: float) -> float:
 @njit
 def add_internal_forces(u: np.ndarray, sig: np.ndarray, visc: np.ndarray, conn: np.ndarray, geo: np.ndarray,
                         mat: np.ndarray, c_hg: float, force: np.ndarray) -> float:
-    """Add the nodal forces of stress, bulk viscosity and hourglass control to ``force`` (n, 2).
+    """Add the nodal forces of stress, damping and hourglass control to ``force`` (n, 2).
 
-    Returns the hourglass energy (J). ``visc`` (n_el,) is the viscous pressure-like stress added to the
-    three normal stresses (tension positive).
+    Returns the hourglass energy (J). ``visc`` (n_el, 4) is the viscous stress added to ``sig``
+    (tension positive).
     """
     e_hg = 0.0
     for e in range(conn.shape[0]):
         r1, dr, dz, vol = geo[e, 0], geo[e, 1], geo[e, 2], geo[e, 3]
         rc = r1 + 0.5 * dr
-        srr = sig[e, SRR] + visc[e]
-        szz = sig[e, SZZ] + visc[e]
-        stt = sig[e, STT] + visc[e]
-        srz = sig[e, SRZ]
+        srr = sig[e, SRR] + visc[e, SRR]
+        szz = sig[e, SZZ] + visc[e, SZZ]
+        stt = sig[e, STT] + visc[e, STT]
+        srz = sig[e, SRZ] + visc[e, SRZ]
         k = hourglass_stiffness(mat[e], geo[e], c_hg)
         qr = 0.0
         qz = 0.0
@@ -109,12 +112,12 @@ def add_internal_forces(u: np.ndarray, sig: np.ndarray, visc: np.ndarray, conn: 
 
 @njit
 def update_stresses(du: np.ndarray, dt: float, sig: np.ndarray, visc: np.ndarray, conn: np.ndarray,
-                    geo: np.ndarray, mat: np.ndarray, c_bulk: float) -> tuple[float, float]:
+                    geo: np.ndarray, mat: np.ndarray, damping: float) -> tuple[float, float]:
     """Stresses after the displacement increment ``du`` (n, 2) of one step.
 
     Returns (stress work, viscous dissipation) (J): V (s_old + s_new) / 2 : d_eps summed over the
-    elements (elastic energy plus plastic dissipation), and V q d_eps_vol with the viscous stress q
-    that acted during the step. ``visc`` is then set to the bulk-viscosity stress of this step's strain rate.
+    elements (elastic energy plus plastic dissipation), and V s_v : d_eps with the viscous stress s_v
+    that acted during the step. ``visc`` is then set to the damping stress of this step's strain rate.
     """
     work = 0.0
     d_visc = 0.0
@@ -144,8 +147,12 @@ def update_stresses(du: np.ndarray, dt: float, sig: np.ndarray, visc: np.ndarray
             drucker_prager_return(sig[e], mat[e, COH], mat[e, ALPHA])
         work += 0.5 * vol * ((o0 + sig[e, SRR]) * d_rr + (o1 + sig[e, SZZ]) * d_zz
                              + (o2 + sig[e, STT]) * d_tt + (o3 + sig[e, SRZ]) * g_rz)
-        d_visc += vol * visc[e] * tr
-        visc[e] = c_bulk * mat[e, RHO] * mat[e, CP] * min(dr, dz) * tr / dt
+        d_visc += vol * (visc[e, SRR] * d_rr + visc[e, SZZ] * d_zz + visc[e, STT] * d_tt + visc[e, SRZ] * g_rz)
+        eta = damping * min(dr, dz) / mat[e, CP] / dt
+        visc[e, SRR] = eta * (lam * tr + 2.0 * mu * d_rr)
+        visc[e, SZZ] = eta * (lam * tr + 2.0 * mu * d_zz)
+        visc[e, STT] = eta * (lam * tr + 2.0 * mu * d_tt)
+        visc[e, SRZ] = eta * mu * g_rz
     return work, d_visc
 
 
@@ -155,7 +162,7 @@ def elastic_forces(u: np.ndarray, conn: np.ndarray, geo: np.ndarray, mat: np.nda
     """force = -K u for the linear elastic mesh (stress from the total strain of ``u``; no viscosity)."""
     n_el = conn.shape[0]
     sig = np.zeros((n_el, 4))
-    visc = np.zeros(n_el)
+    visc = np.zeros((n_el, 4))
     zero_mat = mat.copy()
     zero_mat[:, PLASTIC] = 0.0
     update_stresses(u, 1.0, sig, visc, conn, geo, zero_mat, 0.0)
@@ -184,7 +191,8 @@ def highest_frequency(mass: np.ndarray, conn: np.ndarray, geo: np.ndarray, mat: 
     return 1.02 * math.sqrt(max(lam, 0.0))
 
 
-def critical_time_step(omega_max: float, *, bulk_viscosity: float) -> float:
-    """Stability limit of central differences (s): (2 / omega_max)(sqrt(1 + z^2) - z), z = c_bulk."""
-    z = bulk_viscosity
+def critical_time_step(omega_max: float, *, damping: float) -> float:
+    """Stability limit of central differences (s): (2 / omega_max)(sqrt(1 + z^2) - z), z the damping ratio
+    of the highest mode."""
+    z = damping
     return 2.0 / omega_max * (math.sqrt(1.0 + z * z) - z)

@@ -96,15 +96,15 @@ def run_axisymmetric(config: SimulationConfig, *, loading: Loading | None = None
         eps_i = float(np.max(loading.at_cell))
     ms = config.model
     par = np.zeros(S.N_PAR)
-    par[[S.DT, S.C_HG, S.C_BULK, S.END_F, S.OFF_SAMPLE, S.OFF_PLUG]] = (
-        dt, ms.hourglass, ms.bulk_viscosity, config.end_friction, cell.offset_sample, cell.offset_plug)
+    par[[S.DT, S.C_HG, S.DAMPING, S.END_F, S.OFF_SAMPLE, S.OFF_PLUG]] = (
+        dt, ms.hourglass, ms.damping, config.end_friction, cell.offset_sample, cell.offset_plug)
     par[[S.Z_I, S.C_I, S.Z_IO, S.C_IO, S.Z_EO, S.C_EO, S.HOOP_R]] = (
         ib.impedance, ib.wave_speed, iob.impedance, iob.wave_speed, eob.impedance, eob.wave_speed, cell.hoop_radius)
     law = LAWS[config.friction_law]
     flag = np.array([cell.plug_front.size > 0, ms.tube, law.code], dtype=np.int64)
     n_nodes, n_el = mesh.n_nodes, mesh.n_elements
     ns, npl = cell.sample_outer.size, cell.plug_outer.size
-    state = dict(u=np.zeros((n_nodes, 2)), v=np.zeros((n_nodes, 2)), sig=np.zeros((n_el, 4)), visc=np.zeros(n_el),
+    state = dict(u=np.zeros((n_nodes, 2)), v=np.zeros((n_nodes, 2)), sig=np.zeros((n_el, 4)), visc=np.zeros((n_el, 4)),
                  slip_s=np.zeros(ns), speed_s=np.zeros(ns), slip_p=np.zeros(npl), speed_p=np.zeros(npl),
                  faces=np.zeros((3, N_FACE_STATE)), acc=np.zeros(S.N_ACC))
     eps_in = [inc_cell.copy(), np.zeros(n), np.zeros(n)]

@@ -5,11 +5,11 @@
     [model]
     fidelity = "1d"               # "1d" (default: the 1-D simulator) | "axisymmetric" (plug, sample, tube in (r, z))
     # the keys below are read by the axisymmetric model only
-    element_size = 0.25e-3        # m, target edge of the 4-node rings of every body, (0, 2e-3]
+    element_size = 0.5e-3         # m, target edge of the 4-node rings of every body, (0, 2e-3]
     cfl = 0.8                     # time step as a fraction of the mesh's stability limit, (0, 1]
     time_step = 0.0               # s; 0: cfl x the limit; else this step, refused when above the limit
     hourglass = 0.05              # hourglass stiffness coefficient c_hg, [0, 0.5]
-    bulk_viscosity = 0.06         # linear bulk viscosity coefficient, [0, 1]
+    damping = 0.3                 # stiffness-proportional damping: ratio of the mesh's highest mode, [0, 1]
     tube = true                   # false: no tube (verification: a free sample between two bars)
     plug_insertion = 5e-3         # m, length of the plug inside the tube at the start, [0, plug length)
     plug_clearance = 1e-5         # m, radial clearance plug/tube, [0, 1e-4]
@@ -36,7 +36,7 @@ from .._checks import Section
 
 FIDELITIES = ("1d", "axisymmetric")
 PLASTICITY = ("elastic", "drucker_prager")
-KEYS = ("fidelity", "element_size", "cfl", "time_step", "hourglass", "bulk_viscosity", "tube", "plug_insertion",
+KEYS = ("fidelity", "element_size", "cfl", "time_step", "hourglass", "damping", "tube", "plug_insertion",
         "plug_clearance", "plug_friction", "sample_plasticity", "cohesion", "dp_alpha")
 
 
@@ -45,11 +45,11 @@ class ModelSettings:
     """The ``[model]`` table (module docstring)."""
 
     fidelity: str = "1d"
-    element_size: float = 0.25e-3
+    element_size: float = 0.5e-3
     cfl: float = 0.8
     time_step: float = 0.0
     hourglass: float = 0.05
-    bulk_viscosity: float = 0.06
+    damping: float = 0.3
     tube: bool = True
     plug_insertion: float = 5e-3
     plug_clearance: float = 1e-5
@@ -73,7 +73,7 @@ def parse_model(source: str, table: Any) -> ModelSettings:
         cfl=s.number("cfl", d.cfl, low=0.0, high=1.0, low_open=True),
         time_step=s.number("time_step", d.time_step, low=0.0, high=1e-5),
         hourglass=s.number("hourglass", d.hourglass, low=0.0, high=0.5),
-        bulk_viscosity=s.number("bulk_viscosity", d.bulk_viscosity, low=0.0, high=1.0),
+        damping=s.number("damping", d.damping, low=0.0, high=1.0),
         tube=s.boolean("tube", d.tube),
         plug_insertion=s.number("plug_insertion", d.plug_insertion, low=0.0, high=1.0),
         plug_clearance=s.number("plug_clearance", d.plug_clearance, low=0.0, high=1e-4),

@@ -2,7 +2,7 @@
 
 One step (t_k -> t_k+1), velocities at half steps:
 
-1. nodal forces of the stresses, bulk viscosity and hourglass control at t_k (:mod:`.kernels`);
+1. nodal forces of the stresses, damping and hourglass control at t_k (:mod:`.kernels`);
 2. trial velocities v + dt f / m (nodes on the axis keep u_r = 0);
 3. contacts on the trial velocities (:mod:`.contact`): plug front face on the sample's input face,
    sample on the tube's bore, plug on the bore;
@@ -14,7 +14,7 @@ One step (t_k -> t_k+1), velocities at half steps:
 
 Energy (J), accumulated for the balance W_bars = KE + W_stress + E_hourglass + D_viscous + D_contact:
 the bars' work on the cell, the stress work (elastic energy and plastic dissipation), the
-hourglass energy, the bulk viscosity's dissipation and the energy taken by the contacts (friction
+hourglass energy, the damping's dissipation and the energy taken by the contacts (friction
 and closure). The kinetic energy is taken at t_k from the mean of the two half-step velocities.
 """
 
@@ -28,7 +28,7 @@ from .coupling import WORK, bar_face
 from .kernels import SZZ, add_internal_forces, update_stresses
 
 # scalar parameters ``par``
-DT, C_HG, C_BULK, END_F, OFF_SAMPLE, OFF_PLUG, Z_I, C_I, Z_IO, C_IO, Z_EO, C_EO, HOOP_R = range(13)
+DT, C_HG, DAMPING, END_F, OFF_SAMPLE, OFF_PLUG, Z_I, C_I, Z_IO, C_IO, Z_EO, C_EO, HOOP_R = range(13)
 N_PAR = 13
 #: friction law code of the plug/tube contact (Coulomb, coefficient in the plug's parameter vector)
 PLUG_LAW = 0
@@ -153,7 +153,7 @@ def run_block(k0: int, k1: int, stride: int, par: np.ndarray, flag: np.ndarray, 
             du[i, 1] = dt * v[i, 1]
             u[i, 0] += du[i, 0]
             u[i, 1] += du[i, 1]
-        w_stress, d_visc = update_stresses(du, dt, sig, visc, conn, geo, mat, par[C_BULK])
+        w_stress, d_visc = update_stresses(du, dt, sig, visc, conn, geo, mat, par[DAMPING])
         acc[W_STRESS] += w_stress
         acc[D_VISC] += d_visc
 
