@@ -12,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .._atomic import atomic_path
 from ..simulate.axisymmetric.compare import PHASES, QUANTITIES, UNITS, Comparison, compare, eq17_friction, figure15
 from ..simulate.config import SimulationConfig
-from .._atomic import atomic_path
 from .style import A4_LANDSCAPE, CORE_FONTS, RC, plt
 
 

@@ -91,7 +91,7 @@ from ..physics.tube import BETA_EFF_PAPER_TUBE
 from ..record import CHANNELS, UNITS, Apparatus, Plug, paper_apparatus
 from ._checks import Section
 from .apparatus import check_consistency, parse_apparatus
-from .axisymmetric.settings import ModelSettings, parse_model
+from .axisymmetric.settings import ModelSettings, check_sizes, parse_model
 from .friction import LAWS
 
 DEFAULT_PLUG = Plug(length=0.01, young_modulus=200e9, density=7800.0)
@@ -246,6 +246,8 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
     cfg = SimulationConfig(**kw)
     check_consistency(cfg.apparatus, source=cfg.source, rise_time=cfg.rise_time,
                       pretrigger=cfg.pretrigger, duration=cfg.duration)
+    if cfg.model.axisymmetric:
+        check_sizes(cfg.model, cfg.apparatus, source=cfg.source)
     return cfg
 
 

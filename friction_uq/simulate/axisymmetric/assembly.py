@@ -1,10 +1,7 @@
 """The cell of a configuration as a mesh with its surfaces, contact areas, gauge weights and time step.
 
-Checks the sizes before any work: a ConfigError names the key when the mesh is too coarse for the
-sample (fewer than 4 elements across its radius or along its length), when the time step asked
-for is above the stability limit, or when sizes do not fit together (the plug inside the tube at
-least as long as the plug, plug and sample longer than the tube, the hoop gauge off the tube, a
-mesh too large to run).
+The sizes were checked when the configuration was read (:func:`.settings.check_sizes`); here a
+mesh too large to run is refused, naming ``model.element_size``.
 """
 
 from __future__ import annotations
@@ -18,11 +15,10 @@ from ...errors import ConfigError
 from ..config import SimulationConfig
 from .kernels import critical_time_step, highest_frequency
 from .mesh import PLUG, SAMPLE, TUBE, Block, Material, Mesh, build_mesh, divisions, face_areas, segment_lengths
+from .settings import check_sizes
 
 #: Steel plug's Poisson ratio (the record contract gives the plug's E and density only).
 PLUG_POISSON_RATIO = 0.29
-#: Fewest elements across the sample's radius and along its length.
-MIN_SAMPLE_ELEMENTS = 4
 #: Most elements of a mesh (memory and run time of one record).
 MAX_ELEMENTS = 200_000
 
@@ -62,32 +58,16 @@ def _fail(source: str, key: str, problem: str) -> ConfigError:
 
 def build_cell(config: SimulationConfig) -> Cell:
     """Mesh the configuration's plug, sample and tube (checks in the module docstring)."""
-    ms, app, src = config.model, config.apparatus, config.source
+    ms, app = config.model, config.apparatus
+    check_sizes(ms, app, source=config.source)
     sample, tube, plug = app.sample, app.tube, app.plug
     h = ms.element_size
     radius, length = sample.radius, sample.length
-    if radius / h < MIN_SAMPLE_ELEMENTS - 1e-9 or length / h < MIN_SAMPLE_ELEMENTS - 1e-9:
-        raise _fail(src, "model.element_size", f"is {h * 1e3:g} mm, too coarse for the sample (radius "
-                    f"{radius * 1e3:g} mm, length {length * 1e3:g} mm): it needs at least {MIN_SAMPLE_ELEMENTS} "
-                    f"elements across its radius and along its length, an element size <= "
-                    f"{min(radius, length) / MIN_SAMPLE_ELEMENTS * 1e3:g} mm")
     a, b = tube.inner_diameter / 2.0, tube.outer_diameter / 2.0
     has_plug = plug is not None and plug.length > 0.0
     lp = plug.length if has_plug else 0.0
-    if has_plug and ms.tube and ms.plug_insertion >= lp:
-        raise _fail(src, "model.plug_insertion", f"is {ms.plug_insertion * 1e3:g} mm, not shorter than the plug "
-                    f"({lp * 1e3:g} mm): the input bar pushes the plug's end outside the tube")
     z_t = -ms.plug_insertion if has_plug else 0.0
-    if ms.tube and z_t + tube.length <= length:
-        raise _fail(src, "apparatus.tube.length", f"is {tube.length * 1e3:g} mm, shorter than the plug inside it "
-                    f"and the sample ({(length - z_t) * 1e3:g} mm)")
     z_gauge = 0.5 * length + tube.gauge_offset
-    if ms.tube and not (z_t + 0.5 * tube.gauge_width <= z_gauge <= z_t + tube.length - 0.5 * tube.gauge_width):
-        raise _fail(src, "apparatus.tube.gauge_offset", f"is {tube.gauge_offset * 1e3:g} mm, which puts the hoop "
-                    f"gauge off the tube (plug inside the tube {ms.plug_insertion * 1e3:g} mm, tube "
-                    f"{tube.length * 1e3:g} mm)")
-    if has_plug and ms.plug_clearance >= a:
-        raise _fail(src, "model.plug_clearance", f"is {ms.plug_clearance!r} m, not below the bore's radius {a!r} m")
     nr_s, nz_s = divisions(radius, h), divisions(length, h)
     counts = nr_s * nz_s
     blocks = []
@@ -106,7 +86,7 @@ def build_cell(config: SimulationConfig) -> Cell:
                             Material(tube.young_modulus, tube.poisson_ratio, config.tube_density)))
         counts += nr_t * nz_t
     if counts > MAX_ELEMENTS:
-        raise _fail(src, "model.element_size", f"is {h * 1e3:g} mm, which needs {counts} elements (at most "
+        raise _fail(config.source, "model.element_size", f"is {h * 1e3:g} mm, which needs {counts} elements (at most "
                     f"{MAX_ELEMENTS})")
     mesh = build_mesh(blocks)
     return _surfaces(mesh, config, has_plug=has_plug, z_gauge=z_gauge, radius=radius, a=a, b=b)

@@ -30,8 +30,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+if TYPE_CHECKING:
+    from ...record import Apparatus
+
+from ...errors import ConfigError
 from .._checks import Section
 
 FIDELITIES = ("1d", "axisymmetric")
@@ -82,3 +86,43 @@ def parse_model(source: str, table: Any) -> ModelSettings:
         cohesion=s.number("cohesion", d.cohesion, low=0.0, high=1e10, low_open=True),
         dp_alpha=s.number("dp_alpha", d.dp_alpha, low=0.0, high=3.0),
     )
+
+
+#: Fewest elements across the sample's radius and along its length.
+MIN_SAMPLE_ELEMENTS = 4
+
+
+def _fail(source: str, key: str, problem: str) -> ConfigError:
+    return ConfigError(f"{source}: key '{key}' {problem}.")
+
+
+def check_sizes(ms: ModelSettings, app: Apparatus, *, source: str) -> None:
+    """Refuse, naming the key, a mesh too coarse for the sample (fewer than 4 elements across its radius
+    or along its length) and sizes that do not fit together (the plug inside the tube at least as long
+    as the plug, plug and sample longer than the tube, the hoop gauge off the tube, a plug clearance
+    as large as the bore). Geometry only: no mesh is built."""
+    sample, tube, plug = app.sample, app.tube, app.plug
+    h = ms.element_size
+    radius, length = sample.radius, sample.length
+    if radius / h < MIN_SAMPLE_ELEMENTS - 1e-9 or length / h < MIN_SAMPLE_ELEMENTS - 1e-9:
+        raise _fail(source, "model.element_size", f"is {h * 1e3:g} mm, too coarse for the sample (radius "
+                    f"{radius * 1e3:g} mm, length {length * 1e3:g} mm): it needs at least {MIN_SAMPLE_ELEMENTS} "
+                    f"elements across its radius and along its length, an element size <= "
+                    f"{min(radius, length) / MIN_SAMPLE_ELEMENTS * 1e3:g} mm")
+    a = tube.inner_diameter / 2.0
+    has_plug = plug is not None and plug.length > 0.0
+    lp = plug.length if has_plug else 0.0
+    if has_plug and ms.tube and ms.plug_insertion >= lp:
+        raise _fail(source, "model.plug_insertion", f"is {ms.plug_insertion * 1e3:g} mm, not shorter than the plug "
+                    f"({lp * 1e3:g} mm): the input bar pushes the plug's end outside the tube")
+    z_t = -ms.plug_insertion if has_plug else 0.0
+    if ms.tube and z_t + tube.length <= length:
+        raise _fail(source, "apparatus.tube.length", f"is {tube.length * 1e3:g} mm, shorter than the plug inside it "
+                    f"and the sample ({(length - z_t) * 1e3:g} mm)")
+    z_gauge = 0.5 * length + tube.gauge_offset
+    if ms.tube and not (z_t + 0.5 * tube.gauge_width <= z_gauge <= z_t + tube.length - 0.5 * tube.gauge_width):
+        raise _fail(source, "apparatus.tube.gauge_offset", f"is {tube.gauge_offset * 1e3:g} mm, which puts the hoop "
+                    f"gauge off the tube (plug inside the tube {ms.plug_insertion * 1e3:g} mm, tube "
+                    f"{tube.length * 1e3:g} mm)")
+    if has_plug and ms.plug_clearance >= a:
+        raise _fail(source, "model.plug_clearance", f"is {ms.plug_clearance!r} m, not below the bore's radius {a!r} m")
