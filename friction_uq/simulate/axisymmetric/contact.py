@@ -55,8 +55,7 @@ def sliding_speed(rel: float, invm: float, law: int, fpar: np.ndarray, p: float,
     """Sliding speed V after the step of a node that slides: V = rel - S(V) invm, S the strength impulse.
 
     Solved by bisection on [0, rel] (S(0) invm < rel when the node slides; S >= 0 at V = rel): the
-    friction law is taken at the end of the step, which keeps a velocity-weakening law from pumping
-    energy into the mesh's fastest modes, as its evaluation at the previous speed does.
+    friction law is taken at the end of the step (implicit in V), as the stick test takes it at V = 0.
     """
     lo, hi = 0.0, rel
     for _ in range(50):
