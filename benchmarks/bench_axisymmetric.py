@@ -6,7 +6,7 @@ Prints five tables (docs/axisymmetric.md quotes them):
 
 1. per set-up (the paper's, the bundled campaigns' A-03 and B-03 configurations), 1-D against
    axisymmetric on the same configuration and loading: F_io, F_eo, hoop strain and reflected wave
-   per phase (rise, stationary, unloading);
+   per phase (rise, stationary, unloading); 1b: the RMS difference of each gauge per phase;
 2. the paper's figure 15 in numbers: F_io (exp(f beta) - 1) against the axisymmetric F_eo in the
    stationary phase (how much the analytical model over- or underestimates F_eo);
 3. eq. 17's f from the axisymmetric forces against the f put in, f 0.02-0.2, nu 0.3-0.45 (Coulomb);
@@ -29,7 +29,15 @@ import numpy as np
 
 from friction_uq.physics.cell import beta
 from friction_uq.simulate import SimulationConfig, load_config, run_model
-from friction_uq.simulate.axisymmetric.compare import PHASES, QUANTITIES, UNITS, compare, eq17_friction, phase_windows
+from friction_uq.simulate.axisymmetric.compare import (
+    PHASES,
+    QUANTITIES,
+    UNITS,
+    compare,
+    eq17_friction,
+    gauge_discrepancy,
+    phase_windows,
+)
 from friction_uq.simulate.axisymmetric.model import run_axisymmetric
 from friction_uq.simulate.axisymmetric.settings import ModelSettings
 
@@ -54,15 +62,24 @@ def table_setups(h: float) -> None:
     print(f"\n1. 1-D against axisymmetric, per phase (element size {h * 1e3:g} mm); diff = (axi - 1-D) / |1-D|")
     print(f"{'set-up':<7} {'phase':<11} " + " ".join(f"{q + ' (' + UNITS[q][:5] + ')':>28}" for q in QUANTITIES))
     print(f"{'':<19} " + " ".join(f"{'1-D':>9} {'axi':>9} {'diff%':>8}" for _ in QUANTITIES))
+    gauges = {}
     for name, path in CONFIGS.items():
         cfg = load_config(path)
         comp = compare(cfg, element_size=h)
+        gauges[name] = gauge_discrepancy(comp)
         for phase in PHASES:
             cells = []
             for q in QUANTITIES:
                 a, b = comp.table[phase][q]
                 cells.append(f"{a:9.1f} {b:9.1f} {100 * comp.relative_difference(phase, q):+8.2f}")
             print(f"{name:<7} {phase:<11} " + " ".join(cells))
+    print("\n1b. Gauge by gauge: RMS of (axisymmetric - 1-D) strain per phase, % of the 1-D channel's peak "
+          "(what a whole-record check's model tolerance must absorb)")
+    channels = ("input_bar", "internal_output_bar", "external_output_bar", "tube_hoop")
+    print(f"{'set-up':<7} {'phase':<11} " + " ".join(f"{c:>20}" for c in channels))
+    for name, table in gauges.items():
+        for phase in PHASES:
+            print(f"{name:<7} {phase:<11} " + " ".join(f"{100 * table[c][phase]:20.2f}" for c in channels))
 
 
 def table_figure15(h: float) -> None:
@@ -80,7 +97,7 @@ def table_figure15(h: float) -> None:
 
 
 def table_eq17(h: float) -> None:
-    print(f"\n3. Eq. 17's f from the axisymmetric forces against the f put in (Coulomb, paper's set-up, {h * 1e3:g} mm);"
+    print(f"\n3. Eq. 17 f from the axisymmetric forces against the f put in (Coulomb, paper's set-up, {h * 1e3:g} mm);"
           " 1-D: the same read from the 1-D simulator (rigid tube)")
     nus = (0.3, 0.4, 0.45)
     print(f"{'f in':>6} " + " ".join(f"{'nu=' + str(nu) + ' axi':>13} {'err%':>6} {'1-D':>7}" for nu in nus))
