@@ -100,27 +100,18 @@ def run_block(k0: int, k1: int, stride: int, par: np.ndarray, flag: np.ndarray, 
     for k in range(k0, k1):
         force[:, :] = 0.0
         e_hg = add_internal_forces(u, sig, visc, conn, geo, mat, par[C_HG], force)
-        for i in range(n):
-            v_prev[i, 0] = v[i, 0]
-            v_prev[i, 1] = v[i, 1]
-            v[i, 0] += dt * force[i, 0] / mass[i]
-            v[i, 1] += dt * force[i, 1] / mass[i]
-        for i in range(axis.size):
-            v[axis[i], 0] = 0.0
-        for i in range(n):
-            v_trial[i, 0] = v[i, 0]
-            v_trial[i, 1] = v[i, 1]
+        _trial_velocities(v, v_prev, v_trial, force, mass, dt, axis)
         if has_plug:
             face_pairs(plug_front, sample_in, X, u, v, mass, dt, par[END_F], jf)
         if has_tube:
             lateral_contact(sample_outer, sample_area, tube_inner, X, u, v, mass, dt, par[OFF_SAMPLE], law,
-                                    fpar, extra_s, slip_s, speed_s, js_n, js_t)
+                            fpar, extra_s, slip_s, speed_s, js_n, js_t)
             if has_plug:
                 s_pf = pf_force + pf_coef * fprev[0]
                 for i in range(plug_outer.size):
                     extra_p[i] = s_pf * plug_extra[i]
                 lateral_contact(plug_outer, plug_area, tube_inner, X, u, v, mass, dt, par[OFF_PLUG], PLUG_LAW,
-                                        fpar_p, extra_p, slip_p, speed_p, jp_n, jp_t)
+                                fpar_p, extra_p, slip_p, speed_p, jp_n, jp_t)
         for i in range(n):  # axial impulses of the contacts (the bar ends' work is counted by the bars)
             v_trial[i, 1] = mass[i] * (v[i, 1] - v_trial[i, 1])
         fi, ei = bar_face(in_face, share_in, 1.0, par[Z_I], par[C_I], eps_in_i[k], v, mass, dt,
@@ -135,10 +126,7 @@ def run_block(k0: int, k1: int, stride: int, par: np.ndarray, flag: np.ndarray, 
             eeo = -eps_in_eo[k]
         for i in range(axis.size):
             v[axis[i], 0] = 0.0
-        lost = 0.0
-        for i in range(n):  # work of the contact impulses over the step, on the mean velocity of the two half steps
-            jr = mass[i] * (v[i, 0] - v_trial[i, 0])
-            lost -= jr * 0.5 * (v[i, 0] + v_prev[i, 0]) + v_trial[i, 1] * 0.5 * (v[i, 1] + v_prev[i, 1])
+        lost = _contact_loss(v, v_prev, v_trial, mass)
         f_i[k], f_io[k], f_eo[k] = fi, fio, feo
         eps_out_i[k], eps_out_io[k], eps_out_eo[k] = ei, eio, eeo
         fprev[0] = fi
@@ -149,13 +137,37 @@ def run_block(k0: int, k1: int, stride: int, par: np.ndarray, flag: np.ndarray, 
                     tube_inner, jp_t, hoop_nodes, hoop_w, sample_rows, faces, acc, e_hg, dt, par[HOOP_R], has_tube,
                     rec_p, rec_u, rec_ff, rec_sz, rec_s)
         for i in range(n):
-            du[i, 0] = dt * v[i, 0]
-            du[i, 1] = dt * v[i, 1]
-            u[i, 0] += du[i, 0]
-            u[i, 1] += du[i, 1]
+            for d in range(2):
+                du[i, d] = dt * v[i, d]
+                u[i, d] += du[i, d]
         w_stress, d_visc = update_stresses(du, dt, sig, visc, conn, geo, mat, par[DAMPING])
         acc[W_STRESS] += w_stress
         acc[D_VISC] += d_visc
+
+
+@njit
+def _trial_velocities(v: np.ndarray, v_prev: np.ndarray, v_trial: np.ndarray, force: np.ndarray, mass: np.ndarray,
+                      dt: float, axis: np.ndarray) -> None:
+    """v <- v + dt f / m (u_r = 0 on the axis); the old velocities to ``v_prev``, the trial ones to ``v_trial``."""
+    for i in range(v.shape[0]):
+        for d in range(2):
+            v_prev[i, d] = v[i, d]
+            v[i, d] += dt * force[i, d] / mass[i]
+    for i in range(axis.size):
+        v[axis[i], 0] = 0.0
+    v_trial[:, :] = v
+
+
+@njit
+def _contact_loss(v: np.ndarray, v_prev: np.ndarray, v_trial: np.ndarray, mass: np.ndarray) -> float:
+    """Energy (J) the contact impulses took over the step: minus their work on the mean of the two half-step
+    velocities. ``v_trial`` holds the radial trial velocities and, axially, the contacts' impulses (the
+    bar ends' axial work is counted by the bars)."""
+    lost = 0.0
+    for i in range(v.shape[0]):
+        jr = mass[i] * (v[i, 0] - v_trial[i, 0])
+        lost -= jr * 0.5 * (v[i, 0] + v_prev[i, 0]) + v_trial[i, 1] * 0.5 * (v[i, 1] + v_prev[i, 1])
+    return lost
 
 
 @njit
