@@ -20,7 +20,7 @@ from friction_uq.simulate.axisymmetric.kernels import elastic_forces
 from friction_uq.simulate.axisymmetric.mesh import TUBE, Block, Material, build_mesh
 from friction_uq.simulate.axisymmetric.model import run_axisymmetric
 from friction_uq.simulate.axisymmetric.settings import ModelSettings
-from friction_uq.simulate.axisymmetric.statics import pressure_load, solve_static, stiffness_matrix
+from friction_uq.simulate.axisymmetric.statics import StaticSolver, pressure_load, stiffness_matrix
 from friction_uq.simulate.config import default_apparatus
 
 NU = 0.4
@@ -53,7 +53,7 @@ def long_tube():
                              Material(200e9, 0.29, 7850.0))])
     grid = mesh.grids[TUBE]
     fixed = np.array([2 * grid[grid.shape[0] // 2, 0] + 1])  # one axial dof: no rigid translation
-    return mesh, grid[:, 0], grid[:, -1], fixed
+    return mesh, grid[:, 0], grid[:, -1], StaticSolver(mesh, fixed, c_hg=0.05)
 
 
 def test_stiffness_matrix_is_the_explicit_kernels_operator(long_tube) -> None:
@@ -66,9 +66,9 @@ def test_stiffness_matrix_is_the_explicit_kernels_operator(long_tube) -> None:
 
 
 def test_thick_tube_outer_hoop_strain_is_lame(long_tube) -> None:
-    mesh, inner, outer, fixed = long_tube
+    mesh, inner, outer, solver = long_tube
     p = 100e6
-    u = solve_static(mesh, pressure_load(mesh, inner, np.full(inner.size - 1, p)), fixed, c_hg=0.05)
+    u = solver.solve(pressure_load(mesh, inner, np.full(inner.size - 1, p)))
     mid = outer[outer.size // 2]
     lame = float(lame_hoop_strain(p, inner_radius=5e-3, outer_radius=12e-3, young_modulus=200e9))
     assert u[mid, 0] / 12e-3 == pytest.approx(lame, rel=0.01)
@@ -76,11 +76,11 @@ def test_thick_tube_outer_hoop_strain_is_lame(long_tube) -> None:
 
 @pytest.mark.parametrize(("distance", "ratio"), [(0.0, 0.77), (5e-3, 0.52), (10e-3, 0.14)])
 def test_ten_millimetre_pressure_band_gives_physics_md_ratios(long_tube, distance: float, ratio: float) -> None:
-    mesh, inner, outer, fixed = long_tube
+    mesh, inner, outer, solver = long_tube
     z = mesh.X[inner, 1]
     band = (np.abs(0.5 * (z[:-1] + z[1:]) - distance) < 5e-3).astype(float)
     p = 100e6
-    u = solve_static(mesh, pressure_load(mesh, inner, band * p), fixed, c_hg=0.05)
+    u = solver.solve(pressure_load(mesh, inner, band * p))
     mid = outer[outer.size // 2]
     lame = float(lame_hoop_strain(p, inner_radius=5e-3, outer_radius=12e-3, young_modulus=200e9))
     assert u[mid, 0] / 12e-3 / lame == pytest.approx(ratio, abs=0.02)

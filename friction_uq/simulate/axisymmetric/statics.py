@@ -42,9 +42,13 @@ def element_stiffness(geo: np.ndarray, mat: np.ndarray, c_hg: float) -> np.ndarr
 
 def stiffness_matrix(mesh: Mesh, c_hg: float) -> sp.csr_matrix:
     """Global stiffness (2 n x 2 n, dofs 2 i (radial) and 2 i + 1 (axial) of node i)."""
+    cache: dict[tuple[float, ...], np.ndarray] = {}  # structured meshes repeat the same few rings
     rows, cols, vals = [], [], []
     for e in range(mesh.n_elements):
-        ke = element_stiffness(mesh.geo[e], mesh.mat[e], c_hg)
+        key = (*mesh.geo[e], *mesh.mat[e])
+        ke = cache.get(key)
+        if ke is None:
+            ke = cache[key] = element_stiffness(mesh.geo[e], mesh.mat[e], c_hg)
         dofs = np.ravel(np.column_stack([2 * mesh.conn[e], 2 * mesh.conn[e] + 1]))
         rows.append(np.repeat(dofs, 8))
         cols.append(np.tile(dofs, 8))
@@ -53,14 +57,20 @@ def stiffness_matrix(mesh: Mesh, c_hg: float) -> sp.csr_matrix:
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
 
 
-def solve_static(mesh: Mesh, load: np.ndarray, fixed_dofs: np.ndarray, *, c_hg: float) -> np.ndarray:
-    """Displacements (n, 2) under nodal ``load`` (n, 2) with the dofs ``fixed_dofs`` held at zero."""
-    k = stiffness_matrix(mesh, c_hg)
-    n = k.shape[0]
-    free = np.setdiff1d(np.arange(n), fixed_dofs)
-    u = np.zeros(n)
-    u[free] = spla.spsolve(k[free][:, free].tocsc(), load.ravel()[free])
-    return u.reshape(-1, 2)
+class StaticSolver:
+    """K u = f on ``mesh`` with the dofs ``fixed_dofs`` held at zero (K factorised once, for many loads)."""
+
+    def __init__(self, mesh: Mesh, fixed_dofs: np.ndarray, *, c_hg: float) -> None:
+        k = stiffness_matrix(mesh, c_hg)
+        self.n = k.shape[0]
+        self.free = np.setdiff1d(np.arange(self.n), fixed_dofs)
+        self._lu = spla.splu(k[self.free][:, self.free].tocsc())
+
+    def solve(self, load: np.ndarray) -> np.ndarray:
+        """Displacements (n, 2) under nodal ``load`` (n, 2)."""
+        u = np.zeros(self.n)
+        u[self.free] = self._lu.solve(load.ravel()[self.free])
+        return u.reshape(-1, 2)
 
 
 def pressure_load(mesh: Mesh, nodes: np.ndarray, pressure: np.ndarray) -> np.ndarray:
