@@ -144,7 +144,7 @@ def gauge_weights(z: np.ndarray, centre: float, width: float, *, points: int = 4
     """Weights w_j with sum_j w_j u_j = the mean over [centre - width/2, centre + width/2] of the nodal
     field ``u`` interpolated linearly between nodes at ``z`` (ascending); the value at ``centre`` when width is 0.
 
-    >>> [round(w, 3) for w in gauge_weights(np.array([0.0, 1.0, 2.0]), 1.0, 1.0)]
+    >>> [round(float(w), 3) for w in gauge_weights(np.array([0.0, 1.0, 2.0]), 1.0, 1.0)]
     [0.125, 0.75, 0.125]
     """
     zs = np.array([centre]) if width <= 0.0 else np.linspace(centre - width / 2, centre + width / 2, points)

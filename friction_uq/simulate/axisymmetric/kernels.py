@@ -50,7 +50,7 @@ def drucker_prager_return(s: np.ndarray, cohesion: float, alpha: float) -> None:
 
     >>> s = np.array([-50e6, -200e6, -50e6, 0.0])   # P = 100 MPa, sigma_mises = 150 MPa > 25 + 64 MPa
     >>> drucker_prager_return(s, 25e6, 0.64)
-    >>> round((s[0] - s[1]) / 1e6, 3)                # sigma_mises on the yield surface
+    >>> round(float(s[0] - s[1]) / 1e6, 3)           # sigma_mises on the yield surface
     89.0
     """
     p = -(s[SRR] + s[SZZ] + s[STT]) / 3.0
