@@ -2,7 +2,8 @@
 
 Page 1: the per-phase table (rise, stationary, unloading) of F_io, F_eo, hoop strain and reflected
 wave, each model's value and the difference. Page 2: the interface forces over time. Page 3: the
-hoop gauge and the reflected wave. Page 4: the paper's figure 15 (F_eo against F_io (exp(f beta) - 1))
+hoop gauge and the reflected wave. Page 4: the axial stress and the wall pressure along the sample
+in the stationary phase, against eq. 11 and eq. 20. Page 5: the paper's figure 15 (F_eo against F_io (exp(f beta) - 1))
 from the axisymmetric forces, with eq. 17's f read back from them (Coulomb friction only).
 """
 
@@ -13,7 +14,16 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import atomic_path
-from ..simulate.axisymmetric.compare import PHASES, QUANTITIES, UNITS, Comparison, compare, eq17_friction, figure15
+from ..simulate.axisymmetric.compare import (
+    PHASES,
+    QUANTITIES,
+    UNITS,
+    Comparison,
+    compare,
+    eq17_friction,
+    figure15,
+    stationary_profiles,
+)
 from ..simulate.config import SimulationConfig
 from .style import A4_LANDSCAPE, CORE_FONTS, RC, plt
 
@@ -97,6 +107,25 @@ def _page_figure15(comp: Comparison):
     return fig
 
 
+def _page_profiles(comp: Comparison):
+    prof = stationary_profiles(comp)
+    fig, axes = plt.subplots(1, 2, figsize=A4_LANDSCAPE)
+    styles = {"axial axi": ("axisymmetric, section mean", "-"), "axial eq11": ("eq. 11 from F_io", "--"),
+              "wall axi": ("axisymmetric", "-"), "wall 1d": ("1-D", ":"),
+              "wall eq20": ("eq. 20 from F_eo", "--")}
+    for key, (z, val) in prof.items():
+        ax = axes[0] if key.startswith("axial") else axes[1]
+        label, ls = styles[key]
+        ax.plot(z * 1e3, val / 1e6, ls=ls, label=label)
+    axes[0].set_ylabel("axial stress (MPa, compression positive)")
+    axes[1].set_ylabel("wall pressure (MPa)")
+    for ax in axes:
+        ax.set_xlabel("z from the sample's input face at the start (mm)")
+        ax.legend()
+    fig.suptitle("Stationary phase along the sample: axial stress and wall pressure")
+    return fig
+
+
 def _shade(ax, comp: Comparison) -> None:
     for (_, (a, b)), colour in zip(comp.windows.items(), ("0.9", "0.8", "0.9"), strict=True):
         ax.axvspan(a * 1e6, b * 1e6, color=colour, alpha=0.5, lw=0)
@@ -106,7 +135,7 @@ def comparison_pages(comp: Comparison, path: str | Path) -> Path:
     """Write the comparison pages to ``path`` (PDF; atomic)."""
     from matplotlib.backends.backend_pdf import PdfPages
 
-    builders = [_page_table, _page_forces, _page_gauges]
+    builders = [_page_table, _page_forces, _page_gauges, _page_profiles]
     if comp.config.friction_law == "coulomb":
         builders.append(_page_figure15)
     out = Path(path)

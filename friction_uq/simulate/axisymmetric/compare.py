@@ -127,6 +127,39 @@ def gauge_discrepancy(comp: Comparison) -> dict[str, dict[str, float]]:
     return out
 
 
+def stationary_profiles(comp: Comparison) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Stationary-phase profiles along the sample (z from the input face, m; Pa): name -> (z, value).
+
+    ``axial axi``: the axisymmetric section-mean axial stress; ``wall axi`` and ``wall 1d``: the wall
+    pressure of each model; ``wall eq20``: eq. 20 with p_mean = F_eo / (2 pi R L f) of the axisymmetric
+    forces (Coulomb only); ``axial eq11``: sigma(L) exp(f beta (L - z) / L), sigma(L) = F_io / (pi R^2).
+    """
+    cfg, one, two = comp.config, comp.one_d, comp.axisymmetric
+    sample = cfg.apparatus.sample
+    length, radius = sample.length, sample.radius
+    w = comp.windows["stationary"]
+
+    def mean(out, series):
+        m = (out.time >= w[0]) & (out.time < w[1])
+        return series[m].mean(axis=0)
+
+    p2 = mean(two, two.wall_pressure_nodes)
+    p1 = mean(one, one.wall_pressure)
+    out = {"axial axi": (two.row_z, mean(two, two.axial_stress)),
+           "wall axi": (np.linspace(0.0, length, p2.size), p2),
+           "wall 1d": ((np.arange(p1.size) + 0.5) * length / p1.size, p1)}
+    if cfg.friction_law == "coulomb":
+        f = float(cfg.friction_params["f"])
+        fb = f * float(beta(cfg.poisson_ratio, radius=radius, length=length))
+        z = np.linspace(0.0, length, 101)
+        if f > 0.0:
+            p_mean = mean(two, two.force_external) / (2 * np.pi * radius * length * f)
+            out["wall eq20"] = (z, p_mean * fb * np.exp(fb * (length - z) / length) / np.expm1(fb))
+        sigma_out = mean(two, two.force_internal) / (np.pi * radius**2)
+        out["axial eq11"] = (z, sigma_out * np.exp(fb * (length - z) / length))
+    return out
+
+
 def figure15(config: SimulationConfig, out: ModelOutput, *, f: float) -> tuple[np.ndarray, np.ndarray]:
     """(F_eo, F_io (exp(f beta) - 1)) over time (N): the paper's figure 15 (eq. 13 with the model's F_io)."""
     sample = config.apparatus.sample

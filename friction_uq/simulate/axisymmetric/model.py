@@ -149,7 +149,7 @@ def _output(config: SimulationConfig, cell: Cell, rec: dict, eps_out: list, forc
         "external_output_bar": bars.gauge_strain_output(eps_out[2], dt=dt, bar=eob, dispersive=disp)[::n_sub],
     }
     s = rec["s"]
-    if config.channels["tube_hoop"].enabled:
+    if config.channels["tube_hoop"].enabled and config.model.tube:  # no tube, no hoop gauge (optional channel)
         strains["tube_hoop"] = -s[:, S.R_HOOP].copy()  # compression positive inside the package
     t_c = ib.gauge_distance / ib.wave_speed
     tr, pulse = config.rise_time, app.pulse_duration
