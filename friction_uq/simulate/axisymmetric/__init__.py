@@ -10,7 +10,8 @@ Modules: :mod:`.settings` (the ``[model]`` table), :mod:`.mesh` (structured mesh
 :mod:`.kernels` (element forces, stress update, Drucker-Prager, stability limit), :mod:`.contact`
 (lateral and end-face contact with friction), :mod:`.coupling` (bar ends), :mod:`.solver` (the
 compiled time loop), :mod:`.assembly` (a configuration's cell and its checks), :mod:`.model` (the
-run, gauges and outputs), :mod:`.compare` (1-D against axisymmetric, per phase).
+run, gauges and outputs), :mod:`.compare` (1-D against axisymmetric, per phase), :mod:`.statics`
+(static solves with the same element, for verification against closed forms).
 """
 
 from __future__ import annotations
