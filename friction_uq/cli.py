@@ -167,8 +167,10 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("simulate", help="simulate a whole test into a record",
                        description="Simulate a confined friction test from a TOML configuration.")
     s.add_argument("config", type=Path, help="simulation configuration (TOML)")
-    s.add_argument("-o", "--output", type=Path, required=True, help="record to write (test.h5)")
+    s.add_argument("-o", "--output", type=Path, help="record to write (test.h5); required unless --compare")
     s.add_argument("--seed", type=_seed, help="noise seed, 0 <= seed < 2**64 (default: the config's)")
+    s.add_argument("--compare", type=Path, metavar="PDF", help="also run the 1-D and the axisymmetric model on "
+                   "the configuration and draw them side by side per phase into this PDF (table on stdout)")
 
     s = sub.add_parser("compare", help="compare tests across campaigns from run results (JSON)",
                        description="Table and figure of kappa and f against sliding velocity and wall "
@@ -262,13 +264,22 @@ def _dispatch(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
         return 0
     if args.command == "simulate":
-        _output_file(args.output, RECORD_SUFFIXES, "record")
+        if args.output is None and args.compare is None:
+            raise OutputError("simulate: give -o RECORD.h5, --compare PAGES.pdf, or both")
+        if args.output is not None:
+            _output_file(args.output, RECORD_SUFFIXES, "record")
+        if args.compare is not None:
+            _output_file(args.compare, (".pdf",), "comparison")
         _check_config(args.config)
         from .simulate import load_config, simulate_to_file
 
         cfg = load_config(args.config)
-        path = simulate_to_file(cfg, args.output, seed=args.seed)
-        print(f"wrote {path}")
+        if args.output is not None:
+            print(f"wrote {simulate_to_file(cfg, args.output, seed=args.seed)}")
+        if args.compare is not None:
+            from .report.axisymmetric_pages import compare_to_pdf
+
+            print(compare_to_pdf(cfg, args.compare))
         return 0
     if args.command == "compare":
         if args.output:

@@ -62,6 +62,9 @@ file and the key.
     cfl = 0.8                   # time step as a fraction of the column's stability limit, (0, 1]
     damping = 0.2               # artificial viscosity: damping ratio of the column's highest mode, [0, 1]
 
+    [model]                     # which simulator: fidelity = "1d" (default) | "axisymmetric", and the
+    fidelity = "1d"             # axisymmetric model's mesh and contacts (friction_uq/simulate/axisymmetric/settings.py)
+
     [apparatus.input_bar]       # overrides of record.paper_apparatus(), per part and attribute:
     length = 2.5                # striker, input_bar, internal_output_bar (diameter, young_modulus,
                                 # wave_speed, length, gauge_distance, poisson_ratio),
@@ -88,11 +91,12 @@ from ..physics.tube import BETA_EFF_PAPER_TUBE
 from ..record import CHANNELS, UNITS, Apparatus, Plug, paper_apparatus
 from ._checks import Section
 from .apparatus import check_consistency, parse_apparatus
+from .axisymmetric.settings import ModelSettings, check_sizes, parse_model
 from .friction import LAWS
 
 DEFAULT_PLUG = Plug(length=0.01, young_modulus=200e9, density=7800.0)
 SECTIONS = ("record", "loading", "sample", "friction", "cell", "bars", "measurement", "channels",
-            "numerics", "apparatus")
+            "numerics", "apparatus", "model")
 
 
 @dataclass(frozen=True)
@@ -152,6 +156,7 @@ class SimulationConfig:
     damping: float = 0.2
     min_substeps: int = 1  # not a TOML key: fits fix the time step so the output is smooth in the parameters
     apparatus: Apparatus = field(default_factory=default_apparatus)
+    model: ModelSettings = field(default_factory=ModelSettings)
     source: str = "<config>"
 
 
@@ -237,9 +242,12 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
     kw["damping"] = s.number("damping", d.damping, low=0.0, high=1.0)
 
     kw["apparatus"] = parse_apparatus(source, data.get("apparatus", {}), default_apparatus())
+    kw["model"] = parse_model(source, data.get("model", {}))
     cfg = SimulationConfig(**kw)
     check_consistency(cfg.apparatus, source=cfg.source, rise_time=cfg.rise_time,
                       pretrigger=cfg.pretrigger, duration=cfg.duration)
+    if cfg.model.axisymmetric:
+        check_sizes(cfg.model, cfg.apparatus, source=cfg.source)
     return cfg
 
 

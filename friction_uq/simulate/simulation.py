@@ -67,11 +67,20 @@ def resolve_seed(seed: int | None, config: SimulationConfig) -> int:
 def simulate(config: SimulationConfig, *, seed: int | None = None) -> Simulation:
     """Simulate one test: model, then measurement noise drawn from ``default_rng(seed)``."""
     seed = resolve_seed(seed, config)
-    model = run_model(config)
+    model = run_any(config)
     rng = np.random.default_rng(seed)
     noisy = measure(model.strains, config.channels, rng)
     return Simulation(config=config, seed=seed, model=model, clean=dict(model.strains), noisy=noisy,
                       truth=truth_attributes(config, seed=seed, model=model))
+
+
+def run_any(config: SimulationConfig) -> ModelOutput:
+    """The noise-free model the configuration asks for: 1-D (default) or axisymmetric (``[model] fidelity``)."""
+    if config.model.axisymmetric:
+        from .axisymmetric import run_axisymmetric
+
+        return run_axisymmetric(config)
+    return run_model(config)
 
 
 def truth_attributes(config: SimulationConfig, *, seed: int, model: ModelOutput) -> dict[str, Any]:
@@ -100,6 +109,13 @@ def truth_attributes(config: SimulationConfig, *, seed: int, model: ModelOutput)
         "plateau_end": model.plateau[1],
         "config_source": Path(config.source).name,
     }
+    if config.model.axisymmetric:  # written only then, so 1-D records regenerate bit for bit
+        t["fidelity"] = "axisymmetric"
+        t["element_size"] = config.model.element_size
+        t["plug_insertion"] = config.model.plug_insertion
+        t["plug_clearance"] = config.model.plug_clearance
+        t["plug_friction"] = config.model.plug_friction
+        t["sample_plasticity"] = config.model.sample_plasticity
     if config.end_friction > 0.0:  # written only when present, so older records regenerate bit for bit
         t["end_friction"] = config.end_friction
     for k, v in config.friction_params.items():
