@@ -312,7 +312,7 @@ def _add_campaign_parser(sub) -> None:
     s.add_argument("--workers", type=_workers, default=2, help="local worker processes (default 2)")
     s.add_argument("--scheduler", help="address of a running Dask scheduler (e.g. tcp://10.0.0.5:8786) "
                    "instead of a local cluster")
-    s.add_argument("--seed", type=int, default=20161, help="campaign seed (default 20161)")
+    s.add_argument("--seed", type=_seed, default=20161, help="campaign seed, 0 <= seed < 2**64 (default 20161)")
     s.add_argument("--priors", type=Path, help="prior file for every record (default: priors/<material>.toml)")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")

@@ -75,7 +75,11 @@ def read_header(path: Path) -> RecordHeader:
 
 
 def check_headers(headers: Sequence[RecordHeader]) -> None:
-    """Refuse a campaign that mixes sample materials, or names one record (or one test id) twice."""
+    """Refuse a campaign that mixes sample materials, names one record (or one test id) twice, or has two
+    records whose output names collide (``A_B``/``C`` and ``A``/``B_C`` both write ``A_B_C.*``; names that
+    differ only in case collide on some file systems)."""
+    from ..run import safe_stem
+
     by_material: dict[str, list[str]] = {}
     for h in headers:
         if h.material is not None:
@@ -86,6 +90,7 @@ def check_headers(headers: Sequence[RecordHeader]) -> None:
                               "of one material pair, run one campaign per material")
     seen: dict[str, str] = {}
     ids: dict[tuple[str, str], str] = {}
+    stems: dict[str, RecordHeader] = {}
     for h in headers:
         if h.sha256 and h.sha256 in seen:
             raise FrictionUQError(f"{h.path} and {seen[h.sha256]} are the same record (same sha256): give it once")
@@ -96,6 +101,13 @@ def check_headers(headers: Sequence[RecordHeader]) -> None:
                 raise FrictionUQError(f"{h.path} and {ids[key]} have the same campaign and test_id "
                                       f"({h.campaign} {h.test_id}): their outputs would overwrite each other")
             ids[key] = h.path
+            stem = safe_stem(h.campaign, h.test_id)
+            other = stems.get(stem.casefold())
+            if other is not None:
+                raise FrictionUQError(
+                    f"{h.path} (campaign {h.campaign!r}, test_id {h.test_id!r}) and {other.path} (campaign "
+                    f"{other.campaign!r}, test_id {other.test_id!r}) would both write {stem}.*: rename one test_id")
+            stems[stem.casefold()] = h
 
 
 def record_seed(campaign_seed: int, sha256: str, path: str) -> int:
@@ -137,6 +149,19 @@ class Progress:
             print("\r" + line.ljust(100), end="\n" if left == 0 else "", file=self.stream, flush=True)
         else:
             print(line, file=self.stream, flush=True)
+
+
+def local_workers(workers: int) -> int:
+    """The local cluster's worker processes: ``workers``, at most one per core of this machine (more only
+    share the cores, each with its own memory), with a note on stderr when it is capped."""
+    if workers < 1:
+        raise FrictionUQError(f"--workers must be at least 1, got {workers}")
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if workers > cores:
+        print(f"friction-uq: note: --workers {workers} is more than the {cores} core(s) this process may use: "
+              f"{cores} worker process(es)", file=sys.stderr, flush=True)
+        return cores
+    return workers
 
 
 def open_client(*, workers: int, scheduler: str | None, timeout: float = CONNECT_TIMEOUT_S):
