@@ -203,6 +203,27 @@ def output_lock(folder: Path, stem: str, *, busy: str | None = None) -> Iterator
         os.close(fd)
 
 
+def check_unlocked(folder: Path, stem: str) -> None:
+    """Refuse at once, as :func:`output_lock` would, when another process holds ``folder/.<stem>.lock``: a
+    busy folder is said before any work. Takes nothing and creates nothing (the lock itself is taken later)."""
+    import fcntl
+
+    path = folder / f".{stem}.lock"
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return  # no lock file (or none readable): nobody holds it, or output_lock will say why
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise OutputError(f"{folder}: another friction-uq run is writing {stem} into this folder (lock {path.name}); "
+                          "wait for it to end or choose another --out") from None
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
 def remove_orphans(folder: Path, names: list[str]) -> list[Path]:
     """Remove the temporary files an interrupted process left for ``names`` in ``folder``.
 

@@ -61,10 +61,19 @@ def _output_file(path: Path, suffixes: Sequence[str], what: str) -> None:
 
 def _check_text_file(path: Path, what: str, error: type[FrictionUQError]) -> str:
     """The UTF-8 text of an input file, or one sentence saying why it is not one."""
+    import stat
+
+    from .plausible import MAX_TEXT_BYTES
+
     try:
-        raw = path.read_bytes()
+        if not stat.S_ISREG(path.stat().st_mode):
+            raise error(f"{path}: is not a regular file (a device, a pipe or a folder), not a {what}")
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_TEXT_BYTES + 1)
     except OSError as exc:
         raise error(f"{path}: cannot read the {what} ({os_error_text(exc)})") from None
+    if len(raw) > MAX_TEXT_BYTES:
+        raise error(f"{path}: is larger than {MAX_TEXT_BYTES} bytes, too large for a {what} (docs/limits.md)")
     if raw.startswith(HDF5_SIGNATURE):
         raise error(f"{path}: is an HDF5 file (a test record?), not a {what}")
     try:
@@ -80,7 +89,12 @@ def _check_config(path: Path) -> None:
     """Refuse a configuration that is not UTF-8 TOML, or is nested too deeply to parse."""
     import tomllib
 
+    from .plausible import toml_shape_problem
+
     text = _check_text_file(path, "simulation configuration (TOML)", ConfigError)
+    problem = toml_shape_problem(text)
+    if problem:
+        raise ConfigError(f"{path}: {problem}, too deep for a simulation configuration (docs/limits.md)")
     try:
         tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -123,3 +123,62 @@ def apparatus_problem(app) -> tuple[str, str, str] | None:
     if t.gauge_width >= t.length:
         return "tube", "gauge_width", f"is {t.gauge_width!r} m, not narrower than the tube's length {t.length!r} m"
     return None
+
+
+def toml_shape_problem(text: str) -> str | None:
+    """None if a TOML text stays within :data:`MAX_TOML_DEPTH` (dotted-key parts, nesting of arrays and
+    tables), else the problem in words. One pass over the text, before the parser (whose time and memory
+    grow with the depth: 50,000 dotted parts take minutes)."""
+    depth = dots = 0
+    i, n = 0, len(text)
+    while i < n:
+        c = text[i]
+        if c == "#":
+            j = text.find("\n", i)
+            i = n if j < 0 else j
+            continue
+        if c in "\"'":
+            i = _string_end(text, i)
+            continue
+        if c == ".":
+            dots += 1
+            if dots >= MAX_TOML_DEPTH:
+                return f"has a dotted key of more than {MAX_TOML_DEPTH} parts (line {text.count(chr(10), 0, i) + 1})"
+        elif c in "[{":
+            depth, dots = depth + 1, 0
+            if depth > MAX_TOML_DEPTH:
+                return f"nests arrays or tables more than {MAX_TOML_DEPTH} deep (line {text.count(chr(10), 0, i) + 1})"
+        elif c in "]}":
+            depth, dots = max(0, depth - 1), 0
+        elif not (c.isalnum() or c in "_-+: \t"):
+            dots = 0
+        i += 1
+    return None
+
+
+def _string_end(text: str, i: int) -> int:
+    """Index just past the TOML string that starts at ``text[i]`` (basic or literal, one line or multi-line)."""
+    q = text[i]
+    if text.startswith(q * 3, i):
+        j = i + 3
+        while True:
+            k = text.find(q * 3, j)
+            if k < 0:
+                return len(text)
+            if q == "'" or not _escaped_at(text, k):
+                return k + 3
+            j = k + 1
+    j = i + 1
+    while j < len(text) and text[j] != "\n":
+        if text[j] == q and (q == "'" or not _escaped_at(text, j)):
+            return j + 1
+        j += 1
+    return j
+
+
+def _escaped_at(text: str, k: int) -> bool:
+    """The character at ``k`` follows an odd number of backslashes."""
+    b = 0
+    while k - b - 1 >= 0 and text[k - b - 1] == "\\":
+        b += 1
+    return b % 2 == 1

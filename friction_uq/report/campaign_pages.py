@@ -3,6 +3,7 @@ band, the law comparison and the flag table. Draws what the campaign analysis co
 
 from __future__ import annotations
 
+import io
 import os
 import textwrap
 from pathlib import Path
@@ -10,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .._atomic import atomic_path
+from .._atomic import write_bytes
 from .style import RC, figure
 
 #: What is drawn is friction_uq.campaign.analysis.CampaignAnalysis, read by its attributes: the report sits below the campaign
@@ -128,8 +129,10 @@ def write_campaign_report(ca: CampaignAnalysis, doc: dict[str, Any], path: str |
             if not ca.flagged:
                 flag_lines.append("nothing flagged: every set-up and test follows the shared law")
             pages.append(_text_page("Flags: set-ups and tests off the shared law", flag_lines))
-        with atomic_path(out) as tmp, PdfPages(tmp) as pdf:
+        buf = io.BytesIO()  # in memory, then written at once (a disk that fills mid-file is one OSError)
+        with PdfPages(buf) as pdf:
             for fig in pages:
                 pdf.savefig(fig)
                 plt.close(fig)
+        write_bytes(out, buf.getvalue())
     return out

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from .._atomic import output_lock, remove_orphans, write_together
+from .._atomic import check_unlocked, output_lock, remove_orphans, write_together
 from .._parallel import Background
 from ..analysis import Identification, Prepared, identify, prepare
 from ..discrepancy.check import WholeRecordCheck
@@ -114,10 +114,11 @@ def run_file(
             print(f"friction-uq: note: {msg}", file=sys.stderr, flush=True)
 
     record = read_record(path)
+    p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
+    priors = load_priors(p_path)  # every input is checked before the signals' work, the busy folder too
+    check_unlocked(Path(out_dir), safe_stem(record.campaign, record.test_id))
     prep = prepare(record, window=window, dispersion=dispersion)
     settings = AnalysisSettings(window=window, dispersion=dispersion, hoop=hoop)
-    p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
-    priors = load_priors(p_path)
     alternatives = alternative_nu_priors(p_path, priors)
     left_out = hoop_unusable(prep) if settings.hoop and prep.data.hoop is not None else None
     use_hoop = bool(settings.hoop and prep.data.hoop is not None and left_out is None)
