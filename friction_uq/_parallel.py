@@ -24,12 +24,14 @@ def can_fork() -> bool:
 
 def end_with_parent() -> None:
     """In a forked child: be killed when the parent dies (Linux ``PR_SET_PDEATHSIG``), so a run killed
-    with ``kill -9`` leaves no process working on for it; elsewhere nothing (the child ends when its
-    value cannot be sent)."""
+    with ``kill -9`` leaves no process working on for it (elsewhere the child ends when its value cannot
+    be sent); ignore Ctrl-C, which the terminal sends to the whole process group: the parent handles it
+    and stops the child, without a second traceback from the child."""
     import os
     import signal
     import sys
 
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle: it stops the child
     if not sys.platform.startswith("linux"):
         return
     try:

@@ -13,9 +13,10 @@ campaign leaves the seeds (and so the up-to-date results) of the others unchange
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -180,9 +181,42 @@ def open_client(*, workers: int, scheduler: str | None, timeout: float = CONNECT
         raise FrictionUQError(f"--workers must be at least 1, got {workers}")
     # numba's default threading layer is not fork- or thread-safe: one thread per worker process
     with dask.config.set({"distributed.nanny.pre-spawn-environ.NUMBA_NUM_THREADS": 1,
-                          "distributed.worker.daemon": True}):
+                          "distributed.worker.daemon": True}), _workers_ignore_ctrl_c():
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
     return Client(cluster)
+
+
+@contextlib.contextmanager
+def _workers_ignore_ctrl_c() -> Iterator[None]:
+    """Ignore SIGINT while the local cluster starts its worker processes: they inherit it, so Ctrl-C (sent by
+    the terminal to the whole process group) reaches only this process, which stops them quietly."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old if old is not None else signal.default_int_handler)
+
+
+@contextlib.contextmanager
+def _quiet_shutdown() -> Iterator[None]:
+    """Dask's loggers silenced while an interrupted campaign stops its cluster (tracebacks of tasks cut short)."""
+    import logging
+
+    loggers = [logging.getLogger(n) for n in ("distributed", "tornado", "asyncio")]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, levels):
+            lg.setLevel(level)
 
 
 def run_tasks(tasks: Sequence[RecordTask], *, workers: int = 1, scheduler: str | None = None,
@@ -193,6 +227,7 @@ def run_tasks(tasks: Sequence[RecordTask], *, workers: int = 1, scheduler: str |
     client = open_client(workers=workers, scheduler=scheduler)
     cluster = None if scheduler else client.cluster
     bar = Progress(len(tasks), enabled=progress)
+    interrupted = False
     try:
         futures = client.map(job, list(tasks), pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
@@ -207,7 +242,11 @@ def run_tasks(tasks: Sequence[RecordTask], *, workers: int = 1, scheduler: str |
             results[i] = res
             bar.update(res)
         return [r for r in results if r is not None]
+    except KeyboardInterrupt:
+        interrupted = True  # each record's checkpoint stays; the next campaign resumes from them
+        raise
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        with _quiet_shutdown() if interrupted else contextlib.nullcontext():
+            client.close()
+            if cluster is not None:
+                cluster.close()

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
+import threading
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import emcee
@@ -50,6 +53,24 @@ def integrated_time(chain: np.ndarray, *, c: float = 5.0) -> np.ndarray:
     ok = m >= c * taus
     window = np.where(ok.any(axis=0), np.argmax(ok, axis=0), n - 1)
     return taus[window, np.arange(x.shape[2])]
+
+
+@contextlib.contextmanager
+def _interrupt_between_steps() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) while emcee steps and raise KeyboardInterrupt when the block of steps ends: emcee's
+    wrapper of the log-probability prints the walkers' positions and a traceback for any exception raised in
+    it, KeyboardInterrupt included. Only in the main thread (elsewhere signals cannot be handled)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old if old is not None else signal.default_int_handler)
+    if caught:
+        raise KeyboardInterrupt
 
 
 def _memory_backend(ck: checkpoint.Checkpoint, nwalkers: int, ndim: int) -> emcee.backends.Backend:
@@ -186,7 +207,13 @@ def sample_posterior(
         done = backend.iteration
         target = min(max_steps, (done // check_every + 1) * check_every)
         if not check_first and target > done:
-            state = sampler.run_mcmc(state, target - done, progress=False, skip_initial_state_check=True)
+            try:
+                with _interrupt_between_steps():
+                    state = sampler.run_mcmc(state, target - done, progress=False, skip_initial_state_check=True)
+            except KeyboardInterrupt:
+                if backend_path is not None and backend.iteration > 0:
+                    save()  # the steps made so far are kept: the next run resumes from them
+                raise
             if backend_path is not None and time.perf_counter() - last_save >= checkpoint_seconds:
                 save()
                 last_save = time.perf_counter()
