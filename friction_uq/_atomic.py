@@ -203,7 +203,7 @@ def output_lock(folder: Path, stem: str, *, busy: str | None = None) -> Iterator
         os.close(fd)
 
 
-def check_unlocked(folder: Path, stem: str) -> None:
+def check_unlocked(folder: Path, stem: str, *, busy: str | None = None) -> None:
     """Refuse at once, as :func:`output_lock` would, when another process holds ``folder/.<stem>.lock``: a
     busy folder is said before any work. Takes nothing and creates nothing (the lock itself is taken later)."""
     import fcntl
@@ -216,8 +216,8 @@ def check_unlocked(folder: Path, stem: str) -> None:
     try:
         fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
     except BlockingIOError:
-        raise OutputError(f"{folder}: another friction-uq run is writing {stem} into this folder (lock {path.name}); "
-                          "wait for it to end or choose another --out") from None
+        raise OutputError(busy or f"{folder}: another friction-uq run is writing {stem} into this folder (lock "
+                          f"{path.name}); wait for it to end or choose another --out") from None
     except OSError:
         pass
     finally:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._atomic import output_lock
+from .._atomic import check_unlocked, output_lock
 from ..errors import FrictionUQError, check_seed
 from .analysis import CampaignAnalysis, analyse
 from .compare import Comparison, TestResult, TrendFit, compare, comparison_table, fit_trend, load_result
@@ -68,6 +68,9 @@ def run_campaign(
         raise FrictionUQError(f"{out}: --out must be a directory, and this is a file")
     if not scheduler:
         workers = local_workers(workers)
+    busy = (f"{out}: another friction-uq campaign is writing into this folder (lock .{CAMPAIGN_LOCK}.lock); "
+            "wait for it to end or choose another --out")
+    check_unlocked(out, CAMPAIGN_LOCK, busy=busy)  # said at once; the lock itself is taken below
     headers = [read_header(p) for p in find_records(inputs)]
     check_headers(headers)
     made = not out.exists()
@@ -75,8 +78,6 @@ def run_campaign(
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise FrictionUQError(f"{out}: cannot create the output directory ({exc.strerror or exc})") from None
-    busy = (f"{out}: another friction-uq campaign is writing into this folder (lock {CAMPAIGN_LOCK}.lock); "
-            "wait for it to end or choose another --out")
     try:
         with output_lock(out, CAMPAIGN_LOCK, busy=busy):
             return _run_locked(headers, out, workers=workers, scheduler=scheduler, seed=seed,

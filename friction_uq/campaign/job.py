@@ -193,6 +193,10 @@ def run_record(task: RecordTask) -> RecordResult:
     from ..record import read_record
     from ..run import run_file, safe_stem
 
+    import logging
+
+    # a Dask worker's state machine warns of each task cut short when an interrupted campaign stops it
+    logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
     t0, c0 = time.perf_counter(), time.process_time()
     out = Path(task.out_dir)
     base = RecordResult(path=str(task.path), status="failed", settings=task.settings)
