@@ -19,6 +19,8 @@ from . import __version__
 from .errors import ConfigError, FrictionUQError, OutputError, os_error_text
 
 EXIT_BAD_INPUT = 2
+#: Exit status of an unexpected error (a bug), said in one line; FRICTION_UQ_TRACEBACK=1 shows its traceback.
+EXIT_INTERNAL = 3
 #: Figure formats of ``design -o`` and ``compare -o`` (matplotlib writes them without extra packages).
 FIGURE_SUFFIXES = (".pdf", ".png", ".svg", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp")
 #: Record file names ``simulate -o`` writes.
@@ -139,6 +141,19 @@ def _window(text: str) -> tuple[float, float]:
     return vals[0], vals[1]
 
 
+def _striker_velocity(text: str) -> float:
+    from .plausible import out_of_range
+
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"striker velocity {text!r} is not a number") from None
+    problem = out_of_range("striker_velocity", v)
+    if problem:
+        raise argparse.ArgumentTypeError(f"striker velocity {problem}")
+    return v
+
+
 def _nu(text: str) -> float:
     try:
         v = float(text)
@@ -176,7 +191,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("file", type=Path, help="test record (test.h5)")
     s.add_argument("-o", "--output", type=Path, required=True, help="figure file (PDF or PNG)")
     s.add_argument("--nu", type=_nu, default=0.4, help="sample Poisson ratio (default 0.4)")
-    s.add_argument("--striker-velocity", type=float, help="m/s (default: the record's, else from the incident wave)")
+    s.add_argument("--striker-velocity", type=_striker_velocity,
+                   help="m/s (default: the record's, else from the incident wave)")
 
     s = sub.add_parser("simulate", help="simulate a whole test into a record",
                        description="Simulate a confined friction test from a TOML configuration.")
@@ -223,18 +239,34 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return _dispatch(args)
     except FrictionUQError as exc:
-        print(f"friction-uq: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _error(str(exc))
     except OSError as exc:  # a system error no writer turned into a sentence: still one line
         where = exc.filename or ""
-        print(f"friction-uq: error: {where}{': ' if where else ''}{os_error_text(exc)}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _error(f"{where}{': ' if where else ''}{os_error_text(exc)}")
     except (RecursionError, UnicodeDecodeError) as exc:
-        print(f"friction-uq: error: an input file cannot be read ({type(exc).__name__}: {exc})", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _error(f"an input file cannot be read ({type(exc).__name__}: {exc})")
+    except MemoryError:
+        return _error("out of memory; an input is larger than this machine can analyse (docs/limits.md)")
     except KeyboardInterrupt:
         print("friction-uq: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # noqa: BLE001 - a bug: one line naming where, the traceback on request
+        if os.environ.get("FRICTION_UQ_TRACEBACK"):
+            raise
+        import traceback
+
+        last = traceback.extract_tb(exc.__traceback__)[-1]
+        _error(f"internal error ({type(exc).__name__}: {exc}; {Path(last.filename).name} line {last.lineno}); this "
+               "is a bug: please report it with the input (FRICTION_UQ_TRACEBACK=1 shows the traceback)")
+        return EXIT_INTERNAL
+
+
+def _error(message: str) -> int:
+    """Print ``message`` as one line (control characters from a file's text escaped) and return exit status 2."""
+    from .plausible import escaped
+
+    print(f"friction-uq: error: {escaped(message)}", file=sys.stderr)
+    return EXIT_BAD_INPUT
 
 
 def _dispatch(args: argparse.Namespace) -> int:

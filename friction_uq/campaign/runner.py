@@ -61,7 +61,11 @@ def read_header(path: Path) -> RecordHeader:
     """Checksum, campaign, test id and sample material, or None for what cannot be read (the job says why)."""
     import h5py
 
+    from ..plausible import MAX_RECORD_BYTES
+
     try:
+        if path.stat().st_size > MAX_RECORD_BYTES:  # not hashed: the job refuses it in one sentence
+            return RecordHeader(str(path), "", None, None, None)
         sha = file_sha256(path)
     except OSError:
         return RecordHeader(str(path), "", None, None, None)

@@ -39,7 +39,7 @@ from ..diagnostics import (
     ratio_ppc,
     summarize,
 )
-from ..errors import OutputError, check_seed, os_error_text
+from ..errors import OutputError, SamplingError, check_seed, os_error_text
 from ..likelihood import Likelihood, LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import default_prior_path, load_priors
@@ -165,9 +165,12 @@ def run_file(
         loader = prepare_soon()
 
         t = time.perf_counter()
-        samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
-                                   progress=stderr_progress if progress else None, notify=note,
-                                   likelihood=likelihood)
+        try:
+            samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
+                                       progress=stderr_progress if progress else None, notify=note,
+                                       likelihood=likelihood)
+        except SamplingError as exc:  # the sampler knows the priors, not the record: name it
+            raise SamplingError(f"{record.path}: {exc}") from None
         stages["sampling"] = time.perf_counter() - t
         loader.join()  # no thread left running: later stages fork only where this process has one thread
         t = time.perf_counter()
