@@ -38,7 +38,8 @@ def end_with_parent() -> None:
         import ctypes
 
         libc = ctypes.CDLL(None, use_errno=True)
-        parent = os.getppid()
+        known = multiprocessing.parent_process()  # its pid was taken before the fork
+        parent = known.pid if known is not None else os.getppid()
         libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1 = PR_SET_PDEATHSIG
         if os.getppid() != parent:  # the parent died before the call: end now
             os._exit(1)
