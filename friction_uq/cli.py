@@ -324,6 +324,9 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "campaign":
         return _campaign(args)
     if args.command in ("run", "diagnose"):
+        from .record import read_record
+
+        read_record(args.file)  # a bad record is refused before the analysis' libraries load (seconds)
         from .run import run_file
 
         run_file(
