@@ -147,7 +147,8 @@ def toml_shape_problem(text: str) -> str | None:
         elif c in "[{":
             depth, dots = depth + 1, 0
             if depth > MAX_TOML_DEPTH:
-                return f"nests arrays or tables more than {MAX_TOML_DEPTH} deep (line {text.count(chr(10), 0, i) + 1})"
+                return (f"is nested too deeply (arrays or tables more than {MAX_TOML_DEPTH} levels, line "
+                        f"{text.count(chr(10), 0, i) + 1})")
         elif c in "]}":
             depth, dots = max(0, depth - 1), 0
         elif not (c.isalnum() or c in "_-+: \t"):
