@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import OutputError, os_error_text
+from .errors import LockedError, OutputError, os_error_text
 
 
 def temporary_glob(name: str) -> str:
@@ -178,7 +178,7 @@ def output_lock(folder: Path, stem: str, *, busy: str | None = None) -> Iterator
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             os.close(fd)
-            raise OutputError(busy or (
+            raise LockedError(busy or (
                 f"{folder}: another friction-uq run is writing {stem} into this folder (lock {path.name}); "
                 "wait for it to end or choose another --out")) from None
         except OSError as exc:
@@ -216,7 +216,7 @@ def check_unlocked(folder: Path, stem: str, *, busy: str | None = None) -> None:
     try:
         fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
     except BlockingIOError:
-        raise OutputError(busy or f"{folder}: another friction-uq run is writing {stem} into this folder (lock "
+        raise LockedError(busy or f"{folder}: another friction-uq run is writing {stem} into this folder (lock "
                           f"{path.name}); wait for it to end or choose another --out") from None
     except OSError:
         pass

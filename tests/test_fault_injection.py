@@ -149,6 +149,25 @@ def test_a_killed_runs_forked_child_does_not_hold_its_lock(tmp_path):
         pytest.fail("the forked child outlived its killed parent")
 
 
+def test_a_record_locked_by_a_dying_worker_is_waited_for(good_record, tmp_path, monkeypatch):
+    """Inside a campaign's folder only a killed campaign's worker can hold a record's lock: the job waits for
+    it to end instead of failing the record."""
+    import friction_uq.run
+
+    calls = []
+
+    def locked_twice(*args, **kwargs):
+        calls.append(1)
+        if len(calls) <= 2:
+            raise _atomic.LockedError("out: another friction-uq run is writing A_A-01 into this folder")
+        raise job.FrictionUQError("analysed")  # the third try gets the lock (and stops here: no sampling)
+
+    monkeypatch.setattr(friction_uq.run, "run_file", locked_twice)
+    monkeypatch.setattr(job.time, "sleep", lambda s: None)
+    r = job.run_record(job.RecordTask(path=str(good_record), seed=1, out_dir=str(tmp_path)))
+    assert len(calls) == 3 and r.status == "failed" and r.message == "analysed"
+
+
 def _stored(tmp_path: Path, nc: bytes = b"netcdf bytes") -> job.RecordResult:
     import hashlib
 

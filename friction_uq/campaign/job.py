@@ -38,12 +38,15 @@ from typing import Any
 
 from .. import __version__
 from .._atomic import atomic_path
-from ..errors import FrictionUQError
+from ..errors import FrictionUQError, LockedError
 
 SCHEMA = "friction-uq/campaign-record"
 SCHEMA_VERSION = 1
 SUMMARY_VARIABLES = ("f", "kappa", "nu", "V", "p_mean")
 STATUSES = ("done", "skipped", "failed")
+#: Seconds a record waits for its lock in the campaign's folder: only a killed campaign's worker can hold it
+#: (the campaign holds the folder's lock), and Dask stops such a worker within a few seconds.
+LOCK_WAIT_S = 30
 
 
 @dataclass(frozen=True)
@@ -219,10 +222,17 @@ def run_record(task: RecordTask) -> RecordResult:
             if fresh:
                 return dataclasses.replace(old, status="skipped", path=str(task.path))
         buf_out, buf_err = io.StringIO(), io.StringIO()
-        with contextlib.redirect_stdout(buf_out), contextlib.redirect_stderr(buf_err):
-            run = run_file(task.path, priors_path=task.priors_path, out_dir=out, seed=task.seed,
-                           dispersion=task.dispersion, hoop=task.hoop, pdf=task.pdf, progress=False, table=False,
-                           diagnose=task.diagnose)
+        for attempt in range(LOCK_WAIT_S + 1):
+            try:
+                with contextlib.redirect_stdout(buf_out), contextlib.redirect_stderr(buf_err):
+                    run = run_file(task.path, priors_path=task.priors_path, out_dir=out, seed=task.seed,
+                                   dispersion=task.dispersion, hoop=task.hoop, pdf=task.pdf, progress=False,
+                                   table=False, diagnose=task.diagnose)
+                break
+            except LockedError:  # the campaign holds the folder: the holder is a killed campaign's dying worker
+                if attempt == LOCK_WAIT_S:
+                    raise
+                time.sleep(1.0)
         doc = json.loads(run.outputs["json"].read_text())
         notes = [line.removeprefix("friction-uq: note: ") for line in buf_err.getvalue().splitlines() if line.strip()]
         result = dataclasses.replace(
