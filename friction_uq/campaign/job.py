@@ -10,8 +10,8 @@ never raises for a bad record, so the campaign goes on.
 The result is written beside the run outputs as ``<stem>.result.json`` and read back with
 :func:`read_result` (the one function that knows the schema). A record whose stored result is
 up to date (same record sha256, same settings, same prior file checksum, same package version,
-outputs present and holding the bytes the run JSON names) is not analysed again: the job returns the stored result with ``status =
-"skipped"``.
+outputs present and holding the bytes the run JSON names) is not analysed again: the job returns
+the stored result with ``status = "skipped"``; one that cannot be read is analysed again.
 
 Schema version 1 (``schema = "friction-uq/campaign-record"``): ``path``, ``status``
 (``done`` | ``skipped`` | ``failed``), ``message``, ``campaign`` (the set-up), ``test_id``,
