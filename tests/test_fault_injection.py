@@ -66,28 +66,27 @@ def _ids(campaign: str, test_id: str):
     return _set("/", campaign=campaign, test_id=test_id)
 
 
+#: Runs the command and writes its exit status and peak resident memory (kB) to the file named first. A
+#: small launcher: a child's peak memory counts what it inherited at the fork (here a few MB, not pytest's).
+_LAUNCHER = """
+import os, sys
+pid = os.posix_spawn(sys.executable, [sys.executable, "-m", "friction_uq.cli", *sys.argv[2:]], os.environ)
+_, status, usage = os.wait4(pid, 0)
+open(sys.argv[1], "w").write(f"{os.waitstatus_to_exitcode(status)} {usage.ru_maxrss}")
+"""
+
+
 def _subprocess(argv, *, env=None, timeout=120):
     """Run the command in a fresh interpreter: (completed process, seconds, its peak resident MB)."""
     import tempfile
 
-    t = time.perf_counter()
-    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
-        p = subprocess.Popen([sys.executable, "-m", "friction_uq.cli", *map(str, argv)], stdout=out, stderr=err,
-                             text=True, env=env)
-        deadline = time.monotonic() + timeout
-        while True:  # wait4: this child's own resource use
-            pid, status, usage = os.wait4(p.pid, os.WNOHANG)
-            if pid:
-                break
-            if time.monotonic() > deadline:
-                p.kill()
-                raise TimeoutError(argv)
-            time.sleep(0.02)
-        p.returncode = os.waitstatus_to_exitcode(status)
-        out.seek(0)
-        err.seek(0)
-        r = subprocess.CompletedProcess(p.args, p.returncode, out.read(), err.read())
-    return r, time.perf_counter() - t, usage.ru_maxrss / 1024.0
+    with tempfile.TemporaryDirectory() as d:
+        t = time.perf_counter()
+        r = subprocess.run([sys.executable, "-c", _LAUNCHER, f"{d}/usage", *map(str, argv)], capture_output=True,
+                           text=True, timeout=timeout, env=env)
+        seconds = time.perf_counter() - t
+        code, kb = Path(f"{d}/usage").read_text().split()
+    return subprocess.CompletedProcess(r.args, int(code), r.stdout, r.stderr), seconds, int(kb) / 1024.0
 
 
 # ---------------------------------------------------------------- 1. a campaign loses nothing

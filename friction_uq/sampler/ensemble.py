@@ -203,44 +203,44 @@ def sample_posterior(
     # a resumed run whose stored chain ends on a check point is checked before stepping, so that
     # resuming a finished run gives back the same draws instead of stepping one block further
     check_first = backend.iteration > 0 and backend.iteration % check_every == 0
-    while True:
-        done = backend.iteration
-        target = min(max_steps, (done // check_every + 1) * check_every)
-        if not check_first and target > done:
-            try:
+    try:
+        while True:
+            done = backend.iteration
+            target = min(max_steps, (done // check_every + 1) * check_every)
+            if not check_first and target > done:
                 with _interrupt_between_steps():
                     state = sampler.run_mcmc(state, target - done, progress=False, skip_initial_state_check=True)
-            except KeyboardInterrupt:
-                if backend_path is not None and backend.iteration > 0:
-                    save()  # the steps made so far are kept: the next run resumes from them
-                raise
-            if backend_path is not None and time.perf_counter() - last_save >= checkpoint_seconds:
-                save()
-                last_save = time.perf_counter()
-        check_first = False
-        n = backend.iteration
-        chains = backend.get_chain()  # (n, all walkers, ndim)
-        tau = integrated_time(chains)
-        if prev_tau is None:  # first check (or first after resuming): previous check from the stored chain
-            prev_tau = integrated_time(chains[: n - check_every]) if n >= 2 * check_every else np.full(ndim, np.inf)
-        change = float(np.max(np.abs(prev_tau - tau) / tau))
-        prev_tau = tau
-        tau_max = float(np.max(tau))
-        acc = float(np.mean(backend.accepted) / max(n, 1))
-        if progress is not None:
-            progress(Progress(n, max_steps, tau_max, change, n / tau_max, acc, time.perf_counter() - t_start,
-                              settings.tau_factor, settings.tau_rtol))
-        if n > settings.tau_factor * tau_max and change < settings.tau_rtol:
-            converged = True
-            break
-        if n >= max_steps:
-            warnings.warn(
-                f"sampler stopped at max_steps={max_steps} before convergence: steps/tau = {n / tau_max:.1f} "
-                f"(needs > {settings.tau_factor:g}), tau change {100 * change:.1f} % (needs < "
-                f"{100 * settings.tau_rtol:g} %); raise max_steps or treat the posterior as approximate",
-                ConvergenceWarning, stacklevel=2,
-            )
-            break
+                if backend_path is not None and time.perf_counter() - last_save >= checkpoint_seconds:
+                    save()
+                    last_save = time.perf_counter()
+            check_first = False
+            n = backend.iteration
+            chains = backend.get_chain()  # (n, all walkers, ndim)
+            tau = integrated_time(chains)
+            if prev_tau is None:  # first check (or first after resuming): previous check from the stored chain
+                prev_tau = integrated_time(chains[: n - check_every]) if n >= 2 * check_every else np.full(ndim, np.inf)
+            change = float(np.max(np.abs(prev_tau - tau) / tau))
+            prev_tau = tau
+            tau_max = float(np.max(tau))
+            acc = float(np.mean(backend.accepted) / max(n, 1))
+            if progress is not None:
+                progress(Progress(n, max_steps, tau_max, change, n / tau_max, acc, time.perf_counter() - t_start,
+                                  settings.tau_factor, settings.tau_rtol))
+            if n > settings.tau_factor * tau_max and change < settings.tau_rtol:
+                converged = True
+                break
+            if n >= max_steps:
+                warnings.warn(
+                    f"sampler stopped at max_steps={max_steps} before convergence: steps/tau = {n / tau_max:.1f} "
+                    f"(needs > {settings.tau_factor:g}), tau change {100 * change:.1f} % (needs < "
+                    f"{100 * settings.tau_rtol:g} %); raise max_steps or treat the posterior as approximate",
+                    ConvergenceWarning, stacklevel=2,
+                )
+                break
+    except KeyboardInterrupt:  # Ctrl-C: the steps made so far are kept, the next run resumes from them
+        if backend_path is not None and backend.iteration > 0:
+            save()
+        raise
     if backend_path is not None:
         save()  # a run killed while its outputs are written resumes here without stepping
 
