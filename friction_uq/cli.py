@@ -326,7 +326,10 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command in ("run", "diagnose"):
         from .record import read_record
 
-        read_record(args.file)  # a bad record is refused before the analysis' libraries load (seconds)
+        rec = read_record(args.file)  # a bad record or prior file is refused before the analysis' libraries load
+        from .priors import default_prior_path, load_priors
+
+        load_priors(args.priors or default_prior_path(rec.apparatus.sample.material))
         from .run import run_file
 
         run_file(
