@@ -23,7 +23,15 @@ import numpy as np
 
 from ..errors import RecordError
 from ._apparatus_reader import read_apparatus
-from ..plausible import MAX_RECORD_BYTES, MAX_SAMPLES, apparatus_problem, escaped, out_of_range, unprintable
+from ..plausible import (
+    MAX_ATTRIBUTE_BYTES,
+    MAX_RECORD_BYTES,
+    MAX_SAMPLES,
+    apparatus_problem,
+    escaped,
+    out_of_range,
+    unprintable,
+)
 from ._checks import Reader, check_distinct, check_samples, check_strain, plain, sha256_of
 from .contract import (
     CHANNELS,
@@ -220,6 +228,9 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
     provenance: dict[str, Any] = {}
     prov = r.member(fh, "provenance", "/provenance")
     if prov is not None:
+        for k in prov.attrs:  # free-form, but bounded like every attribute
+            if prov.attrs.get_id(k).get_storage_size() > MAX_ATTRIBUTE_BYTES:
+                raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
         provenance = {k: plain(v) for k, v in prov.attrs.items()}
 
     return Record(
