@@ -520,3 +520,46 @@ def test_ctrl_c_is_one_line_exit_130_and_keeps_the_checkpoint(tmp_path):
     assert err[-1].strip() == "friction-uq: interrupted"
     names = sorted(q.name for q in out.iterdir())
     assert names == [".fault_F-01.checkpoint.npz"], names  # kept: the next run resumes from it
+
+
+_CAMPAIGN_SCRIPT = """
+import sys, time
+from pathlib import Path
+from friction_uq.campaign.job import RecordResult, RecordTask
+from friction_uq.campaign.runner import run_tasks
+
+def job(task):
+    Path(task.out_dir, task.path + ".started").touch()
+    time.sleep(120)
+    return RecordResult(path=task.path, status="done")
+
+if __name__ == "__main__":
+    tasks = [RecordTask(path=f"r{i}", seed=1, out_dir=sys.argv[1]) for i in range(2)]
+    try:
+        run_tasks(tasks, workers=2, progress=False, job=job)
+    except KeyboardInterrupt:
+        print("friction-uq: interrupted", file=sys.stderr)
+        sys.exit(130)
+"""
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_a_campaigns_dask_workers_quietly(tmp_path):
+    """Ctrl-C (to the whole process group, as a terminal sends it) while Dask workers run records: one line, no
+    traceback from the workers or the scheduler, every worker process gone."""
+    p = subprocess.Popen([sys.executable, "-c", _CAMPAIGN_SCRIPT, str(tmp_path)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while len(list(tmp_path.glob("*.started"))) < 2 and time.monotonic() < deadline:
+        time.sleep(0.2)
+    workers = subprocess.run(["ps", "--ppid", str(p.pid), "-o", "pid="], capture_output=True, text=True).stdout.split()
+    os.killpg(p.pid, signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err[-3000:]
+    assert err.strip().splitlines() == ["friction-uq: interrupted"], err[-3000:]
+    for _ in range(100):  # the worker processes (and multiprocessing's resource tracker) end within seconds
+        alive = [w for w in workers if Path(f"/proc/{w}").exists()]
+        if not alive:
+            break
+        time.sleep(0.1)
+    assert not alive, [Path(f"/proc/{w}/cmdline").read_bytes()[:200] for w in alive]

@@ -198,7 +198,8 @@ def run_record(task: RecordTask) -> RecordResult:
 
     import logging
 
-    # a Dask worker's state machine warns of each task cut short when an interrupted campaign stops it
+    # a Dask worker's state machine warns of each task cut short when an interrupted campaign stops it (also
+    # set by the runner on the workers it starts with; here for a worker started later)
     logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
     t0, c0 = time.perf_counter(), time.process_time()
     out = Path(task.out_dir)

@@ -207,6 +207,13 @@ def _workers_ignore_ctrl_c() -> Iterator[None]:
         signal.signal(signal.SIGINT, old if old is not None else signal.default_int_handler)
 
 
+def quiet_cancellations() -> None:
+    """In a Dask worker: no warning for each task cut short when an interrupted campaign stops the worker."""
+    import logging
+
+    logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
+
+
 @contextlib.contextmanager
 def _quiet_shutdown() -> Iterator[None]:
     """Dask's loggers silenced while an interrupted campaign stops its cluster (tracebacks of tasks cut short)."""
@@ -233,6 +240,7 @@ def run_tasks(tasks: Sequence[RecordTask], *, workers: int = 1, scheduler: str |
     bar = Progress(len(tasks), enabled=progress)
     interrupted = False
     try:
+        client.run(quiet_cancellations)
         futures = client.map(job, list(tasks), pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
         results: list[RecordResult | None] = [None] * len(tasks)
