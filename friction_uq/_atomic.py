@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import OutputError, os_error_text
+from .errors import LockedError, OutputError, os_error_text
 
 
 def temporary_glob(name: str) -> str:
@@ -131,13 +131,35 @@ def write_together(files: dict[Path, bytes | None], *, last: Path) -> None:
                 os.unlink(tmp)
 
 
+#: File descriptors of the locks this process holds: a forked child closes them at once
+#: (:func:`_close_locks_in_child`), so a lock ends with the process that took it, never later with a child.
+_HELD_LOCKS: set[int] = set()
+
+
+def _close_locks_in_child() -> None:
+    """After a fork, in the child: drop its copies of the parent's lock descriptors. An ``flock`` is held
+    while any descriptor of it is open; a child still working (or stopped) after its parent was killed
+    would otherwise keep the folder locked."""
+    for fd in list(_HELD_LOCKS):
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+    _HELD_LOCKS.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_close_locks_in_child)
+
+
 @contextmanager
-def output_lock(folder: Path, stem: str) -> Iterator[Path]:
+def output_lock(folder: Path, stem: str, *, busy: str | None = None) -> Iterator[Path]:
     """Hold ``folder/.<stem>.lock`` (``fcntl.flock``) while a run writes ``<stem>.*`` into ``folder``.
 
     A second run of the same record into the same folder is refused at once with one sentence (it
-    would overwrite the first one's outputs and checkpoint). The lock file is removed on release;
-    a lock whose file was removed meanwhile is taken again on the new file.
+    would overwrite the first one's outputs and checkpoint); ``busy`` replaces that sentence. The lock
+    file is removed on release; a lock whose file was removed meanwhile is taken again on the new file.
+    Forked children do not keep it (their copy of the descriptor is closed at the fork).
 
     Raises
     ------
@@ -156,9 +178,9 @@ def output_lock(folder: Path, stem: str) -> Iterator[Path]:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             os.close(fd)
-            raise OutputError(
+            raise LockedError(busy or (
                 f"{folder}: another friction-uq run is writing {stem} into this folder (lock {path.name}); "
-                "wait for it to end or choose another --out") from None
+                "wait for it to end or choose another --out")) from None
         except OSError as exc:
             os.close(fd)
             raise output_error(path, exc) from None
@@ -169,6 +191,7 @@ def output_lock(folder: Path, stem: str) -> Iterator[Path]:
         if same:
             break
         os.close(fd)  # the holder removed the file between our open and flock: lock the new one
+    _HELD_LOCKS.add(fd)
     try:
         yield path
     finally:
@@ -176,6 +199,28 @@ def output_lock(folder: Path, stem: str) -> Iterator[Path]:
             os.unlink(path)
         except OSError:
             pass
+        _HELD_LOCKS.discard(fd)
+        os.close(fd)
+
+
+def check_unlocked(folder: Path, stem: str, *, busy: str | None = None) -> None:
+    """Refuse at once, as :func:`output_lock` would, when another process holds ``folder/.<stem>.lock``: a
+    busy folder is said before any work. Takes nothing and creates nothing (the lock itself is taken later)."""
+    import fcntl
+
+    path = folder / f".{stem}.lock"
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return  # no lock file (or none readable): nobody holds it, or output_lock will say why
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise LockedError(busy or f"{folder}: another friction-uq run is writing {stem} into this folder (lock "
+                          f"{path.name}); wait for it to end or choose another --out") from None
+    except OSError:
+        pass
+    finally:
         os.close(fd)
 
 

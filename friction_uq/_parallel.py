@@ -22,9 +22,36 @@ def can_fork() -> bool:
             and threading.active_count() == 1)
 
 
+def end_with_parent() -> None:
+    """In a forked child: be killed when the parent dies (Linux ``PR_SET_PDEATHSIG``), so a run killed
+    with ``kill -9`` leaves no process working on for it (elsewhere the child ends when its value cannot
+    be sent); ignore Ctrl-C, which the terminal sends to the whole process group: the parent handles it
+    and stops the child, without a second traceback from the child."""
+    import os
+    import signal
+    import sys
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle: it stops the child
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        known = multiprocessing.parent_process()  # its pid was taken before the fork
+        parent = known.pid if known is not None else os.getppid()
+        libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1 = PR_SET_PDEATHSIG
+        if os.getppid() != parent:  # the parent died before the call: end now
+            os._exit(1)
+    except (OSError, AttributeError):
+        pass
+
+
 def _child(fn: Callable[..., Any], args: tuple, kwargs: dict, send: Any, recv: Any) -> None:
     """In the forked process: run the call, send (ok, value or exception) once, exit. A parent gone
-    meanwhile closes the pipe's other end: the send fails and the child ends all the same."""
+    meanwhile closes the pipe's other end: the send fails and the child ends all the same (and on
+    Linux it is killed with its parent)."""
+    end_with_parent()
     recv.close()
     try:
         out: tuple[bool, Any] = (True, fn(*args, **kwargs))

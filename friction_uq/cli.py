@@ -19,6 +19,8 @@ from . import __version__, import_command, priors_command
 from .errors import ConfigError, FrictionUQError, OutputError, os_error_text
 
 EXIT_BAD_INPUT = 2
+#: Exit status of an unexpected error (a bug), said in one line; FRICTION_UQ_TRACEBACK=1 shows its traceback.
+EXIT_INTERNAL = 3
 #: Figure formats of ``design -o`` and ``compare -o`` (matplotlib writes them without extra packages).
 FIGURE_SUFFIXES = (".pdf", ".png", ".svg", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp")
 #: Record file names ``simulate -o`` writes.
@@ -61,10 +63,19 @@ def _output_file(path: Path, suffixes: Sequence[str], what: str) -> None:
 
 def _check_text_file(path: Path, what: str, error: type[FrictionUQError]) -> str:
     """The UTF-8 text of an input file, or one sentence saying why it is not one."""
+    import stat
+
+    from .plausible import MAX_TEXT_BYTES
+
     try:
-        raw = path.read_bytes()
+        if not stat.S_ISREG(path.stat().st_mode):
+            raise error(f"{path}: is not a regular file (a device, a pipe or a folder), not a {what}")
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_TEXT_BYTES + 1)
     except OSError as exc:
         raise error(f"{path}: cannot read the {what} ({os_error_text(exc)})") from None
+    if len(raw) > MAX_TEXT_BYTES:
+        raise error(f"{path}: is larger than {MAX_TEXT_BYTES} bytes, too large for a {what} (docs/limits.md)")
     if raw.startswith(HDF5_SIGNATURE):
         raise error(f"{path}: is an HDF5 file (a test record?), not a {what}")
     try:
@@ -80,7 +91,12 @@ def _check_config(path: Path) -> None:
     """Refuse a configuration that is not UTF-8 TOML, or is nested too deeply to parse."""
     import tomllib
 
+    from .plausible import toml_shape_problem
+
     text = _check_text_file(path, "simulation configuration (TOML)", ConfigError)
+    problem = toml_shape_problem(text)
+    if problem:
+        raise ConfigError(f"{path}: {problem}, too deep for a simulation configuration (docs/limits.md)")
     try:
         tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -125,6 +141,19 @@ def _window(text: str) -> tuple[float, float]:
     return vals[0], vals[1]
 
 
+def _striker_velocity(text: str) -> float:
+    from .plausible import out_of_range
+
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"striker velocity {text!r} is not a number") from None
+    problem = out_of_range("striker_velocity", v)
+    if problem:
+        raise argparse.ArgumentTypeError(f"striker velocity {problem}")
+    return v
+
+
 def _nu(text: str) -> float:
     try:
         v = float(text)
@@ -162,7 +191,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("file", type=Path, help="test record (test.h5)")
     s.add_argument("-o", "--output", type=Path, required=True, help="figure file (PDF or PNG)")
     s.add_argument("--nu", type=_nu, default=0.4, help="sample Poisson ratio (default 0.4)")
-    s.add_argument("--striker-velocity", type=float, help="m/s (default: the record's, else from the incident wave)")
+    s.add_argument("--striker-velocity", type=_striker_velocity,
+                   help="m/s (default: the record's, else from the incident wave)")
 
     s = sub.add_parser("simulate", help="simulate a whole test into a record",
                        description="Simulate a confined friction test from a TOML configuration.")
@@ -219,18 +249,34 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _dispatch(args)
         return _dispatch(args)
     except FrictionUQError as exc:
-        print(f"friction-uq: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _error(str(exc))
     except OSError as exc:  # a system error no writer turned into a sentence: still one line
         where = exc.filename or ""
-        print(f"friction-uq: error: {where}{': ' if where else ''}{os_error_text(exc)}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _error(f"{where}{': ' if where else ''}{os_error_text(exc)}")
     except (RecursionError, UnicodeDecodeError) as exc:
-        print(f"friction-uq: error: an input file cannot be read ({type(exc).__name__}: {exc})", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _error(f"an input file cannot be read ({type(exc).__name__}: {exc})")
+    except MemoryError:
+        return _error("out of memory; an input is larger than this machine can analyse (docs/limits.md)")
     except KeyboardInterrupt:
         print("friction-uq: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # noqa: BLE001 - a bug: one line naming where, the traceback on request
+        if os.environ.get("FRICTION_UQ_TRACEBACK"):
+            raise
+        import traceback
+
+        last = traceback.extract_tb(exc.__traceback__)[-1]
+        _error(f"internal error ({type(exc).__name__}: {exc}; {Path(last.filename).name} line {last.lineno}); this "
+               "is a bug: please report it with the input (FRICTION_UQ_TRACEBACK=1 shows the traceback)")
+        return EXIT_INTERNAL
+
+
+def _error(message: str) -> int:
+    """Print ``message`` as one line (control characters from a file's text escaped) and return exit status 2."""
+    from .plausible import escaped
+
+    print(f"friction-uq: error: {escaped(message)}", file=sys.stderr)
+    return EXIT_BAD_INPUT
 
 
 def _dispatch(args: argparse.Namespace) -> int:
@@ -301,6 +347,12 @@ def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "priors":
         return priors_command.run(args)
     if args.command in ("run", "diagnose"):
+        from .record import read_record
+
+        rec = read_record(args.file)  # a bad record or prior file is refused before the analysis' libraries load
+        from .priors import default_prior_path, load_priors
+
+        load_priors(args.priors or default_prior_path(rec.apparatus.sample.material))
         from .run import run_file
 
         run_file(
@@ -335,7 +387,7 @@ def _add_campaign_parser(sub) -> None:
     s.add_argument("--workers", type=_workers, default=2, help="local worker processes (default 2)")
     s.add_argument("--scheduler", help="address of a running Dask scheduler (e.g. tcp://10.0.0.5:8786) "
                    "instead of a local cluster")
-    s.add_argument("--seed", type=int, default=20161, help="campaign seed (default 20161)")
+    s.add_argument("--seed", type=_seed, default=20161, help="campaign seed, 0 <= seed < 2**64 (default 20161)")
     s.add_argument("--priors", type=Path, help="prior file for every record (default: priors/<material>.toml)")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")

@@ -58,6 +58,10 @@ class OutputError(FrictionUQError):
     """An output cannot be written (no space, read-only, permission, a directory in the way, a lock)."""
 
 
+class LockedError(OutputError):
+    """Another process holds the output folder's lock (a run or a campaign writing the same names)."""
+
+
 class SeedError(FrictionUQError):
     """A random seed outside [0, 2**64)."""
 

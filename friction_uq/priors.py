@@ -58,6 +58,7 @@ import numpy as np
 from scipy import special, stats
 
 from .errors import PriorError
+from .plausible import is_name, toml_shape_problem
 
 #: Physical support (lower, upper) of each parameter the analysis knows.
 PARAMETERS: Mapping[str, tuple[float, float]] = {
@@ -79,6 +80,10 @@ DISTRIBUTIONS: Mapping[str, tuple[str, ...]] = {
 }
 #: Smallest probability mass the untruncated normal may put inside [lower, upper].
 MIN_MASS = 1e-9
+#: Where each parameter may plausibly lie (friction coefficients above 2 are not friction), and the least
+#: prior mass there: a prior with less is a slip of its parameters (a scale of 1e300), not a belief.
+PLAUSIBLE: Mapping[str, tuple[float, float]] = {"f": (0.0, 2.0), "nu": (0.0, 0.5), "hoop_gain": (0.5, 2.0)}
+MIN_PLAUSIBLE_MASS = 1e-3
 
 
 
@@ -332,6 +337,11 @@ def _parameter_prior(path: Path, name: str, table: object) -> ParameterPrior:
             f"normal(mean={params['mean']:g}, sd={params['sd']:g}) puts no mass (< {MIN_MASS:g}) on "
             f"[{lo:g}, {hi:g}]; move the mean inside the bounds or widen sd",
         )
+    plo, phi = PLAUSIBLE[name]
+    mass = float(prior.frozen().cdf(phi) - prior.frozen().cdf(plo))
+    if not mass >= MIN_PLAUSIBLE_MASS:
+        raise _fail(path, where, f"{prior.describe()} puts {mass:.2g} of its mass on [{plo:g}, {phi:g}], where "
+                    f"{name} may lie (docs/limits.md); at least {MIN_PLAUSIBLE_MASS:g} is needed: check its parameters")
     return prior
 
 
@@ -376,6 +386,9 @@ def load_priors(path: str | Path) -> Priors:
                     "save it as UTF-8 TOML") from None
     if "\x00" in text:
         raise _fail(path, "file", "contains NUL characters: a binary file, not TOML")
+    shape = toml_shape_problem(text)
+    if shape:
+        raise _fail(path, "file", f"{shape}, too deep for a prior file")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -383,6 +396,15 @@ def load_priors(path: str | Path) -> Priors:
     except RecursionError:
         raise _fail(path, "file", "is nested too deeply to be a prior file") from None
     return parse_priors(doc, path=path)
+
+
+def check_material_name(material: str) -> str:
+    """``material`` if it is a name (letters, digits, '-', '_'), else PriorError: a record's material is data,
+    looked up among the prior files, never a path."""
+    if not is_name(material):
+        raise PriorError(f"sample material {material!r} is not a material name (letters, digits, '-' and '_' "
+                         "only); name the material in the record, or pass a prior file with --priors")
+    return material
 
 
 def default_prior_path(material: str, *, directory: str | Path | None = None) -> Path:
@@ -394,6 +416,7 @@ def default_prior_path(material: str, *, directory: str | Path | None = None) ->
         If there is no file for ``material``; the message lists the materials that have one.
     """
     folder = Path(directory) if directory is not None else PRIORS_DIR
+    check_material_name(material)
     path = folder / f"{material}.toml"
     if not path.is_file():
         known = prior_files(folder)

@@ -6,6 +6,7 @@ import numpy as np
 
 from .analysis import Identification
 from .errors import SignalError
+from .plausible import escaped
 from .record import Record
 from .signals import prepulse_noise
 
@@ -25,8 +26,8 @@ def inspect_text(record: Record) -> str:
         f"test        {record.test_id}   campaign {record.campaign}"
         + (f"   date {record.date}" if record.date else ""),
     ]
-    if record.description:
-        out.append(f"description {record.description}")
+    if record.description:  # free text from the file: control characters shown escaped, never sent to the terminal
+        out.append(f"description {escaped(record.description)}")
     if record.striker_velocity is not None:
         out.append(f"striker     {record.striker_velocity:.3f} m/s (measured)")
     out.append(
@@ -34,7 +35,7 @@ def inspect_text(record: Record) -> str:
         f"{record.duration * 1e6:.1f} us, t0 = {record.t0 * 1e6:.1f} us"
     )
     if record.provenance:
-        out.append("provenance  " + ", ".join(f"{k}={v}" for k, v in record.provenance.items()))
+        out.append("provenance  " + escaped(", ".join(f"{k}={v}" for k, v in record.provenance.items())))
     out.append("")
     span = int(a.pulse_duration * record.sample_rate / 2)
     rows = []

@@ -50,8 +50,12 @@ def test_a_result_of_another_schema_is_refused(tmp_path, edit, message):
 
 
 def test_up_to_date_needs_same_record_settings_prior_version_and_outputs(tmp_path):
-    (tmp_path / "A_A-01.json").write_text("{}")
-    old = _result()
+    import hashlib
+
+    (tmp_path / "A_A-01.nc").write_bytes(b"draws")  # the run JSON names the .nc's checksum
+    (tmp_path / "A_A-01.json").write_text(json.dumps({"outputs": {"netcdf": {
+        "file": "A_A-01.nc", "sha256": hashlib.sha256(b"draws").hexdigest()}, "pdf": None}}))
+    old = _result(outputs={"json": "A_A-01.json", "netcdf": "A_A-01.nc"})
     assert _up_to_date(old, _result(status="failed"), tmp_path)
     for change in ({"record_sha256": "ff" * 32}, {"prior_sha256": "ee" * 32}, {"friction_uq_version": "0.0.1"},
                    {"settings": old.settings | {"seed": 6}}, {"settings": old.settings | {"dispersion": True}}):
@@ -60,6 +64,8 @@ def test_up_to_date_needs_same_record_settings_prior_version_and_outputs(tmp_pat
     with_pdf = dataclasses.replace(old, settings=old.settings | {"pdf": True})
     assert _up_to_date(with_pdf, old, tmp_path)  # a run with the report serves one without
     assert not _up_to_date(old, with_pdf, tmp_path)
+    (tmp_path / "A_A-01.nc").write_bytes(b"drawz")  # changed since its run: redone
+    assert not _up_to_date(old, old, tmp_path)
     (tmp_path / "A_A-01.json").unlink()
     assert not _up_to_date(old, old, tmp_path)
 

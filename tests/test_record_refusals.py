@@ -270,7 +270,7 @@ CASES = [
          IB, "is a broken link"),
     Case("channel-external-link-to-missing-file",
          replace_by(EOB, lambda g, n: g.__setitem__(n, h5py.ExternalLink("scope_raw.h5", "/ch3"))),
-         EOB, "is a broken link"),
+         EOB, "is an external link"),
     Case("channel-2d", channel(IB, lambda x: x.reshape(-1, 2)), IB, r"must be 1-D, got shape \(3250, 2\)"),
     Case("channel-column", channel(EOB, lambda x: x[:, None]), EOB, r"must be 1-D, got shape \(6500, 1\)"),
     Case("channel-scalar", channel(HOOP, lambda x: x[0]), HOOP, r"must be 1-D, got shape \(\)"),

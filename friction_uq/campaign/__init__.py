@@ -23,14 +23,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..errors import FrictionUQError
+from .._atomic import check_unlocked, output_lock
+from ..errors import FrictionUQError, check_seed
 from .analysis import CampaignAnalysis, analyse
 from .compare import Comparison, TestResult, TrendFit, compare, comparison_table, fit_trend, load_result
 from .job import RecordResult, RecordTask, read_result, run_record
 from .outputs import campaign_doc, summary_text, write_json, write_netcdf
-from .runner import check_headers, find_records, make_tasks, read_header, record_seed, run_tasks
+from .runner import check_headers, find_records, local_workers, make_tasks, read_header, record_seed, run_tasks
 
 RECORDS_SUBDIR = "records"
+#: The campaign's lock in its output folder (``.campaign.lock``): one campaign writes into a folder at a time.
+CAMPAIGN_LOCK = "campaign"
 
 
 @dataclass(frozen=True)
@@ -60,11 +63,35 @@ def run_campaign(
     Per-record outputs go to ``out_dir/records/`` (their PDF reports only with ``pdf``);
     ``campaign.json``, ``campaign.nc`` and ``campaign.pdf`` to ``out_dir``.
     """
+    seed = check_seed(seed)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise FrictionUQError(f"{out}: --out must be a directory, and this is a file")
+    if not scheduler:
+        workers = local_workers(workers)
+    busy = (f"{out}: another friction-uq campaign is writing into this folder (lock .{CAMPAIGN_LOCK}.lock); "
+            "wait for it to end or choose another --out")
+    check_unlocked(out, CAMPAIGN_LOCK, busy=busy)  # said at once; the lock itself is taken below
     headers = [read_header(p) for p in find_records(inputs)]
     check_headers(headers)
+    made = not out.exists()
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FrictionUQError(f"{out}: cannot create the output directory ({exc.strerror or exc})") from None
+    try:
+        with output_lock(out, CAMPAIGN_LOCK, busy=busy):
+            return _run_locked(headers, out, workers=workers, scheduler=scheduler, seed=seed,
+                               priors_path=priors_path, dispersion=dispersion, hoop=hoop, pdf=pdf, diagnose=diagnose,
+                               progress=progress)
+    finally:
+        if made and out.is_dir() and not any(out.iterdir()):
+            out.rmdir()  # a refused campaign leaves no empty folder behind
+
+
+def _run_locked(headers, out: Path, *, workers: int, scheduler: str | None, seed: int, priors_path, dispersion: bool,
+                hoop: bool, pdf: bool, diagnose: bool, progress: bool) -> CampaignOutcome:
+    """:func:`run_campaign` once its inputs are checked and it holds the folder's campaign lock."""
     records_dir = out / RECORDS_SUBDIR
     try:
         records_dir.mkdir(parents=True, exist_ok=True)

@@ -21,6 +21,8 @@ import numpy as np
 from ..errors import FrictionUQError
 
 REQUIRED = ("f", "kappa", "nu", "V", "p_mean", "test_id", "campaign")
+SUMMARIES = ("f", "kappa", "nu", "V", "p_mean")
+STATISTICS = ("mean", "sd", "q05", "q50", "q95")
 
 
 @dataclass(frozen=True)
@@ -54,15 +56,39 @@ class TrendFit:
 
 
 def load_result(path: str | os.PathLike[str]) -> TestResult:
-    """Read one ``<campaign>_<test_id>.json`` written by ``friction-uq run``."""
+    """Read one ``<campaign>_<test_id>.json`` written by ``friction-uq run``; refuse, in one sentence naming the
+    file and the key, one that is not a JSON object with the ids as text and each summary as finite numbers."""
+    import math
+
+    from ..plausible import MAX_TEXT_BYTES, escaped, unprintable
+
     p = Path(path)
     try:
-        doc = json.loads(p.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+        with open(p, "rb") as fh:
+            raw = fh.read(MAX_TEXT_BYTES + 1)
+        if len(raw) > MAX_TEXT_BYTES:
+            raise FrictionUQError(f"{p}: more than {MAX_TEXT_BYTES} bytes, not a friction-uq result file")
+        doc = json.loads(raw)
+    except (OSError, ValueError, RecursionError) as exc:
         raise FrictionUQError(f"{p}: not a friction-uq result file ({exc})") from None
+    if not isinstance(doc, dict):
+        raise FrictionUQError(f"{p}: not a friction-uq run result (a JSON {type(doc).__name__}, not an object)")
     missing = [k for k in REQUIRED if k not in doc]
     if missing:
         raise FrictionUQError(f"{p}: not a friction-uq run result: key(s) {', '.join(missing)} missing")
+    for key in ("campaign", "test_id"):
+        if not isinstance(doc[key], str) or not doc[key].strip() or unprintable(doc[key]):
+            shown = escaped(doc[key]) if isinstance(doc[key], str) else repr(doc[key])
+            raise FrictionUQError(f"{p}: key {key!r} is {shown!r}, not an id (non-empty text, no control characters)")
+    for key in SUMMARIES:
+        v = doc[key]
+        bad = [s for s in STATISTICS if not isinstance(v, dict) or isinstance(v.get(s), bool)
+               or not isinstance(v.get(s), (int, float)) or not math.isfinite(v[s])]
+        if bad:
+            raise FrictionUQError(f"{p}: key {key!r} must hold finite numbers {', '.join(STATISTICS)}; "
+                                  f"{', '.join(bad)} {'is' if len(bad) == 1 else 'are'} not")
+        if v["sd"] < 0 or (key == "kappa" and v["sd"] == 0):
+            raise FrictionUQError(f"{p}: key '{key}': sd is {v['sd']!r}, it must be > 0")
     return TestResult(doc["campaign"], doc["test_id"], doc["f"], doc["kappa"], doc["nu"], doc["V"], doc["p_mean"],
                       str(p))
 
@@ -103,7 +129,8 @@ def compare(paths: list[str | os.PathLike[str]]) -> Comparison:
         raise FrictionUQError("no result files given")
     fits: dict[str, TrendFit] = {}
     for name, regs in (("V", ("V",)), ("p_mean", ("p_mean",)), ("V+p_mean", ("V", "p_mean"))):
-        if len(results) > len(regs) + 1:
+        X = np.column_stack([np.ones(len(results))] + [[getattr(r, x)["mean"] for r in results] for x in regs])
+        if len(results) > len(regs) + 1 and np.linalg.matrix_rank(X) == X.shape[1]:  # the regressors vary
             fits[name] = fit_trend(results, regs)
     return Comparison(results, fits)
 

@@ -10,8 +10,8 @@ never raises for a bad record, so the campaign goes on.
 The result is written beside the run outputs as ``<stem>.result.json`` and read back with
 :func:`read_result` (the one function that knows the schema). A record whose stored result is
 up to date (same record sha256, same settings, same prior file checksum, same package version,
-outputs present) is not analysed again: the job returns the stored result with ``status =
-"skipped"``.
+outputs present and holding the bytes the run JSON names) is not analysed again: the job returns
+the stored result with ``status = "skipped"``; one that cannot be read is analysed again.
 
 Schema version 1 (``schema = "friction-uq/campaign-record"``): ``path``, ``status``
 (``done`` | ``skipped`` | ``failed``), ``message``, ``campaign`` (the set-up), ``test_id``,
@@ -38,12 +38,15 @@ from typing import Any
 
 from .. import __version__
 from .._atomic import atomic_path
-from ..errors import FrictionUQError
+from ..errors import FrictionUQError, LockedError
 
 SCHEMA = "friction-uq/campaign-record"
 SCHEMA_VERSION = 1
 SUMMARY_VARIABLES = ("f", "kappa", "nu", "V", "p_mean")
 STATUSES = ("done", "skipped", "failed")
+#: Seconds a record waits for its lock in the campaign's folder: only a killed campaign's worker can hold it
+#: (the campaign holds the folder's lock), and Dask stops such a worker within a few seconds.
+LOCK_WAIT_S = 30
 
 
 @dataclass(frozen=True)
@@ -152,7 +155,26 @@ def _up_to_date(old: RecordResult, new: RecordResult, out_dir: Path) -> bool:
     pdf_ok = old.settings.get("pdf", False) or not new.settings.get("pdf", False)
     same = (old.ok and old.record_sha256 == new.record_sha256 and analysis and pdf_ok
             and old.prior_sha256 == new.prior_sha256 and old.friction_uq_version == new.friction_uq_version)
-    return same and all((out_dir / name).exists() for name in old.outputs.values())
+    return same and _outputs_intact(old, out_dir)
+
+
+def _outputs_intact(old: RecordResult, out_dir: Path) -> bool:
+    """The stored outputs are there and are the bytes their run wrote: the run JSON names the sha256 of the
+    ``.nc`` and the ``.pdf``. Anything missing, unreadable or changed: False (the record is analysed again)."""
+    try:
+        if not all((out_dir / name).is_file() for name in old.outputs.values()):
+            return False
+        doc = json.loads((out_dir / old.outputs["json"]).read_text())
+        for kind in ("netcdf", "pdf"):
+            if kind not in old.outputs:
+                continue
+            named = doc["outputs"][kind]
+            if named is None or named["file"] != old.outputs[kind] or \
+                    file_sha256(out_dir / named["file"]) != named["sha256"]:
+                return False
+        return "netcdf" in old.outputs
+    except (OSError, KeyError, TypeError, ValueError):
+        return False
 
 
 def _summary(doc: dict[str, Any]) -> dict[str, dict[str, float]]:
@@ -174,6 +196,11 @@ def run_record(task: RecordTask) -> RecordResult:
     from ..record import read_record
     from ..run import run_file, safe_stem
 
+    import logging
+
+    # a Dask worker's state machine warns of each task cut short when an interrupted campaign stops it (also
+    # set by the runner on the workers it starts with; here for a worker started later)
+    logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
     t0, c0 = time.perf_counter(), time.process_time()
     out = Path(task.out_dir)
     base = RecordResult(path=str(task.path), status="failed", settings=task.settings)
@@ -188,17 +215,25 @@ def run_record(task: RecordTask) -> RecordResult:
             prior_sha256=file_sha256(prior) if prior.is_file() else None)
         stored = result_path(out, stem)
         if stored.exists():
-            try:
+            try:  # a stored result that cannot be read, or holds values of the wrong kind, is redone
                 old = read_result(stored)
-            except FrictionUQError:
-                old = None
-            if old is not None and _up_to_date(old, base, out):
+                fresh = _up_to_date(old, base, out)
+            except (FrictionUQError, TypeError, ValueError, AttributeError, KeyError):
+                fresh = False
+            if fresh:
                 return dataclasses.replace(old, status="skipped", path=str(task.path))
         buf_out, buf_err = io.StringIO(), io.StringIO()
-        with contextlib.redirect_stdout(buf_out), contextlib.redirect_stderr(buf_err):
-            run = run_file(task.path, priors_path=task.priors_path, out_dir=out, seed=task.seed,
-                           dispersion=task.dispersion, hoop=task.hoop, pdf=task.pdf, progress=False, table=False,
-                           diagnose=task.diagnose)
+        for attempt in range(LOCK_WAIT_S + 1):
+            try:
+                with contextlib.redirect_stdout(buf_out), contextlib.redirect_stderr(buf_err):
+                    run = run_file(task.path, priors_path=task.priors_path, out_dir=out, seed=task.seed,
+                                   dispersion=task.dispersion, hoop=task.hoop, pdf=task.pdf, progress=False,
+                                   table=False, diagnose=task.diagnose)
+                break
+            except LockedError:  # the campaign holds the folder: the holder is a killed campaign's dying worker
+                if attempt == LOCK_WAIT_S:
+                    raise
+                time.sleep(1.0)
         doc = json.loads(run.outputs["json"].read_text())
         notes = [line.removeprefix("friction-uq: note: ") for line in buf_err.getvalue().splitlines() if line.strip()]
         result = dataclasses.replace(

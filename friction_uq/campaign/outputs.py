@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from .._atomic import atomic_path
+from .._atomic import atomic_path, write_bytes
 from .analysis import WEIGHT_RULE, CampaignAnalysis, f_law_draws
 from .job import RecordResult
 
@@ -169,9 +169,9 @@ def write_netcdf(ca: CampaignAnalysis, path: Path) -> Path:
     dt = xr.DataTree.from_dict({"/": xr.Dataset(attrs={"friction_uq_version": __version__,
                                                        "best_law": ca.best or "none"})}
                                | {f"/{k}": v for k, v in groups.items()})
-    with atomic_path(path) as tmp:
-        dt.to_netcdf(tmp, engine="h5netcdf")
-    return path
+    from ..run import netcdf_bytes
+
+    return write_bytes(path, netcdf_bytes(dt))  # built in memory (HDF5 crashes on a disk that fills mid-file)
 
 
 def summary_text(doc: dict[str, Any]) -> str:

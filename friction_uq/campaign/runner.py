@@ -13,9 +13,10 @@ campaign leaves the seeds (and so the up-to-date results) of the others unchange
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -60,7 +61,11 @@ def read_header(path: Path) -> RecordHeader:
     """Checksum, campaign, test id and sample material, or None for what cannot be read (the job says why)."""
     import h5py
 
+    from ..plausible import MAX_RECORD_BYTES
+
     try:
+        if path.stat().st_size > MAX_RECORD_BYTES:  # not hashed: the job refuses it in one sentence
+            return RecordHeader(str(path), "", None, None, None)
         sha = file_sha256(path)
     except OSError:
         return RecordHeader(str(path), "", None, None, None)
@@ -75,7 +80,11 @@ def read_header(path: Path) -> RecordHeader:
 
 
 def check_headers(headers: Sequence[RecordHeader]) -> None:
-    """Refuse a campaign that mixes sample materials, or names one record (or one test id) twice."""
+    """Refuse a campaign that mixes sample materials, names one record (or one test id) twice, or has two
+    records whose output names collide (``A_B``/``C`` and ``A``/``B_C`` both write ``A_B_C.*``; names that
+    differ only in case collide on some file systems)."""
+    from ..run import safe_stem
+
     by_material: dict[str, list[str]] = {}
     for h in headers:
         if h.material is not None:
@@ -86,6 +95,7 @@ def check_headers(headers: Sequence[RecordHeader]) -> None:
                               "of one material pair, run one campaign per material")
     seen: dict[str, str] = {}
     ids: dict[tuple[str, str], str] = {}
+    stems: dict[str, RecordHeader] = {}
     for h in headers:
         if h.sha256 and h.sha256 in seen:
             raise FrictionUQError(f"{h.path} and {seen[h.sha256]} are the same record (same sha256): give it once")
@@ -96,6 +106,13 @@ def check_headers(headers: Sequence[RecordHeader]) -> None:
                 raise FrictionUQError(f"{h.path} and {ids[key]} have the same campaign and test_id "
                                       f"({h.campaign} {h.test_id}): their outputs would overwrite each other")
             ids[key] = h.path
+            stem = safe_stem(h.campaign, h.test_id)
+            other = stems.get(stem.casefold())
+            if other is not None:
+                raise FrictionUQError(
+                    f"{h.path} (campaign {h.campaign!r}, test_id {h.test_id!r}) and {other.path} (campaign "
+                    f"{other.campaign!r}, test_id {other.test_id!r}) would both write {stem}.*: rename one test_id")
+            stems[stem.casefold()] = h
 
 
 def record_seed(campaign_seed: int, sha256: str, path: str) -> int:
@@ -139,6 +156,19 @@ class Progress:
             print(line, file=self.stream, flush=True)
 
 
+def local_workers(workers: int) -> int:
+    """The local cluster's worker processes: ``workers``, at most one per core of this machine (more only
+    share the cores, each with its own memory), with a note on stderr when it is capped."""
+    if workers < 1:
+        raise FrictionUQError(f"--workers must be at least 1, got {workers}")
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if workers > cores:
+        print(f"friction-uq: note: --workers {workers} is more than the {cores} core(s) this process may use: "
+              f"{cores} worker process(es)", file=sys.stderr, flush=True)
+        return cores
+    return workers
+
+
 def open_client(*, workers: int, scheduler: str | None, timeout: float = CONNECT_TIMEOUT_S):
     """A Dask client: on an existing scheduler, or on a new local cluster of one-thread processes."""
     import dask
@@ -159,9 +189,49 @@ def open_client(*, workers: int, scheduler: str | None, timeout: float = CONNECT
         raise FrictionUQError(f"--workers must be at least 1, got {workers}")
     # numba's default threading layer is not fork- or thread-safe: one thread per worker process
     with dask.config.set({"distributed.nanny.pre-spawn-environ.NUMBA_NUM_THREADS": 1,
-                          "distributed.worker.daemon": True}):
+                          "distributed.worker.daemon": True}), _workers_ignore_ctrl_c():
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
     return Client(cluster)
+
+
+@contextlib.contextmanager
+def _workers_ignore_ctrl_c() -> Iterator[None]:
+    """Ignore SIGINT while the local cluster starts its worker processes: they inherit it, so Ctrl-C (sent by
+    the terminal to the whole process group) reaches only this process, which stops them quietly."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old if old is not None else signal.default_int_handler)
+
+
+def quiet_cancellations() -> None:
+    """In a Dask worker: no warning for each task cut short when an interrupted campaign stops the worker."""
+    import logging
+
+    logging.getLogger("distributed.worker.state_machine").setLevel(logging.ERROR)
+
+
+@contextlib.contextmanager
+def _quiet_shutdown() -> Iterator[None]:
+    """Dask's loggers silenced while an interrupted campaign stops its cluster (tracebacks of tasks cut short)."""
+    import logging
+
+    loggers = [logging.getLogger(n) for n in ("distributed", "tornado", "asyncio")]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, levels):
+            lg.setLevel(level)
 
 
 def run_tasks(tasks: Sequence[RecordTask], *, workers: int = 1, scheduler: str | None = None,
@@ -172,7 +242,9 @@ def run_tasks(tasks: Sequence[RecordTask], *, workers: int = 1, scheduler: str |
     client = open_client(workers=workers, scheduler=scheduler)
     cluster = None if scheduler else client.cluster
     bar = Progress(len(tasks), enabled=progress)
+    interrupted = False
     try:
+        client.run(quiet_cancellations)
         futures = client.map(job, list(tasks), pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
         results: list[RecordResult | None] = [None] * len(tasks)
@@ -186,7 +258,11 @@ def run_tasks(tasks: Sequence[RecordTask], *, workers: int = 1, scheduler: str |
             results[i] = res
             bar.update(res)
         return [r for r in results if r is not None]
+    except KeyboardInterrupt:
+        interrupted = True  # each record's checkpoint stays; the next campaign resumes from them
+        raise
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        with _quiet_shutdown() if interrupted else contextlib.nullcontext():
+            client.close()
+            if cluster is not None:
+                cluster.close()

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from .._parallel import can_fork
+from .._parallel import can_fork, end_with_parent
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
@@ -229,7 +229,7 @@ class Diagnoser:
         global _ACTIVE
         _ACTIVE = (self, jobs)
         try:
-            with multiprocessing.get_context("fork").Pool(workers) as pool:
+            with multiprocessing.get_context("fork").Pool(workers, initializer=end_with_parent) as pool:
                 parts = pool.map(_fit_job, range(len(jobs)), chunksize=1)
         finally:
             _ACTIVE = None

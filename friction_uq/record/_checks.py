@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import RecordError
+from ..plausible import MAX_ATTRIBUTE_BYTES
 from .contract import CLIP_RUN
 
 
@@ -31,8 +32,14 @@ class Reader:
             if required:
                 raise self.fail(where, f"required attribute '{name}' is missing")
             return None
-        value = obj.attrs[name]
         loc = f"{where}@{name}" if where != "/" else f"/@{name}"
+        try:
+            stored = obj.attrs.get_id(name).get_storage_size()
+        except (KeyError, OSError, RuntimeError) as exc:
+            raise self.fail(loc, f"cannot be read ({exc})") from None
+        if stored > MAX_ATTRIBUTE_BYTES:
+            raise self.fail(loc, f"takes {stored} bytes, more than the {MAX_ATTRIBUTE_BYTES} an attribute may")
+        value = obj.attrs[name]
         if isinstance(value, np.ndarray):
             if value.shape not in ((), (1,)):
                 raise self.fail(loc, f"must be a scalar, got an array of shape {value.shape}")
@@ -64,12 +71,29 @@ class Reader:
 
     def member(self, group: Any, name: str, where: str) -> Any:
         """``group[name]``, or None if absent; a dangling soft or external link is refused at ``where``."""
+        import h5py
+
         if name not in group:
-            return None
+            try:  # a dangling link is not "in" its group
+                link = group.get(name, getlink=True)
+            except (KeyError, OSError):
+                link = None
+            if link is None:
+                return None
+        else:
+            link = group.get(name, getlink=True)
+        if isinstance(link, h5py.ExternalLink):
+            raise self.fail(where, f"is an external link (to {link.filename}:{link.path}); a record must hold its "
+                            "data itself, so that its checksum covers every byte it is analysed from (copy the "
+                            "linked object in, e.g. with h5copy)")
         try:
-            return group[name]
+            obj = group[name]
         except (KeyError, OSError) as exc:
             raise self.fail(where, f"is a broken link ({exc})") from None
+        if isinstance(obj, h5py.Dataset) and (obj.is_virtual or obj.external):
+            raise self.fail(where, "keeps its data in other files (a virtual or external dataset); a record must "
+                            "hold its data itself, so that its checksum covers every byte it is analysed from")
+        return obj
 
     def positive(self, obj: Any, where: str, name: str) -> float:
         value = self.attr(obj, where, name, "float")
@@ -128,3 +152,27 @@ def longest_run(mask: np.ndarray) -> int:
     padded = np.concatenate(([0], mask.astype(np.int8), [0]))
     edges = np.flatnonzero(np.diff(padded))
     return int((edges[1::2] - edges[0::2]).max())
+
+
+def check_strain(strain: np.ndarray, where: str, r: Reader) -> None:
+    """Refuse a channel whose strain is larger than an elastic bar or tube can carry (a gain or unit slip)."""
+    from ..plausible import out_of_range
+
+    peak = float(np.max(np.abs(strain)))
+    problem = out_of_range("signals.strain", peak)
+    if problem:
+        raise r.fail(where, f"reaches a strain of {peak:.3g}: {problem.removeprefix('is ')}; check its units and "
+                     "strain_per_volt")
+
+
+def check_distinct(strain: np.ndarray, earlier: dict[str, Any], where: str, r: Reader) -> None:
+    """Refuse a channel that is another channel's data again (equal, or equal up to a factor): two gauges on
+    different bars never record proportional noise."""
+    for name, ch in earlier.items():
+        other = ch.strain
+        if np.array_equal(strain, other):
+            raise r.fail(where, f"holds the same samples as /signals/{name}: a channel copied twice?")
+        a, b = strain - strain.mean(), other - other.mean()
+        den = float(np.sqrt(np.dot(a, a) * np.dot(b, b)))
+        if den > 0 and abs(float(np.dot(a, b))) / den > 1.0 - 1e-12:
+            raise r.fail(where, f"is /signals/{name} multiplied by a constant: a channel copied twice?")

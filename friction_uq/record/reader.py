@@ -23,7 +23,16 @@ import numpy as np
 
 from ..errors import RecordError
 from ._apparatus_reader import read_apparatus
-from ._checks import Reader, check_samples, plain, sha256_of
+from ..plausible import (
+    MAX_ATTRIBUTE_BYTES,
+    MAX_RECORD_BYTES,
+    MAX_SAMPLES,
+    apparatus_problem,
+    escaped,
+    out_of_range,
+    unprintable,
+)
+from ._checks import Reader, check_distinct, check_samples, check_strain, plain, sha256_of
 from .contract import (
     CHANNELS,
     FORMAT,
@@ -69,6 +78,10 @@ def read_record(path: str | os.PathLike[str]) -> Record:
         raise r.fail("/", f"cannot be read ({exc.strerror or exc})") from None
     if not is_hdf5:
         raise r.fail("/", "is not an HDF5 file (no HDF5 signature); a test record must be HDF5")
+    size = p.stat().st_size
+    if size > MAX_RECORD_BYTES:
+        raise r.fail("/", f"is {size / 2**20:.0f} MiB, more than the {MAX_RECORD_BYTES // 2**20} MiB a record may be "
+                     "(docs/limits.md)")
     try:
         fh = h5py.File(p, "r")
     except OSError as exc:
@@ -97,11 +110,13 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
     if version < 1:
         raise r.fail("/@format_version", f"is {version}, expected {FORMAT_VERSION}")
     test_id = r.attr(fh, "/", "test_id", "str")
-    if not test_id.strip():
-        raise r.fail("/@test_id", "is empty")
     campaign = r.attr(fh, "/", "campaign", "str")
-    if not campaign.strip():
-        raise r.fail("/@campaign", "is empty")
+    for key, value in (("test_id", test_id), ("campaign", campaign)):
+        if not value.strip():
+            raise r.fail(f"/@{key}", "is empty")
+        bad = unprintable(value)
+        if bad:
+            raise r.fail(f"/@{key}", f"{bad} ('{escaped(value)}'): an id is printed on terminals and names files")
     date = r.attr(fh, "/", "date", "str", required=False)
     if date is not None:
         try:
@@ -114,6 +129,8 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
     striker_velocity = r.attr(fh, "/", "striker_velocity", "float", required=False)
     if striker_velocity is not None and striker_velocity <= 0:
         raise r.fail("/@striker_velocity", f"must be > 0 m/s, got {striker_velocity!r}")
+    if striker_velocity is not None and out_of_range("striker_velocity", striker_velocity):
+        raise r.fail("/@striker_velocity", out_of_range("striker_velocity", striker_velocity))
 
     # ---- apparatus ----
     app = r.member(fh, "apparatus", "/apparatus")
@@ -122,6 +139,13 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
     if not isinstance(app, h5py.Group):
         raise r.fail("/apparatus", "must be a group")
     apparatus = read_apparatus(app, r)
+    implausible = apparatus_problem(apparatus)
+    if implausible:
+        part, attr, problem = implausible
+        raise r.fail(f"/apparatus/{part}@{attr}", problem)
+    bad = unprintable(apparatus.sample.material)
+    if bad:
+        raise r.fail("/apparatus/sample@material", f"{bad} ('{escaped(apparatus.sample.material)}')")
 
     # ---- signals ----
     sig = r.member(fh, "signals", "/signals")
@@ -134,6 +158,9 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
         raise r.fail("/signals@sample_rate", f"must be > 0 Hz, got {sample_rate!r}")
     t0 = r.attr(sig, "/signals", "t0", "float", required=False)
     t0 = 0.0 if t0 is None else t0
+    for key, value in (("sample_rate", sample_rate), ("t0", t0)):
+        if out_of_range(f"signals.{key}", value):
+            raise r.fail(f"/signals@{key}", out_of_range(f"signals.{key}", value))
 
     channels: dict[str, Channel] = {}
     length: int | None = None
@@ -151,6 +178,9 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
             raise r.fail(where, f"must be 1-D, got shape {ds.shape}")
         if ds.dtype.kind != "f" or ds.dtype.itemsize not in (4, 8):
             raise r.fail(where, f"must be float32 or float64, got {ds.dtype}")
+        if ds.shape[0] > MAX_SAMPLES:
+            raise r.fail(where, f"declares {ds.shape[0]} samples, more than the {MAX_SAMPLES} a channel may have "
+                         "(docs/limits.md)")
         if length is None:
             length, first = ds.shape[0], name
             if length < MIN_SAMPLES:
@@ -169,6 +199,8 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
                 raise r.fail(where, "units are 'V' but attribute 'strain_per_volt' is missing")
             if spv == 0:
                 raise r.fail(f"{where}@strain_per_volt", "must not be zero")
+            if out_of_range("signals.strain_per_volt", abs(spv)):
+                raise r.fail(f"{where}@strain_per_volt", out_of_range("signals.strain_per_volt", abs(spv)))
             scale = spv
         else:
             scale = UNITS[units]
@@ -176,6 +208,8 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
         check_samples(raw, where, r)
         strain = -scale * raw  # the one sign flip of the package: compression positive from here on
         strain.setflags(write=False)
+        check_strain(strain, where, r)
+        check_distinct(strain, channels, where, r)
         channels[name] = Channel(name, strain, units, spv)
     assert length is not None  # REQUIRED_CHANNELS is not empty
 
@@ -194,6 +228,9 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
     provenance: dict[str, Any] = {}
     prov = r.member(fh, "provenance", "/provenance")
     if prov is not None:
+        for k in prov.attrs:  # free-form, but bounded like every attribute
+            if prov.attrs.get_id(k).get_storage_size() > MAX_ATTRIBUTE_BYTES:
+                raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
         provenance = {k: plain(v) for k, v in prov.attrs.items()}
 
     return Record(

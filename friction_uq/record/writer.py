@@ -6,6 +6,8 @@ simulator both use it); it flips the gauge sign back (elongation positive in the
 
 from __future__ import annotations
 
+import io
+
 import os
 from collections.abc import Mapping
 from dataclasses import asdict
@@ -14,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from .._atomic import atomic_path
+from .._atomic import write_bytes
 from ..apparatus import Apparatus, Bar
 from .contract import CHANNELS, FORMAT, FORMAT_VERSION, UNITS
 
@@ -79,45 +81,46 @@ def write_record(
     units = dict(units or {})
     strain_per_volt = dict(strain_per_volt or {})
     p = Path(path)
-    with atomic_path(p) as tmp:
-        with h5py.File(tmp, "w") as fh:
-            fh.attrs["format"] = FORMAT
-            fh.attrs["format_version"] = FORMAT_VERSION
-            fh.attrs["test_id"] = test_id
-            fh.attrs["campaign"] = campaign
-            for k, v in (("date", date), ("description", description), ("striker_velocity", striker_velocity)):
-                if v is not None:
-                    fh.attrs[k] = v
-            sig = fh.create_group("signals")
-            sig.attrs["sample_rate"] = float(sample_rate)
-            sig.attrs["t0"] = float(t0)
-            for name, eps in strains.items():
-                if name not in CHANNELS:
-                    raise ValueError(f"unknown channel {name!r}, allowed: {CHANNELS}")
-                u = units.get(name, "strain")
-                if u == "V":
-                    scale = strain_per_volt[name]
-                elif u in UNITS:
-                    scale = UNITS[u]
-                else:
-                    raise ValueError(f"unknown units {u!r} for {name!r}, allowed: {tuple(UNITS)}")
-                raw = -np.asarray(eps, dtype=np.float64) / scale
-                ds = sig.create_dataset(name, data=raw.astype(dtype))
-                ds.attrs["units"] = u
-                if u == "V":
-                    ds.attrs["strain_per_volt"] = float(scale)
-            app = fh.create_group("apparatus")
-            for part, attrs in _apparatus_attrs(apparatus).items():
-                g = app.create_group(part)
-                for k, v in attrs.items():
-                    g.attrs[k] = v
-            prov = fh.create_group("provenance")
-            prov.attrs["generator"] = "friction-uq"
-            prov.attrs["generator_version"] = __version__
-            for k, v in (provenance or {}).items():
-                prov.attrs[k] = v
-            if truth is not None:
-                tg = fh.create_group("truth")
-                for k, v in truth.items():
-                    tg.attrs[k] = v
+    buf = io.BytesIO()  # built in memory, then written at once: HDF5 crashes on a disk that fills mid-file
+    with h5py.File(buf, "w") as fh:
+        fh.attrs["format"] = FORMAT
+        fh.attrs["format_version"] = FORMAT_VERSION
+        fh.attrs["test_id"] = test_id
+        fh.attrs["campaign"] = campaign
+        for k, v in (("date", date), ("description", description), ("striker_velocity", striker_velocity)):
+            if v is not None:
+                fh.attrs[k] = v
+        sig = fh.create_group("signals")
+        sig.attrs["sample_rate"] = float(sample_rate)
+        sig.attrs["t0"] = float(t0)
+        for name, eps in strains.items():
+            if name not in CHANNELS:
+                raise ValueError(f"unknown channel {name!r}, allowed: {CHANNELS}")
+            u = units.get(name, "strain")
+            if u == "V":
+                scale = strain_per_volt[name]
+            elif u in UNITS:
+                scale = UNITS[u]
+            else:
+                raise ValueError(f"unknown units {u!r} for {name!r}, allowed: {tuple(UNITS)}")
+            raw = -np.asarray(eps, dtype=np.float64) / scale
+            ds = sig.create_dataset(name, data=raw.astype(dtype))
+            ds.attrs["units"] = u
+            if u == "V":
+                ds.attrs["strain_per_volt"] = float(scale)
+        app = fh.create_group("apparatus")
+        for part, attrs in _apparatus_attrs(apparatus).items():
+            g = app.create_group(part)
+            for k, v in attrs.items():
+                g.attrs[k] = v
+        prov = fh.create_group("provenance")
+        prov.attrs["generator"] = "friction-uq"
+        prov.attrs["generator_version"] = __version__
+        for k, v in (provenance or {}).items():
+            prov.attrs[k] = v
+        if truth is not None:
+            tg = fh.create_group("truth")
+            for k, v in truth.items():
+                tg.attrs[k] = v
+    write_bytes(p, buf.getvalue())
     return p

@@ -3,6 +3,7 @@ band, the law comparison and the flag table. Draws what the campaign analysis co
 
 from __future__ import annotations
 
+import io
 import os
 import textwrap
 from pathlib import Path
@@ -10,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .._atomic import atomic_path
+from .._atomic import write_bytes
 from .style import RC, figure
 
 #: What is drawn is friction_uq.campaign.analysis.CampaignAnalysis, read by its attributes: the report sits below the campaign
@@ -179,8 +180,10 @@ def write_campaign_report(ca: CampaignAnalysis, doc: dict[str, Any], path: str |
             pages.append(_forest(ca))
         if ca.law_data is not None and ca.ranking:
             pages += [_law_page(ca), _comparison_page(ca), _flag_page(ca)]
-        with atomic_path(out) as tmp, PdfPages(tmp) as pdf:
+        buf = io.BytesIO()  # in memory, then written at once (a disk that fills mid-file is one OSError)
+        with PdfPages(buf) as pdf:
             for fig in pages:
                 pdf.savefig(fig)
                 plt.close(fig)
+        write_bytes(out, buf.getvalue())
     return out

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import matplotlib
 
-from .._atomic import atomic_path
+from .._atomic import write_bytes
 
 matplotlib.use("Agg")
 
@@ -54,10 +54,12 @@ def figure(title: str, *, nrows: int = 1, ncols: int = 1, **kw):
 
 def save_figure(fig, path: str | os.PathLike[str]) -> Path:
     """Save ``fig`` atomically (format from the suffix, PDF by default) and close it."""
+    import io
+
     out = Path(path)
+    buf = io.BytesIO()  # rendered in memory, then written at once: a disk that fills mid-file is one OSError
     try:
-        with atomic_path(out) as tmp:
-            fig.savefig(tmp, format=out.suffix.lstrip(".") or "pdf")
+        fig.savefig(buf, format=out.suffix.lstrip(".") or "pdf")
     finally:
         plt.close(fig)
-    return out
+    return write_bytes(out, buf.getvalue())

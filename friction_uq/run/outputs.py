@@ -23,18 +23,33 @@ def sha256_hex(data: bytes) -> str:
 
 
 def netcdf_bytes(dt) -> bytes:
-    """The DataTree as netCDF bytes. Written through a private temporary file, not to memory: inside a
-    Dask worker xarray guards a write with a distributed lock named after its target, and an
-    in-memory buffer has no name the scheduler knows."""
-    import tempfile
+    """The DataTree as netCDF bytes, built in memory: nothing is written to TMPDIR (a full one made the HDF5
+    library crash on close, and a run killed meanwhile left its file there). Inside a Dask worker xarray
+    would guard the write with a distributed lock named after its target, which an in-memory buffer does
+    not have: the write runs under dask's synchronous scheduler, so a local lock guards it.
+
+    The bytes depend on the analysis only: the creation times ArviZ stamps on each group are removed
+    (:func:`reproducible`), so the same analysis gives the same bytes and the checksum the JSON names."""
+    import dask
 
     try:
-        with tempfile.TemporaryDirectory(prefix="friction-uq-") as d:
-            path = Path(d) / "run.nc"
-            dt.to_netcdf(path, engine="h5netcdf")
-            return path.read_bytes()
+        with dask.config.set(scheduler="synchronous"):
+            return bytes(reproducible(dt).to_netcdf(engine="h5netcdf"))
     except OSError as exc:
-        raise OutputError(f"{tempfile.gettempdir()}: cannot build the netCDF output there ({os_error_text(exc)})") from None
+        raise OutputError(f"cannot build the netCDF output in memory ({os_error_text(exc)})") from None
+
+
+#: Attributes that say when or how fast a result was made, not what it is: left out of the ``.nc``.
+TIME_ATTRIBUTES = ("created_at", "sampling_seconds")
+
+
+def reproducible(dt):
+    """A copy of ``dt`` without :data:`TIME_ATTRIBUTES` on any group (the JSON keeps the run's times)."""
+    out = dt.copy()
+    for node in out.subtree:
+        for key in TIME_ATTRIBUTES:
+            node.attrs.pop(key, None)
+    return out
 
 
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from .._atomic import output_lock, remove_orphans, write_together
+from .._atomic import check_unlocked, output_lock, remove_orphans, write_together
 from .._parallel import Background
 from ..analysis import Identification, Prepared, identify, prepare
 from ..discrepancy.check import WholeRecordCheck
@@ -39,7 +39,7 @@ from ..diagnostics import (
     ratio_ppc,
     summarize,
 )
-from ..errors import OutputError, check_seed, os_error_text
+from ..errors import OutputError, SamplingError, check_seed, os_error_text
 from ..likelihood import Likelihood, LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import default_prior_path, load_priors
@@ -114,10 +114,11 @@ def run_file(
             print(f"friction-uq: note: {msg}", file=sys.stderr, flush=True)
 
     record = read_record(path)
+    p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
+    priors = load_priors(p_path)  # every input is checked before the signals' work, the busy folder too
+    check_unlocked(Path(out_dir), safe_stem(record.campaign, record.test_id))
     prep = prepare(record, window=window, dispersion=dispersion)
     settings = AnalysisSettings(window=window, dispersion=dispersion, hoop=hoop)
-    p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
-    priors = load_priors(p_path)
     alternatives = alternative_nu_priors(p_path, priors)
     left_out = hoop_unusable(prep) if settings.hoop and prep.data.hoop is not None else None
     use_hoop = bool(settings.hoop and prep.data.hoop is not None and left_out is None)
@@ -164,9 +165,12 @@ def run_file(
         loader = prepare_soon()
 
         t = time.perf_counter()
-        samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
-                                   progress=stderr_progress if progress else None, notify=note,
-                                   likelihood=likelihood)
+        try:
+            samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
+                                       progress=stderr_progress if progress else None, notify=note,
+                                       likelihood=likelihood)
+        except SamplingError as exc:  # the sampler knows the priors, not the record: name it
+            raise SamplingError(f"{record.path}: {exc}") from None
         stages["sampling"] = time.perf_counter() - t
         loader.join()  # no thread left running: later stages fork only where this process has one thread
         t = time.perf_counter()

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
+import threading
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import emcee
@@ -50,6 +53,24 @@ def integrated_time(chain: np.ndarray, *, c: float = 5.0) -> np.ndarray:
     ok = m >= c * taus
     window = np.where(ok.any(axis=0), np.argmax(ok, axis=0), n - 1)
     return taus[window, np.arange(x.shape[2])]
+
+
+@contextlib.contextmanager
+def _interrupt_between_steps() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) while emcee steps and raise KeyboardInterrupt when the block of steps ends: emcee's
+    wrapper of the log-probability prints the walkers' positions and a traceback for any exception raised in
+    it, KeyboardInterrupt included. Only in the main thread (elsewhere signals cannot be handled)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old if old is not None else signal.default_int_handler)
+    if caught:
+        raise KeyboardInterrupt
 
 
 def _memory_backend(ck: checkpoint.Checkpoint, nwalkers: int, ndim: int) -> emcee.backends.Backend:
@@ -182,38 +203,44 @@ def sample_posterior(
     # a resumed run whose stored chain ends on a check point is checked before stepping, so that
     # resuming a finished run gives back the same draws instead of stepping one block further
     check_first = backend.iteration > 0 and backend.iteration % check_every == 0
-    while True:
-        done = backend.iteration
-        target = min(max_steps, (done // check_every + 1) * check_every)
-        if not check_first and target > done:
-            state = sampler.run_mcmc(state, target - done, progress=False, skip_initial_state_check=True)
-            if backend_path is not None and time.perf_counter() - last_save >= checkpoint_seconds:
-                save()
-                last_save = time.perf_counter()
-        check_first = False
-        n = backend.iteration
-        chains = backend.get_chain()  # (n, all walkers, ndim)
-        tau = integrated_time(chains)
-        if prev_tau is None:  # first check (or first after resuming): previous check from the stored chain
-            prev_tau = integrated_time(chains[: n - check_every]) if n >= 2 * check_every else np.full(ndim, np.inf)
-        change = float(np.max(np.abs(prev_tau - tau) / tau))
-        prev_tau = tau
-        tau_max = float(np.max(tau))
-        acc = float(np.mean(backend.accepted) / max(n, 1))
-        if progress is not None:
-            progress(Progress(n, max_steps, tau_max, change, n / tau_max, acc, time.perf_counter() - t_start,
-                              settings.tau_factor, settings.tau_rtol))
-        if n > settings.tau_factor * tau_max and change < settings.tau_rtol:
-            converged = True
-            break
-        if n >= max_steps:
-            warnings.warn(
-                f"sampler stopped at max_steps={max_steps} before convergence: steps/tau = {n / tau_max:.1f} "
-                f"(needs > {settings.tau_factor:g}), tau change {100 * change:.1f} % (needs < "
-                f"{100 * settings.tau_rtol:g} %); raise max_steps or treat the posterior as approximate",
-                ConvergenceWarning, stacklevel=2,
-            )
-            break
+    try:
+        while True:
+            done = backend.iteration
+            target = min(max_steps, (done // check_every + 1) * check_every)
+            if not check_first and target > done:
+                with _interrupt_between_steps():
+                    state = sampler.run_mcmc(state, target - done, progress=False, skip_initial_state_check=True)
+                if backend_path is not None and time.perf_counter() - last_save >= checkpoint_seconds:
+                    save()
+                    last_save = time.perf_counter()
+            check_first = False
+            n = backend.iteration
+            chains = backend.get_chain()  # (n, all walkers, ndim)
+            tau = integrated_time(chains)
+            if prev_tau is None:  # first check (or first after resuming): previous check from the stored chain
+                prev_tau = integrated_time(chains[: n - check_every]) if n >= 2 * check_every else np.full(ndim, np.inf)
+            change = float(np.max(np.abs(prev_tau - tau) / tau))
+            prev_tau = tau
+            tau_max = float(np.max(tau))
+            acc = float(np.mean(backend.accepted) / max(n, 1))
+            if progress is not None:
+                progress(Progress(n, max_steps, tau_max, change, n / tau_max, acc, time.perf_counter() - t_start,
+                                  settings.tau_factor, settings.tau_rtol))
+            if n > settings.tau_factor * tau_max and change < settings.tau_rtol:
+                converged = True
+                break
+            if n >= max_steps:
+                warnings.warn(
+                    f"sampler stopped at max_steps={max_steps} before convergence: steps/tau = {n / tau_max:.1f} "
+                    f"(needs > {settings.tau_factor:g}), tau change {100 * change:.1f} % (needs < "
+                    f"{100 * settings.tau_rtol:g} %); raise max_steps or treat the posterior as approximate",
+                    ConvergenceWarning, stacklevel=2,
+                )
+                break
+    except KeyboardInterrupt:  # Ctrl-C: the steps made so far are kept, the next run resumes from them
+        if backend_path is not None and backend.iteration > 0:
+            save()
+        raise
     if backend_path is not None:
         save()  # a run killed while its outputs are written resumes here without stepping
 

@@ -101,11 +101,10 @@ def start_ball(
     walkers falling outside the prior support are redrawn.
     """
     z0 = log_post.to_z(_initial_guess(log_post.likelihood, priors))
+    source = f"prior file {priors.path}" if priors.path else "the priors"
     if not np.isfinite(log_post(z0)[0]):
-        raise SamplingError(
-            f"the starting point {dict(zip(priors.names, log_post.to_theta(z0)))} has zero prior or likelihood; "
-            "check the priors against the data"
-        )
+        raise SamplingError(f"the starting point {_point(priors.names, log_post.to_theta(z0))} has zero density under "
+                            f"{source} or the likelihood; check the sections {_sections(priors.names)} against the data")
     res = optimize.minimize(lambda z: -float(log_post(z)[0]), z0, method="Nelder-Mead",
                             options={"xatol": 1e-7, "fatol": 1e-7, "maxiter": 4000})
     z_map = res.x if np.isfinite(res.fun) and res.fun <= -float(log_post(z0)[0]) else z0
@@ -126,5 +125,16 @@ def start_ball(
             if not todo.any():
                 break
         else:
-            raise SamplingError("could not place the walkers inside the prior support around the MAP")
+            raise SamplingError(f"could not place the walkers around the most probable point "
+                                f"{_point(priors.names, log_post.to_theta(z_map))} inside the support of {source}: "
+                                f"the data put the parameters at the edge of it; widen {_sections(priors.names)}")
     return z_map, out
+
+
+def _point(names, theta) -> str:
+    """``f = 0.0512, nu = 0.401``: a parameter vector in words (plain numbers, not numpy reprs)."""
+    return ", ".join(f"{n} = {float(v):.4g}" for n, v in zip(names, np.ravel(theta)))
+
+
+def _sections(names) -> str:
+    return ", ".join(f"[{n}]" for n in names)

@@ -88,6 +88,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..physics.tube import BETA_EFF_PAPER_TUBE
+from ..plausible import MAX_SIMULATED_SAMPLES, apparatus_problem
 from ..record import CHANNELS, UNITS, Apparatus, Plug, paper_apparatus
 from ._checks import Section
 from .apparatus import check_consistency, parse_apparatus
@@ -244,6 +245,14 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
     kw["apparatus"] = parse_apparatus(source, data.get("apparatus", {}), default_apparatus())
     kw["model"] = parse_model(source, data.get("model", {}))
     cfg = SimulationConfig(**kw)
+    n_samples = cfg.sample_rate * cfg.duration
+    if n_samples > MAX_SIMULATED_SAMPLES:
+        raise ConfigError(f"{source}: key 'measurement.duration' x 'measurement.sample_rate' = {n_samples:.3g} samples "
+                          f"per channel, more than the {MAX_SIMULATED_SAMPLES} a record may have (docs/limits.md).")
+    implausible = apparatus_problem(cfg.apparatus)
+    if implausible:
+        part, attr, problem = implausible
+        raise ConfigError(f"{source}: key 'apparatus.{part}.{attr}' {problem}.")
     check_consistency(cfg.apparatus, source=cfg.source, rise_time=cfg.rise_time,
                       pretrigger=cfg.pretrigger, duration=cfg.duration)
     if cfg.model.axisymmetric:

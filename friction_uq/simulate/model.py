@@ -29,7 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ConfigError
 from ..physics.tube import bore_compliance_factor
+from ..plausible import MAX_SIMULATION_STEPS
 from . import bars, cell
 from .config import SimulationConfig
 from .friction import LAWS
@@ -116,10 +118,15 @@ def run_model(config: SimulationConfig, *, loading: Loading | None = None) -> Mo
     dt_crit = cell.critical_time_step(element_length=h, wave_speed=c_max, damping=config.damping)
     n_sub = max(1, math.ceil(dt_out / (config.cfl * dt_crit)), config.min_substeps)
     if n_sub > MAX_SUBSTEPS:
-        raise ValueError(f"the sample's wave speed {c_max:.0f} m/s needs {n_sub} time steps per sample (at most "
-                         f"{MAX_SUBSTEPS}): check its modulus, density and Poisson ratio")
+        raise ConfigError(f"{config.source}: the sample's wave speed {c_max:.0f} m/s with numerics.cfl = {config.cfl:g} "
+                          f"needs {n_sub} time steps per sample (at most {MAX_SUBSTEPS}): check cfl, and the sample's "
+                          "modulus, density and Poisson ratio")
     dt = dt_out / n_sub
     n = n_out * n_sub
+    if n > MAX_SIMULATION_STEPS:  # checked before any array is made (docs/limits.md)
+        raise ConfigError(f"{config.source}: {n_out} samples x {n_sub} time steps per sample = {n} time steps, more "
+                          f"than the {MAX_SIMULATION_STEPS} a simulation may take: lower measurement.sample_rate or "
+                          "measurement.duration, or raise numerics.cfl")
     m_plug = plug.density * math.pi * a * a * plug.length
     mass = np.full(n_el + 1, sample.density * area * h)
     mass[0] = 0.5 * mass[0] + m_plug
