@@ -335,7 +335,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
         ca.best, ca.chosen = supported[0], ca.law_models[supported[0]]
     else:
         say("the expected information of one more test at each set-up and speed")
-        ca.next_tests = rank_next_tests({law: ca.fits[m] for law, m in ca.law_models.items()}, ca.weights, seed=seed)
+        ca.next_tests = rank_next_tests({law: ca.fits[m] for law, m in ca.law_models.items()}, ca.weights)
         tip = advice(ca.next_tests, ca.weights)
         if tip:
             ca.sentences.append(tip)

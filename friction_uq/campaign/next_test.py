@@ -10,8 +10,9 @@ outcome y (Lindley 1956; for telling models apart, Box and Hill 1967):
 with w_k the laws' stacking weights (renormalised over the laws still in play) and p_k the law's
 posterior predictive of the new test's value: the law's draws at (V, p) for that set-up (with its
 calibration offset), widened by the law's test-to-test scatter and by a test's own uncertainty (the
-median of the campaign's), each taken as normal. H of the mixture is a Monte Carlo average of
--log density (seeded). I is in nats, at most the entropy of the weights (log 2 for two laws equally
+median of the campaign's), each taken as normal. H of the mixture is integrated on a grid (the
+outcome is one number: a quadrature is exact to the grid's resolution and has no Monte Carlo noise
+to rank candidates by). I is in nats, at most the entropy of the weights (log 2 for two laws equally
 weighted): a test where the laws predict the same value brings nothing, one where their predictions
 do not overlap settles the question.
 """
@@ -49,19 +50,19 @@ def _predictive(fit: Fit, setup: str, V: float, p: float, test_sd: float) -> tup
     return float(np.mean(y)), var
 
 
-def information(means: np.ndarray, variances: np.ndarray, weights: np.ndarray, rng: np.random.Generator,
-                n: int = 4000) -> float:
-    """I(K; y) for a mixture of normals (module docstring), by Monte Carlo over the mixture."""
+def information(means: np.ndarray, variances: np.ndarray, weights: np.ndarray, *, points: int = 4001) -> float:
+    """I(K; y) for a mixture of normals (module docstring), the mixture's entropy by the trapezoid rule."""
     w = weights / weights.sum()
-    k = rng.choice(len(w), size=n, p=w)
-    y = rng.normal(means[k], np.sqrt(variances[k]))
+    sd = np.sqrt(variances)
+    y = np.linspace(float(np.min(means - 10 * sd)), float(np.max(means + 10 * sd)), points)
     log_comp = -0.5 * (y[:, None] - means[None, :]) ** 2 / variances[None, :] - 0.5 * np.log(2 * np.pi * variances)
-    h_mix = -float(np.mean(logsumexp(log_comp + np.log(w)[None, :], axis=1)))
+    log_mix = logsumexp(log_comp + np.log(w)[None, :], axis=1)
+    h_mix = -float(np.trapezoid(np.exp(log_mix) * log_mix, y))
     h_each = float(np.sum(w * 0.5 * np.log(2 * np.pi * np.e * variances)))
     return max(0.0, h_mix - h_each)
 
 
-def rank_next_tests(fits: dict[str, Fit], weights: dict[str, float], *, seed: int) -> list[Candidate]:
+def rank_next_tests(fits: dict[str, Fit], weights: dict[str, float]) -> list[Candidate]:
     """Every candidate test, the most informative first; empty when fewer than two laws are in play."""
     play = [k for k, w in weights.items() if w >= IN_PLAY and k in fits]
     if len(play) < 2:
@@ -69,7 +70,6 @@ def rank_next_tests(fits: dict[str, Fit], weights: dict[str, float], *, seed: in
     w = np.array([weights[k] for k in play])
     data = fits[play[0]].data
     test_sd = float(np.median(data.kappa_sd)) / fits[play[0]].kbar
-    rng = np.random.default_rng(seed)
     out = []
     for setup in sorted(set(data.setups)):
         on = np.array([s == setup for s in data.setups])
@@ -78,7 +78,7 @@ def rank_next_tests(fits: dict[str, Fit], weights: dict[str, float], *, seed: in
             p = float(np.polyval(coef, V))
             pred = [_predictive(fits[k], setup, float(V), p, test_sd) for k in play]
             m, v = np.array([a for a, _ in pred]), np.array([b for _, b in pred])
-            out.append(Candidate(setup, float(V), p, information(m, v, w, rng)))
+            out.append(Candidate(setup, float(V), p, information(m, v, w)))
     return sorted(out, key=lambda c: -c.information)
 
 
