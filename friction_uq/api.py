@@ -12,11 +12,8 @@ until a function is called.
 
 from __future__ import annotations
 
-import inspect
 import json
 import os
-import sys
-import types
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -183,22 +180,3 @@ def import_scope_files(files: Sequence[str | os.PathLike[str]], setup: str | os.
     from .acquisition import import_scope_files as _import
 
     return _import(files, setup, output, check=check)
-
-
-def make_callable(module_name: str, func_name: str) -> None:
-    """Make the subpackage ``module_name`` callable as the function ``func_name`` of this module.
-
-    ``friction_uq.run`` and ``friction_uq.campaign`` are both a function of the interface and a
-    subpackage; once the subpackage is imported, Python binds its name on the package to the
-    module. Calling that module then calls the function, so ``friction_uq.run(path)`` works
-    whichever was loaded first.
-    """
-    func = globals()[func_name]
-    mod = sys.modules[module_name]
-
-    class CallableModule(types.ModuleType):
-        def __call__(self, *args: Any, **kwargs: Any) -> Any:
-            return func(*args, **kwargs)
-
-    mod.__class__ = CallableModule
-    mod.__signature__ = inspect.signature(func)  # type: ignore[attr-defined]

@@ -128,6 +128,6 @@ __all__ = [
 ]
 
 
-from ..api import make_callable  # noqa: E402
+from .._callable import make_callable  # noqa: E402
 
 make_callable(__name__, "campaign")  # friction_uq.campaign(...) is the interface's function even once this package is loaded

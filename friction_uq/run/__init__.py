@@ -10,6 +10,6 @@ __all__ = ["JSON_VARIABLES", "RunResult", "alternative_nu_priors", "hoop_unusabl
            "safe_stem", "sliding_velocity_summary", "summary_table"]
 
 
-from ..api import make_callable  # noqa: E402
+from .._callable import make_callable  # noqa: E402
 
 make_callable(__name__, "run")  # friction_uq.run(...) is the interface's function even once this package is loaded
