@@ -27,7 +27,7 @@ from friction_uq import _atomic, plausible
 from friction_uq.campaign import job, runner
 from friction_uq.cli import main
 from friction_uq.errors import PriorError, RecordError
-from friction_uq.priors import check_material_name, default_prior_path, load_priors
+from friction_uq.priors import PRIORS_DIR, check_material_name, default_prior_path, load_priors
 from friction_uq.record import read_record
 
 REPO = Path(__file__).resolve().parents[1]
@@ -307,7 +307,7 @@ def test_shipped_configs_and_priors_pass_the_shape_check():
 
 
 def test_a_material_is_a_name_never_a_path(record_copy, tmp_path, capsys):
-    (tmp_path / "evil.toml").write_text((REPO / "friction_uq" / "prior_files" / "I1.toml").read_text())
+    (tmp_path / "evil.toml").write_text((PRIORS_DIR / "I1.toml").read_text())
     for bad in (str(tmp_path / "evil"), "../evil", "I1.toml", "I 1", ""):
         with pytest.raises(PriorError, match="is not a material name"):
             default_prior_path(bad)
@@ -389,7 +389,7 @@ def test_simulation_refusals(tmp_path, capsys):
 
 
 def test_an_absurd_prior_scale_is_refused(tmp_path):
-    text = (REPO / "friction_uq" / "prior_files" / "I1.toml").read_text().replace("scale = 0.3", "scale = 1e300")
+    text = (PRIORS_DIR / "I1.toml").read_text().replace("scale = 0.3", "scale = 1e300")
     (tmp_path / "p.toml").write_text(text)
     with pytest.raises(PriorError, match=r"p.toml: \[f\]: .* puts .* of its mass on \[0, 2\]"):
         load_priors(tmp_path / "p.toml")
