@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..record.writer import write_apparatus
 from .._atomic import atomic_path
 from ..errors import RecordError, ScopeFileError, SetupError
 from ..record.contract import FORMAT, FORMAT_VERSION
@@ -174,11 +175,7 @@ def _write(tmp: str, setup: Setup, chans: list[Channel], t0: float, dt: float) -
             ds.attrs["sign_applied"] = s.sign
             for k, v in s.conversion.items():
                 ds.attrs[k] = v
-        app = fh.create_group("apparatus")
-        for part, attrs in setup.apparatus.items():
-            g = app.create_group(part)
-            for k, v in attrs.items():
-                g.attrs[k] = v
+        write_apparatus(fh, setup.apparatus)
         prov = fh.create_group("provenance")
         prov.attrs["generator"] = "friction-uq import"
         prov.attrs["generator_version"] = __version__

@@ -108,11 +108,7 @@ def write_record(
             ds.attrs["units"] = u
             if u == "V":
                 ds.attrs["strain_per_volt"] = float(scale)
-        app = fh.create_group("apparatus")
-        for part, attrs in _apparatus_attrs(apparatus).items():
-            g = app.create_group(part)
-            for k, v in attrs.items():
-                g.attrs[k] = v
+        write_apparatus(fh, _apparatus_attrs(apparatus))
         prov = fh.create_group("provenance")
         prov.attrs["generator"] = "friction-uq"
         prov.attrs["generator_version"] = __version__
@@ -124,3 +120,12 @@ def write_record(
                 tg.attrs[k] = v
     write_bytes(p, buf.getvalue())
     return p
+
+
+def write_apparatus(fh, parts) -> None:
+    """The record's ``/apparatus`` group: one subgroup per part, its SI attributes (docs/record-format.md)."""
+    app = fh.create_group("apparatus")
+    for part, attrs in parts.items():
+        g = app.create_group(part)
+        for k, v in attrs.items():
+            g.attrs[k] = v
