@@ -154,6 +154,7 @@ def test_a_hoop_gauge_calibration_error_is_said_not_named(tmp_path):
     assert f"the tube hoop gauge reads {dg.final.hoop_gain:.2f} times the model" in doc["sentence"]
 
 
+@pytest.mark.slow  # a whole diagnose with exact posteriors, 50-110 s
 def test_plug_friction_is_named_and_f_recovered(tmp_path):
     prep, dg = _diagnose(tmp_path, noisy_config(striker_velocity=11.0, plug_friction_force=300.0,
                                            plug_friction_coefficient=0.015,
@@ -203,6 +204,7 @@ def test_a_hoop_calibration_finding_needs_the_baseline_and_the_final_model_to_ag
     assert outcome.hoop_gain_off(dg) is found
 
 
+@pytest.mark.slow  # a whole diagnose with exact posteriors, 50-110 s
 def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
     """Friction on bare end faces (no PTFE sheet) lowers the wall pressure near the faces: the baseline then
     reads the record only with a hoop factor and a sample modulus far from their calibrations, which the
@@ -234,6 +236,7 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
         assert ll.attrs["elpd"] == pytest.approx(float(ll["block_elpd"].sum() + ll["calibration_elpd"].sum()))
 
 
+@pytest.mark.slow  # a whole diagnose with exact posteriors, 50-110 s
 def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(tmp_path):
     """data/B/B-02 hides dispersion, a clearance, velocity weakening, plug friction and a hoop gauge 5 % low
     (data/README.md); the installed command's diagnose names the four mechanisms, says the hoop's factor,
