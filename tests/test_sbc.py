@@ -199,13 +199,18 @@ def test_sbc_coverage_gate():
 FULL_STUDY_LEVEL = 1.0 - 0.05 / 8
 
 
+#: Kappa with the hoop term on whole closed-form records over-covers a little: 0.960 (band [0.840, 0.955])
+#: with the hoop level's 3 % model discrepancy in the likelihood, 0.955 without it (same seeds). The
+#: records carry no such discrepancy (their hoop gauge is the closed form times a gain), so the likelihood
+#: is wider than the records' own model there by design; the rest (0.005) is open.
+_HOOP_RECORDS = pytest.param(True, "records", marks=pytest.mark.xfail(
+    reason="kappa 0.960 against 0.955: the hoop level's model discrepancy is in the likelihood, not in the "
+           "closed-form records", strict=False))
+
+
 @pytest.mark.slow
-@pytest.mark.xfail(reason="known defect, issue 22: since the stationary ratio is read from the window's levels "
-                   "(batch means, Student-t), kappa's 90 % interval over-covers on records that are the model plus "
-                   "its noise (0.975 measured, band [0.84, 0.955]); the study stays and reports it until the "
-                   "level term's standard error is calibrated", strict=False)
-@pytest.mark.parametrize("source", ["closed-form", "records"])
-@pytest.mark.parametrize("hoop", [False, True])
+@pytest.mark.parametrize("hoop, source", [(False, "closed-form"), (True, "closed-form"), (False, "records"),
+                                          _HOOP_RECORDS])
 def test_sbc_coverage_full(hoop, source):
     """200 replicas: coverage of kappa and f inside the binomial band (family-wise 95 %) around 90 %."""
     n = 200
