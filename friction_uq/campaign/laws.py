@@ -48,8 +48,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import logsumexp
-from scipy.stats import t as student_t
 
+from ..stats import RULE, paired_difference
 from .kernels import draw_kernels, log_kernel_mixture
 
 LAWS = ("constant", "velocity", "pressure", "pressure+velocity")
@@ -299,7 +299,7 @@ def loo(fit: Fit, *, seed: int) -> Elpd:
         elpd_i[i] = float(logsumexp(lli) - np.log(lli.size))
         refits += 1
     n = elpd_i.size
-    return Elpd(fit.model.name, float(elpd_i.sum()), float(np.sqrt(n * np.var(elpd_i))), elpd_i, k, refits)
+    return Elpd(fit.model.name, float(elpd_i.sum()), float(np.sqrt(n * np.var(elpd_i, ddof=1))), elpd_i, k, refits)
 
 
 def _one(d: LawData, i: int) -> LawData:
@@ -307,18 +307,14 @@ def _one(d: LawData, i: int) -> LawData:
 
 
 def decisive(d_elpd: float, se: float, n: int | None = None) -> bool:
-    """A difference in ELPD counts only when it is large (> 4) and large against its standard error: beyond
-    the 97.5 % quantile of Student's t with n - 1 degrees of freedom times the SE, n the tests it sums
-    over (the SE is itself estimated from n paired differences: with a campaign of ten tests, 2.26 SE
-    rather than the normal 2; None: 2 SE)."""
-    factor = 2.0 if n is None or n < 2 else float(student_t.ppf(0.975, n - 1))
-    return d_elpd > 4.0 and d_elpd > factor * se
+    """The package's rule (:data:`friction_uq.stats.RULE`) over ``n`` tests: dELPD > 4 and beyond t(0.975, n - 1)
+    standard errors (2 when ``n`` is None)."""
+    return RULE.decisive(d_elpd, se, n=n)
 
 
 def difference(a: Elpd, b: Elpd) -> tuple[float, float]:
-    """ELPD(a) - ELPD(b) and its standard error (paired over tests)."""
-    diff = a.pointwise - b.pointwise
-    return float(diff.sum()), float(np.sqrt(diff.size * np.var(diff)))
+    """ELPD(a) - ELPD(b) and its standard error, paired over tests (:func:`friction_uq.stats.paired_difference`)."""
+    return paired_difference(a.pointwise, b.pointwise)
 
 
 def rank(elpds: Sequence[Elpd]) -> list[dict[str, float | str]]:

@@ -29,13 +29,14 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 
 from ..analysis import Prepared
+from ..stats import RULE
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .misfit import MisfitDecision, decide
 from .whole_record import WholeRecord, compare_whole_record
 
-#: Decisive evidence: dELPD above DECISIVE_ELPD and above DECISIVE_SE standard errors or STRONG_ELPD.
-DECISIVE_ELPD, DECISIVE_SE, STRONG_ELPD = 4.0, 2.0, 40.0
+#: After a misfit, the shared rule's strong route (:class:`friction_uq.stats.DecisionRule`) opens above this dELPD.
+STRONG_ELPD = 40.0
 MAX_CAUSES = 4
 #: Processes fitting one round's extended models by default.
 MAX_WORKERS = 4
@@ -70,8 +71,9 @@ class Ranked:
 
 
 def beyond(d: float, se: float, strong: float | None) -> bool:
-    """dELPD d (with SE se) is decisive evidence (module docstring); ``strong`` None: no strong route."""
-    return d > DECISIVE_ELPD and (d > DECISIVE_SE * se or (strong is not None and d > strong and d > se))
+    """dELPD d (with SE se) is decisive evidence under the package's rule (:data:`friction_uq.stats.RULE`);
+    ``strong`` None: no strong route."""
+    return RULE.decisive(d, se, strong=strong)
 
 
 @dataclass(frozen=True)

@@ -54,6 +54,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..stats.decision import paired_difference
+
 _LOG_2PI = math.log(2.0 * math.pi)
 
 
@@ -198,8 +200,8 @@ def with_calibration(e: Elpd, terms: dict[str, tuple[float, float, float]]) -> E
 def elpd_difference(a: Elpd, b: Elpd) -> tuple[float, float]:
     """elpd(a) - elpd(b) and its standard error (same pointwise layout; module docstring). Calibration data
     count when both models have the same ones."""
-    d = a.pointwise - b.pointwise
-    total, var = float(np.sum(d)), len(d) * float(np.var(d, ddof=1))
+    total, se = paired_difference(a.pointwise, b.pointwise)
+    var = se * se
     if len(a.calibration) and a.calibration_names == b.calibration_names:
         total += float(np.sum(a.calibration - b.calibration))
         spread = 0.5 * (a.calibration_var + b.calibration_var)

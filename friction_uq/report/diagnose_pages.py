@@ -14,7 +14,8 @@ import textwrap
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..discrepancy.diagnose import DECISIVE_ELPD, Diagnosis
+from ..discrepancy.diagnose import Diagnosis
+from ..stats import RULE
 from ..discrepancy.outcome import kappa_draws
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from .style import figure
@@ -46,7 +47,7 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
     hi = np.sign(d + 2 * se) * np.log10(1.0 + np.abs(d + 2 * se))
     ax.barh(y, shown, color=["tab:red" if r.decisive else "0.6" for r in rows])
     ax.errorbar(shown, y, xerr=[shown - lo, hi - shown], fmt="none", ecolor="k", lw=0.8)
-    ax.axvline(np.log10(1.0 + DECISIVE_ELPD), color="tab:blue", ls="--", lw=0.8)
+    ax.axvline(np.log10(1.0 + RULE.min_delpd), color="tab:blue", ls="--", lw=0.8)
     ax.axvline(0.0, color="k", lw=0.6)
     for s in seps[:-1]:
         ax.axhline(len(rows) - s - 0.5, color="0.3", lw=0.6)

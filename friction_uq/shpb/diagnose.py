@@ -3,8 +3,8 @@
 Rule. Start from the nominal model (:mod:`.balance`). At each step fit the current model extended
 by each mechanism of :data:`~.mechanisms.MECHANISMS` not yet in it (:func:`~.fit.fit_balance`) and
 compare each with the current model by block-LOO ELPD. The best one is added, and named a cause,
-only when the evidence is decisive: dELPD > ``DECISIVE_DELPD`` and > ``DECISIVE_SE`` standard
-errors. Another candidate that is also decisive against the current model but not decisively
+only when the evidence is decisive under the package's rule (:data:`friction_uq.stats.RULE`: dELPD > 4
+and > 2 standard errors). Another candidate that is also decisive against the current model but not decisively
 worse than the best (its dELPD to the best within the same rule) is recorded as not separable
 from it by this record. Selection stops at the first step where no candidate is decisive.
 
@@ -22,23 +22,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..discrepancy.elpd import elpd_difference
+from ..stats import RULE
 from .balance import BalanceObservation
 from .fit import BLOCK, N_DRAWS, BalanceFit, fit_balance
 from .mechanisms import MECHANISMS, combine
 
-#: A mechanism is named when its dELPD exceeds this ...
-DECISIVE_DELPD = 4.0
-#: ... and this many of its standard errors.
-DECISIVE_SE = 2.0
-
-
 def decisive(delpd: float, se: float) -> bool:
-    """The rule: dELPD > 4 and > 2 SE.
+    """The package's rule (:data:`friction_uq.stats.RULE`): dELPD > 4 and > 2 SE.
 
     >>> decisive(10.0, 3.0), decisive(10.0, 6.0), decisive(3.0, 0.5)
     (True, False, False)
     """
-    return delpd > DECISIVE_DELPD and delpd > DECISIVE_SE * se
+    return RULE.decisive(delpd, se)
 
 
 @dataclass(frozen=True)
