@@ -152,6 +152,8 @@ def analyse_one(group: str, k: int, rng: np.random.Generator, tmp: str, seed: in
     return row | {"truth": truth, "q05": f.q05, "q50": f.q50, "q95": f.q95, "sd": f.sd,
                   "kappa_covered": bool(k.q05 <= kappa_truth <= k.q95), "kappa_z": (k.q50 - kappa_truth) / k.sd,
                   "misfit": bool(res.whole_record is not None and res.whole_record.decision.detected),
+                  "flagged": [] if res.whole_record is None else
+                  [f"{c.channel}/{c.phase} {c.statistic:.1f}" for c in res.whole_record.decision.flagged()],
                   "warnings": list(res.warnings)}
 
 
@@ -183,7 +185,8 @@ def _row_line(row: dict) -> str:
                                       else "by hand too: " + why.split("; by hand: ")[1])
     flag = "SILENT MISS" if silent_miss(row) else ""
     return (head + f" truth {row['truth']:.4f} f {row['q50']:.4f} [{row['q05']:.4f}, {row['q95']:.4f}] "
-            f"z {(row['q50'] - row['truth']) / row['sd']:+.1f} warnings {len(row['warnings'])} {flag}")
+            f"z {(row['q50'] - row['truth']) / row['sd']:+.1f} kappa z {row['kappa_z']:+.1f} warnings "
+            f"{len(row['warnings'])} {flag} {', '.join(row['flagged'])}")
 
 
 def table(rows: list[dict]) -> str:
