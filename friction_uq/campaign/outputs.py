@@ -98,7 +98,8 @@ def statements(ca: CampaignAnalysis) -> list[str]:
         else:
             out.append(f"flagged: test {f['test']} lies {f['below_median_by']:.1f} below the others' leave-one-out "
                        "log density under the chosen law")
-    for p in [*ca.pooled.values(), *ca.pooled_stationary.values()]:  # after the law: what the tests share
+    # after the law: what the tests share; the stationary f's pooling just after the diagnosed f's
+    for p in [q for name, p in ca.pooled.items() for q in (p, ca.pooled_stationary.get(name)) if q is not None]:
         if p.refused:
             out.append(p.refused + ("" if p.basis == "stationary" else f" ({POOLED_BASIS[p.basis]})"))
         else:
