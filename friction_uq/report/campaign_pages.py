@@ -59,9 +59,8 @@ def _forest(ca: CampaignAnalysis):
     pooled mean beside it in grey, each labelled."""
     pf = ca.pooled.get("f")
     diagnosed = pf is not None and pf.basis == "diagnosed"
-    what = ("f under each test's diagnosed model, kappa of the stationary analysis" if diagnosed
-            else "the stationary analysis")
-    fig, axes = figure(f"Per-test posteriors (90 % intervals) and the pooled population: {what}", nrows=1, ncols=2)
+    what = "f under the diagnosed models" if diagnosed else "the stationary analysis"
+    fig, axes = figure(f"Per-test 90 % intervals and the pooled population: {what}", nrows=1, ncols=2)
     colors = {s: f"C{k}" for k, s in enumerate(sorted({t.setup for t in ca.tests}))}
     for ax, name in zip(axes, ("f", "kappa")):
         y = np.arange(len(ca.tests))[::-1]
@@ -89,7 +88,7 @@ def _forest(ca: CampaignAnalysis):
                        label=f"population mean, stationary analysis ({ps.mu['q50']:.4g})")
         ax.set_yticks(y, [t.label for t in ca.tests])
         ax.set_xlabel("f under the diagnosed model" if use_model else name)
-        ax.legend(loc="lower right", fontsize=8)
+        ax.legend(loc="best", fontsize=8)
     return fig
 
 
