@@ -53,7 +53,8 @@ def test_a_diagnosed_campaign_pools_the_diagnosed_f_and_labels_both(tmp_path):
     doc = _doc(ca)
     assert doc["schema_version"] == SCHEMA_VERSION == 3
     pf, ps = doc["pooled"]["f"], doc["pooled_stationary"]["f"]
-    assert pf["basis"] == "diagnosed" and ps["basis"] == "stationary" and doc["pooled"]["kappa"]["basis"] == "stationary"
+    assert pf["basis"] == "diagnosed" and ps["basis"] == "stationary"
+    assert doc["pooled"]["kappa"]["basis"] == "stationary"
     # the diagnosed f with its stored prior divided out: the same as pooling those draws directly
     direct = pool([StoredDraws(t.label, t.setup, t.f_model, MODEL_PRIOR.logpdf(t.f_model)) for t in tests], "f")
     assert pf["mu"]["q50"] == pytest.approx(direct.mu["q50"], abs=1e-6)

@@ -1,11 +1,12 @@
 """From the per-record results of a campaign to its pooled values, friction law and flags.
 
-Reads each analysed record's stored draws (the ``.nc`` beside its result), pools f and kappa
-(:mod:`.pooling`: f under each test's diagnosed model when every test was diagnosed, its prior on
-f_effective divided out, with the stationary f's pooling kept beside it; else the stationary f), fits the candidate friction laws with and without a set-up offset
-(:mod:`.laws`: to kappa, or, when every test was diagnosed, to f under each test's diagnosed
-model), chooses the best-supported law by leave-one-test-out ELPD, gives its parameters in f
-(from kappa with the campaign's nu), and flags set-ups and tests (:mod:`.flags`).
+Reads each analysed record's stored draws (the ``.nc`` beside its result, :mod:`.draws`), pools f
+and kappa (:mod:`.pooling`: f under each test's diagnosed model when every test was diagnosed, its
+prior on f_effective divided out, with the stationary f's pooling kept beside it; else the
+stationary f), fits the candidate friction laws with and without a set-up offset (:mod:`.laws`:
+to kappa, or, when every test was diagnosed, to f under each test's diagnosed model), chooses the
+best-supported law by leave-one-test-out ELPD, gives its parameters in f (from kappa with the
+campaign's nu), and flags set-ups and tests (:mod:`.flags`).
 """
 
 from __future__ import annotations
