@@ -8,14 +8,15 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from scipy import stats
 
 from friction_uq.discrepancy import outcome
 from friction_uq.discrepancy.effective_prior import EXACT_NOTE, PUSHED_NOTE, log_prior_f_effective
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS, Context
+from friction_uq.priors import PRIORS_DIR, load_priors
 
-F_PRIOR = stats.halfnorm(scale=0.3)  # the bundled prior files' f prior
+F_PRIOR = load_priors(PRIORS_DIR / "I1.toml")["f"]  # half-normal(0.3), as the run passes it
+F_SCIPY = F_PRIOR.frozen()  # the same law, for the quadratures
 CTX = Context(V=9.0, tau_mean=0.05 * 9e7, slip=2e-3)
 
 
@@ -37,7 +38,7 @@ def test_pressure_friction_prior_matches_quadrature_over_p0():
     lp, note = log_prior_f_effective(_variants("pressure_friction"), CTX, F_PRIOR, y, rng=np.random.default_rng(1))
     assert note == PUSHED_NOTE
     p0 = MECHANISMS["pressure_friction"].priors["p0"].ppf((np.arange(200_000) + 0.5) / 200_000)
-    exact = np.array([np.mean(F_PRIOR.pdf(v + CTX.tau_mean / p0)) for v in y])
+    exact = np.array([np.mean(F_SCIPY.pdf(v + CTX.tau_mean / p0)) for v in y])
     np.testing.assert_allclose(np.exp(lp), exact, rtol=1e-3)
     assert np.max(np.abs(lp - F_PRIOR.logpdf(y))) > 0.05  # not the f prior: dividing that out would be wrong
 
@@ -53,8 +54,8 @@ def test_velocity_friction_prior_matches_quadrature():
     e = np.exp(-CTX.V / mech.priors["v_c"].ppf((np.arange(1000) + 0.5) / 1000))[:, None]
     x = np.linspace(0.0, 2.0, 2001)  # the other coefficient, integrated out
     fs = mech.priors["f_s"]
-    exact = np.array([np.trapezoid(np.where(e < 0.5, fs.pdf(x) * F_PRIOR.pdf((v - e * x) / (1 - e)) / (1 - e),
-                                            F_PRIOR.pdf(x) * fs.pdf((v - (1 - e) * x) / e) / e), x, axis=1).mean()
+    exact = np.array([np.trapezoid(np.where(e < 0.5, fs.pdf(x) * F_SCIPY.pdf((v - e * x) / (1 - e)) / (1 - e),
+                                            F_SCIPY.pdf(x) * fs.pdf((v - (1 - e) * x) / e) / e), x, axis=1).mean()
                       for v in y])
     np.testing.assert_allclose(np.exp(lp), exact, rtol=0.01)
     # it falls where the f prior is highest: a sum of two half-normals has no density at 0

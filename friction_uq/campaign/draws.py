@@ -71,7 +71,6 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
                            r.summary["V"], str(r.prior_file), f_model, f_log_prior)
 
 
-
 def pool_tests(tests: Sequence[RecordPosterior]) -> tuple[dict[str, Pooled], dict[str, Pooled], list[str]]:
     """The campaign's pooled f and kappa, the stationary f's pooling when the pooled f is another, and a
     sentence when some tests were diagnosed but the diagnosed f could not be pooled.
