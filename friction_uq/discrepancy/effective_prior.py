@@ -61,7 +61,8 @@ def _theta(variants: Sequence[Any], rng: np.random.Generator) -> dict[str, np.nd
 def log_prior_f_effective(variants: Sequence[Any], context: Context, f_prior: Any, y: np.ndarray, *,
                           rng: np.random.Generator) -> tuple[np.ndarray, str]:
     """log pi(y) of f_effective under a model (its ``variants``: extended.Variant) at the draws ``y``, and what
-    that prior is in words (module docstring). ``f_prior``: the prior file's f prior (a frozen scipy law)."""
+    that prior is in words (module docstring). ``f_prior``: the prior file's f prior
+    (:class:`~friction_uq.priors.ParameterPrior`: its logpdf, cdf and ppf are used)."""
     y = np.asarray(y, float)
     lo, hi = (float(x) for x in f_prior.ppf([1e-9, 1.0 - 1e-9]))
     grid = np.linspace(lo, hi, GRID)
