@@ -185,6 +185,10 @@ class ParameterPrior:
         """Quantile function (inverse CDF) at probabilities ``q``."""
         return np.asarray(self.frozen().ppf(q), float)
 
+    def cdf(self, x: np.ndarray) -> np.ndarray:
+        """Cumulative distribution function at ``x``."""
+        return np.asarray(self.frozen().cdf(x), float)
+
     def describe(self) -> str:
         """One line, e.g. ``nu ~ truncnormal(mean=0.4, sd=0.03, lower=0, upper=0.5)``."""
         args = ", ".join(f"{k}={v:g}" for k, v in self.params.items())

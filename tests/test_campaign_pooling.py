@@ -63,3 +63,31 @@ def test_implied_prior_of_kappa_matches_monte_carlo():
     centres = np.linspace(edges[:-1], edges[1:], 41)
     quad = np.exp(implied_kappa_log_prior(centres, priors)).mean(axis=0)
     np.testing.assert_allclose(quad, mc, rtol=0.04)
+
+
+def test_pooling_draws_made_under_a_stored_prior_divides_it_out():
+    """f under a diagnosed model drawn under a normal prior N(m0, s0) (its log density stored beside the draws):
+    each test's posterior is then normal with the prior's pull; dividing the stored prior out gives back
+    L(mu, sigma) = prod_i N(x_i; mu, sqrt(sigma^2 + s^2)) of the tests' own measurements x_i. Ignoring the prior
+    pools the pulled posteriors and misses the population mean."""
+    rng = np.random.default_rng(3)
+    x = rng.normal(0.05, 0.004, 12)  # what each test measures, to s
+    s, m0, s0 = 0.003, 0.03, 0.01
+    post_sd = 1.0 / np.sqrt(1 / s**2 + 1 / s0**2)
+    post_mean = (x / s**2 + m0 / s0**2) * post_sd**2
+    z = stats.norm.ppf((np.arange(1000) + 0.5) / 1000)
+    draws = [m + post_sd * z for m in post_mean]
+    stored = [StoredDraws(f"T{i}", "A", d, stats.norm.logpdf(d, m0, s0)) for i, d in enumerate(draws)]
+    p = pool(stored, "f", basis="diagnosed")
+    assert p.refused is None and p.basis == "diagnosed" and p.to_json()["basis"] == "diagnosed"
+    mu, sg = np.meshgrid(p.grid_mu, p.grid_sigma)
+    exact = sum(stats.norm.logpdf(m, mu, np.sqrt(sg**2 + s**2)) for m in x)
+    post = np.exp(exact - exact.max())
+    post /= post.sum()
+    assert p.mu["mean"] == pytest.approx(np.sum(post.sum(axis=0) * p.grid_mu), abs=2e-5)
+    assert p.sigma["mean"] == pytest.approx(np.sum(post.sum(axis=1) * p.grid_sigma), rel=0.03)
+    assert p.mu["q05"] < 0.05 < p.mu["q95"]
+    ignored = pool([StoredDraws(t.label, t.setup, t.draws, np.zeros(t.draws.size)) for t in stored], "f")
+    # off by the prior's pull on each test, (m0 - x_i) post_sd^2 / s0^2: about -0.0016, beside a population 0.004 wide
+    pull = np.mean(post_mean - x)
+    assert pull < -0.0015 and ignored.mu["mean"] - p.mu["mean"] == pytest.approx(pull, rel=0.1)

@@ -228,12 +228,16 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
     import xarray as xr
 
     dt = xr.DataTree()
-    outcome.add_to_datatree(dt, dg)
+    outcome.add_to_datatree(dt, dg, load_priors(default_prior_path("I1"))["f"])
     dt.to_netcdf(tmp_path / "d.nc")
     with xr.open_datatree(tmp_path / "d.nc") as back:
         ll = back["discrepancy_end_friction/log_likelihood"]
         assert list(ll["calibration"].values) == ["hoop_gain", "sample_modulus"]
         assert ll.attrs["elpd"] == pytest.approx(float(ll["block_elpd"].sum() + ll["calibration_elpd"].sum()))
+        # end friction leaves f as it is: the prior of f_effective is the prior file's f prior, beside the draws
+        post = back["discrepancy_end_friction/posterior"]
+        np.testing.assert_allclose(post["log_prior_f_effective"].values,
+                                   load_priors(default_prior_path("I1"))["f"].logpdf(post["f_effective"].values))
 
 
 @pytest.mark.slow  # a whole diagnose with exact posteriors, 50-110 s

@@ -1,10 +1,12 @@
 """From the per-record results of a campaign to its pooled values, friction law and flags.
 
-Reads each analysed record's stored draws (the ``.nc`` beside its result), pools f and kappa
-(:mod:`.pooling`), fits the candidate friction laws with and without a set-up offset
-(:mod:`.laws`: to kappa, or, when every test was diagnosed, to f under each test's diagnosed
-model), chooses the best-supported law by leave-one-test-out ELPD, gives its parameters in f
-(from kappa with the campaign's nu), and flags set-ups and tests (:mod:`.flags`).
+Reads each analysed record's stored draws (the ``.nc`` beside its result, :mod:`.draws`), pools f
+and kappa (:mod:`.pooling`: f under each test's diagnosed model when every test was diagnosed, its
+prior on f_effective divided out, with the stationary f's pooling kept beside it; else the
+stationary f), fits the candidate friction laws with and without a set-up offset (:mod:`.laws`:
+to kappa, or, when every test was diagnosed, to f under each test's diagnosed model), chooses the
+best-supported law by leave-one-test-out ELPD, gives its parameters in f (from kappa with the
+campaign's nu), and flags set-ups and tests (:mod:`.flags`).
 """
 
 from __future__ import annotations
@@ -17,37 +19,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FrictionUQError
 from ..priors import load_priors
 from .flags import outlier_tests, setup_flags, tally_causes
 from .job import RecordResult
 from ..stats import WeightRule, stacking_weights
 from .laws import LAW_PARAMS, LAWS, Elpd, Fit, LawData, Model, law_mean, loo, rank
 from .next_test import Candidate, advice, rank_next_tests
-from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin
+from .draws import RecordPosterior, pool_tests, read_test_posterior
+from .pooling import Pooled, implied_kappa_log_prior, thin
+
+__all__ = ["CampaignAnalysis", "RecordPosterior", "analyse", "analyse_tests", "read_test_posterior"]
 
 MIN_TESTS_FOR_LAWS = 5
 #: The verdict's rule on the laws' stacking weights (friction_uq.stats.weights).
 WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
 #: draws per test the laws' likelihood reads (a kernel density of them)
 LAW_DRAWS = 160
-
-
-@dataclass
-class RecordPosterior:
-    """One analysed test's draws (thinned) read back from its ``.nc``."""
-
-    label: str
-    setup: str
-    f: np.ndarray
-    kappa: np.ndarray
-    nu: np.ndarray
-    p_mean: np.ndarray
-    V: dict[str, float]
-    prior_file: str
-    #: f under the model the record's diagnosis chose (its headline f): the extended model's f_effective
-    #: when a cause was named, the stationary posterior's f when none was; None without a diagnosis
-    f_model: np.ndarray | None = None
 
 
 @dataclass
@@ -71,6 +58,8 @@ class CampaignAnalysis:
     next_tests: list[Candidate] = field(default_factory=list)
     #: law -> the name of its model in ``fits`` that the weights are of (the law, or with set-ups left out)
     law_models: dict[str, str] = field(default_factory=dict)
+    #: the stationary analysis's pooled f when ``pooled["f"]`` is f under the diagnosed models (else empty)
+    pooled_stationary: dict[str, Pooled] = field(default_factory=dict)
 
     def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:
         """Draws of f along (V, p) for one set-up under a fitted model, at the campaign's nu: (draws, len(V))."""
@@ -80,26 +69,6 @@ class CampaignAnalysis:
         y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref)
         y = y * fit.model.setup_scale(th, [setup] * len(np.atleast_1d(V)))
         return y * fit.kbar * fit.data.to_f(self.nu[0])
-
-
-def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
-    """Thinned posterior draws of f, kappa, nu and p_mean from the record's ``.nc``."""
-    import xarray as xr
-
-    nc = records_dir / r.outputs.get("netcdf", "")
-    try:
-        dt = xr.open_datatree(nc, engine="h5netcdf")
-        post = dt["posterior"]
-        draws = {k: thin(post[k].values) for k in ("f", "kappa", "nu", "p_mean")}
-        f_model = None
-        final = dt.attrs.get("discrepancy_final_group")  # diagnosed (absent: no diagnosis, or an older version)
-        if final is not None:
-            f_model = thin(dt[f"{final}/posterior"]["f_effective"].values) if final else draws["f"]
-        dt.close()
-    except (OSError, KeyError, ValueError) as exc:
-        raise FrictionUQError(f"{nc}: cannot read the posterior draws of {r.label} ({exc})") from None
-    return RecordPosterior(r.label, str(r.campaign), draws["f"], draws["kappa"], draws["nu"], draws["p_mean"],
-                           r.summary["V"], str(r.prior_file), f_model)
 
 
 def campaign_nu(tests: Sequence[RecordPosterior], prior_mean: float, prior_sd: float) -> tuple[float, float]:
@@ -115,16 +84,23 @@ def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None
     """The laws' data: f under each test's diagnosed model when every test was diagnosed (a cause such as
     a clearance or a plug friction biases the stationary kappa by a load-dependent amount that a law
     in (p, V) would otherwise absorb), else the stationary kappa. Each test carries its draws (thinned
-    to :data:`LAW_DRAWS`) and their log prior: kappa's implied by the test's prior file, f's from the
-    file's f prior (for f under a diagnosed model, the prior of the base f the mechanism starts from:
-    half-normal(0.3) changes by < 1 % across one test's posterior, so the choice barely matters).
+    to :data:`LAW_DRAWS`) and their log prior: kappa's implied by the test's prior file; f's as the run stored
+    it beside the draws (the diagnosed model's prior on f_effective), else, for a record of a version that
+    stored none, the file's f prior (the prior of the base f the mechanism starts from).
     ``diagnosed=False`` takes the stationary kappa whatever the tests carry."""
     if diagnosed is None:
         diagnosed = all(t.f_model is not None for t in tests)
     y = [thin(t.f_model if diagnosed else t.kappa, LAW_DRAWS) for t in tests]
     priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
-    log_prior = tuple(priors[t.prior_file]["f"].logpdf(v) if diagnosed
-                      else implied_kappa_log_prior(v, priors[t.prior_file]) for t, v in zip(tests, y))
+
+    def log_prior_of(t: RecordPosterior, v: np.ndarray) -> np.ndarray:
+        if not diagnosed:
+            return implied_kappa_log_prior(v, priors[t.prior_file])
+        if t.f_model_log_prior is not None:
+            return thin(t.f_model_log_prior, LAW_DRAWS)  # the same draws as thin(t.f_model, LAW_DRAWS)
+        return priors[t.prior_file]["f"].logpdf(v)
+
+    log_prior = tuple(log_prior_of(t, v) for t, v in zip(tests, y))
     return LawData([t.label for t in tests], [t.setup for t in tests],
                    np.array([np.mean(v) for v in y]), np.array([np.std(v) for v in y]),
                    np.array([t.V["mean"] for t in tests]), np.array([t.V["sd"] for t in tests]),
@@ -298,13 +274,9 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     say = say or (lambda _line: None)
     t0 = time.perf_counter()
     tests = list(tests)
-    pooled: dict[str, Pooled] = {}
-    if tests:
-        priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
-        pooled["f"] = pool([StoredDraws(t.label, t.setup, t.f, priors[t.prior_file]["f"].logpdf(t.f)) for t in tests], "f")
-        pooled["kappa"] = pool([StoredDraws(t.label, t.setup, t.kappa, implied_kappa_log_prior(t.kappa, priors[t.prior_file]))
-                                for t in tests], "kappa")
-    ca = CampaignAnalysis(tests, pooled, tallies)
+    pooled, stationary, note = pool_tests(tests)
+    ca = CampaignAnalysis(tests, pooled, tallies, pooled_stationary=stationary)
+    ca.sentences += note
     if len(tests) < MIN_TESTS_FOR_LAWS:
         ca.sentences.append(f"friction law: {len(tests)} analysed test(s); comparing laws needs at least "
                             f"{MIN_TESTS_FOR_LAWS}")

@@ -1,10 +1,15 @@
 """The campaign's outputs: ``campaign.json`` (schema below), ``campaign.nc`` and the text summary.
 
-``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 2``; version 1 had no weights, and its set-up offsets were free): ``records`` (each
+``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 3``; version 1 had no weights, and its
+set-up offsets were free; version 2 pooled the stationary f whatever the records carried, and had no ``basis``
+nor ``pooled_stationary``): ``records`` (each
 record's path, set-up, test id, ``status`` done | skipped | failed, the refusal ``message``,
 seconds, the ``causes`` its diagnosis named or null), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
 scatter ``sigma`` with 90 % intervals, each test's effective sample size, the Monte Carlo variance
-of the hyper-log-likelihood, or ``refused`` with the reason), ``friction_law`` (``best``: the law that
+of the hyper-log-likelihood, or ``refused`` with the reason; ``basis``: ``diagnosed`` when f is f under each
+test's diagnosed model (every test diagnosed), its prior on f_effective divided out, else ``stationary``),
+``pooled_stationary`` (``f`` of the stationary analysis, as in ``pooled``, when ``pooled.f`` is the diagnosed f;
+else empty), ``friction_law`` (``best``: the law that
 carries the stacking weight (one of constant, velocity, pressure, pressure+velocity) or null;
 ``chosen_model``; ``weights``: each law's stacking weight; ``supported``: the fewest laws carrying 90 %
 of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and its weight;
@@ -35,7 +40,7 @@ from .analysis import WEIGHT_RULE, CampaignAnalysis, f_law_draws
 from .job import RecordResult
 
 SCHEMA = "friction-uq/campaign"
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 
 #: The law parameters' meanings and units, as the JSON's ``friction_law.meanings`` and the sentences give them.
@@ -48,6 +53,13 @@ MEANINGS = {
     "c_per_p_ref": "relative change of f per mean wall pressure of pressure (-)",
     "df_dp_per_MPa": "change of f per MPa of wall pressure (1/MPa)",
     "scatter_rel": "test-to-test scatter of f beyond each test's own uncertainty (relative)",
+}
+
+
+#: What a pooled value's draws are, by its ``basis`` (pooling.Pooled.basis).
+POOLED_BASIS = {
+    "stationary": "of the stationary analysis",
+    "diagnosed": "under each test's diagnosed model (its prior on f_effective divided out)",
 }
 
 
@@ -86,11 +98,12 @@ def statements(ca: CampaignAnalysis) -> list[str]:
         else:
             out.append(f"flagged: test {f['test']} lies {f['below_median_by']:.1f} below the others' leave-one-out "
                        "log density under the chosen law")
-    for name, p in ca.pooled.items():  # after the law: what the tests share, whatever f depends on
+    # after the law: what the tests share; the stationary f's pooling just after the diagnosed f's
+    for p in [q for name, p in ca.pooled.items() for q in (p, ca.pooled_stationary.get(name)) if q is not None]:
         if p.refused:
-            out.append(p.refused)
+            out.append(p.refused + ("" if p.basis == "stationary" else f" ({POOLED_BASIS[p.basis]})"))
         else:
-            out.append(f"pooled {name} of the stationary analysis: population mean {p.mu['q50']:.4g} "
+            out.append(f"pooled {p.variable} {POOLED_BASIS[p.basis]}: population mean {p.mu['q50']:.4g} "
                        f"[{p.mu['q05']:.4g}, {p.mu['q95']:.4g}], between-test scatter {p.sigma['q50']:.2g} "
                        f"[{p.sigma['q05']:.2g}, {p.sigma['q95']:.2g}] (90 %; {len(p.tests)} tests, smallest ESS "
                        f"{min(p.ess.values()):.0f}, Monte Carlo variance of the pooled log-likelihood "
@@ -110,8 +123,8 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
                     for r in results],
     }
     if ca is None:
-        doc |= {"pooled": {}, "friction_law": {"best": None, "ranking": []}, "flagged": [], "causes": {},
-                "statements": ["no record was analysed: nothing to pool"]}
+        doc |= {"pooled": {}, "pooled_stationary": {}, "friction_law": {"best": None, "ranking": []}, "flagged": [],
+                "causes": {}, "statements": ["no record was analysed: nothing to pool"]}
         return doc
     models = {}
     for name, fit in ca.fits.items():
@@ -120,6 +133,7 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
                             "q95": float(np.quantile(v, 0.95))} for k, v in draws.items()}
     doc |= {
         "pooled": {k: p.to_json() for k, p in ca.pooled.items()},
+        "pooled_stationary": {k: p.to_json() for k, p in ca.pooled_stationary.items()},
         "friction_law": {"best": ca.best, "chosen_model": ca.chosen, "ranking": ca.ranking,
                          "weights": ca.weights, "supported": WEIGHT_RULE.supported(ca.weights) if ca.weights else [],
                          "posterior": ca.law_posterior, "models": models,
@@ -150,10 +164,12 @@ def write_netcdf(ca: CampaignAnalysis, path: Path) -> Path:
     import xarray as xr
 
     groups: dict[str, xr.Dataset] = {}
-    for name, p in ca.pooled.items():
-        if p.log_post is not None:
-            groups[f"pooled_{name}"] = xr.Dataset({"log_posterior": (("sigma", "mu"), p.log_post)},
-                                                  coords={"mu": p.grid_mu, "sigma": p.grid_sigma})
+    for prefix, pooled in (("pooled", ca.pooled), ("pooled_stationary", ca.pooled_stationary)):
+        for name, p in pooled.items():
+            if p.log_post is not None:
+                groups[f"{prefix}_{name}"] = xr.Dataset({"log_posterior": (("sigma", "mu"), p.log_post)},
+                                                        coords={"mu": p.grid_mu, "sigma": p.grid_sigma},
+                                                        attrs={"basis": p.basis, "draws": POOLED_BASIS[p.basis]})
     if ca.law_data is not None:
         d = ca.law_data
         groups["tests"] = xr.Dataset(

@@ -14,7 +14,10 @@ log-likelihood estimate, sum_i Var(w_i) / (n_i mean(w_i)^2), are reported, and t
 refused when that variance, averaged over the hyper-posterior, exceeds 1 (as gwpopulation does).
 
 The prior of f is the test's prior file; kappa = f nu/(1-nu) has an implied prior, computed
-exactly by quadrature over nu: pi(kappa) = int pi_f(kappa (1-nu)/nu) (1-nu)/nu pi_nu(nu) dnu.
+exactly by quadrature over nu: pi(kappa) = int pi_f(kappa (1-nu)/nu) (1-nu)/nu pi_nu(nu) dnu. f under
+a test's diagnosed model (``basis`` "diagnosed") was drawn under that model's prior on f_effective,
+which the run stores beside the draws (friction_uq.discrepancy.effective_prior) and the campaign
+reads back.
 """
 
 from __future__ import annotations
@@ -56,9 +59,12 @@ class Pooled:
     grid_mu: np.ndarray | None = None
     grid_sigma: np.ndarray | None = None
     log_post: np.ndarray | None = None
+    #: whose draws were pooled: "stationary" (the stationary analysis') or "diagnosed" (f under each test's
+    #: diagnosed model)
+    basis: str = "stationary"
 
     def to_json(self) -> dict[str, object]:
-        return {"variable": self.variable, "tests": self.tests, "mu": self.mu, "sigma": self.sigma,
+        return {"variable": self.variable, "basis": self.basis, "tests": self.tests, "mu": self.mu, "sigma": self.sigma,
                 "ess_per_test": self.ess, "mc_variance_log_likelihood": self.mc_variance, "refused": self.refused}
 
 
@@ -93,12 +99,14 @@ def _quantiles(values: np.ndarray, weights: np.ndarray) -> dict[str, float]:
             "sd": float(np.sqrt(np.sum(w * (v - mean) ** 2) / np.sum(w)))}
 
 
-def pool(tests: Sequence[StoredDraws], variable: str, *, n_mu: int = 81, n_sigma: int = 60) -> Pooled:
-    """Hyper-posterior of (mu, sigma) on a grid; refused (with the reason) where the estimate is too noisy."""
+def pool(tests: Sequence[StoredDraws], variable: str, *, n_mu: int = 81, n_sigma: int = 60,
+         basis: str = "stationary") -> Pooled:
+    """Hyper-posterior of (mu, sigma) on a grid; refused (with the reason) where the estimate is too noisy.
+    ``basis`` says whose draws these are (:attr:`Pooled.basis`)."""
     labels = [t.label for t in tests]
     if len(tests) < 2:
         return Pooled(variable, labels, refused=f"pooling {variable} needs at least 2 analysed tests, "
-                      f"{len(tests)} given")
+                      f"{len(tests)} given", basis=basis)
     med = np.array([np.median(t.draws) for t in tests])
     sds = np.array([np.std(t.draws) for t in tests])
     span = float(np.ptp(med) + 4 * np.max(sds))
@@ -139,4 +147,4 @@ def pool(tests: Sequence[StoredDraws], variable: str, *, n_mu: int = 81, n_sigma
     elif sigma_q["q95"] > 0.95 * sigma[-1]:
         refused = (f"pooling {variable} refused: the between-test scatter runs to the edge of its grid "
                    f"({sigma[-1]:.3g}); the tests disagree too much for one normal population")
-    return Pooled(variable, labels, mu_q, sigma_q, ess, mc_var, refused, mu, sigma, log_post)
+    return Pooled(variable, labels, mu_q, sigma_q, ess, mc_var, refused, mu, sigma, log_post, basis)

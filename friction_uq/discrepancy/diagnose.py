@@ -32,6 +32,7 @@ from ..analysis import Prepared
 from ..stats import RULE
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
+from .mechanisms import Context
 from .misfit import MisfitDecision, decide
 from .whole_record import WholeRecord, compare_whole_record
 
@@ -102,6 +103,10 @@ class Diagnosis:
     pareto_k: float = float("nan")
     importance_ess: float = float("nan")
     posterior_method: str | None = None
+    #: the stationary window's means the mechanisms' f_effective is stated at, and the seed: what the prior of
+    #: f_effective (:mod:`.effective_prior`) is computed from when the draws are written
+    context: Context | None = None
+    seed: int = 0
 
     @property
     def cause(self) -> Variant | None:
@@ -206,7 +211,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
                      not_separable=not_sep, channels_not_separable=other_channels, separate_by=separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
-                     posterior_method=method)
+                     posterior_method=method, context=dg.context, seed=seed)
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

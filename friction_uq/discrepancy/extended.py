@@ -255,7 +255,7 @@ class Diagnoser:
         f = float(values["f"])
         for v in variants:
             f = v.mechanism.f_effective({**values, "f": f}, self.context)
-        return f
+        return float(f)
 
 
 _ACTIVE: tuple[Diagnoser, list] | None = None

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+import numpy as np
 from scipy import stats
 
 from ..models.parameters import Parameter
@@ -65,7 +66,9 @@ class Mechanism:
     priors: Mapping[str, Any]
     start: Mapping[str, float]
     apply: Apply
-    f_effective: Callable[[Mapping[str, float], Context], float] = field(default=lambda v, c: float(v["f"]))
+    #: f_effective(values, context): numpy expressions, so that arrays of values give arrays (the implied prior of
+    #: f_effective, :mod:`.effective_prior`, evaluates it over many parameter draws at once)
+    f_effective: Callable[[Mapping[str, Any], Context], Any] = field(default=lambda v, c: v["f"])
     channels: tuple[str, ...] = ()  # gauge_gain: the gauges it may act on (one fit each)
     group: str | None = None  # mechanisms of one group replace the same thing (the friction law): one at a time
 
@@ -112,7 +115,7 @@ register(Mechanism(
     priors={"f_s": stats.halfnorm(scale=0.3), "v_c": _lognormal(5.0, 1.0)},
     start={"f_s": 0.08, "v_c": 5.0},
     apply=lambda v, s, g, ch: _law(s, "velocity", f_s=v["f_s"], f_d=v["f"], v_c=v["v_c"]),
-    f_effective=lambda v, c: float(v["f"] + (v["f_s"] - v["f"]) * math.exp(-c.V / v["v_c"])),
+    f_effective=lambda v, c: v["f"] + (v["f_s"] - v["f"]) * np.exp(-c.V / v["v_c"]),
     group="friction_law",
 ))
 
@@ -125,7 +128,7 @@ register(Mechanism(
     start={"p0": 1e9},
     apply=lambda v, s, g, ch: _law(s, "hyperbolic", f0=v["f"], p0=v["p0"]),
     # at the window's shear stress: tau = f p / (1 + p/p0) gives tau / p = f - tau / p0
-    f_effective=lambda v, c: float(max(v["f"] - c.tau_mean / v["p0"], 0.0)),
+    f_effective=lambda v, c: np.maximum(v["f"] - c.tau_mean / v["p0"], 0.0),
     group="friction_law",
 ))
 
@@ -137,7 +140,7 @@ register(Mechanism(
     priors={"f_s": stats.halfnorm(scale=0.3), "d_c": _lognormal(1e-3, 1.0)},
     start={"f_s": 0.08, "d_c": 1e-3},
     apply=lambda v, s, g, ch: _law(s, "slip_weakening", f_s=v["f_s"], f_d=v["f"], d_c=v["d_c"]),
-    f_effective=lambda v, c: float(v["f"] + (v["f_s"] - v["f"]) * max(0.0, 1.0 - c.slip / v["d_c"])),
+    f_effective=lambda v, c: v["f"] + (v["f_s"] - v["f"]) * np.maximum(0.0, 1.0 - c.slip / v["d_c"]),
     group="friction_law",
 ))
 

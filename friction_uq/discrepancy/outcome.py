@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import zlib
+
 import numpy as np
 
 from ..models.parameters import effective_sample_size, summarize_draws
 from ..stats import khat_threshold
 from .diagnose import Diagnosis, ModelFit, Ranked
+from .effective_prior import log_prior_f_effective
 from .extended import IMPORTANCE_DRAWS, Variant
 from .whole_record import CHANNEL_LABELS
 
@@ -188,10 +191,11 @@ def group_key(label: str) -> str:
     return label.replace("[", "_").replace("]", "").replace("+", "__")
 
 
-def add_to_datatree(dt, dg: Diagnosis) -> None:
+def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
     """One group per fitted model under ``discrepancy``: the draws (posterior: the normal approximation's, and
-    for the model the headline f comes from its exact posterior's, :meth:`Diagnoser.exact_posterior`) and the
-    pointwise block elpd (log_likelihood)."""
+    for the model the headline f comes from its exact posterior's, :meth:`Diagnoser.exact_posterior`), beside
+    f_effective the log density of its prior at each draw (``log_prior_f_effective``, :mod:`.effective_prior`;
+    ``f_prior``: the prior file's f prior), and the pointwise block elpd (log_likelihood)."""
     import xarray as xr
 
     fits: list[ModelFit] = [dg.baseline] + [dg.final if dg.causes and r.fit.label == dg.final.label else r.fit
@@ -202,6 +206,9 @@ def add_to_datatree(dt, dg: Diagnosis) -> None:
         key = group_key(mf.label)
         post = {n: (("chain", "draw"), v[None]) for n, v in mf.fit.draws.items()}
         post["f_effective"] = (("chain", "draw"), mf.f_effective[None])
+        rng = np.random.default_rng(np.random.SeedSequence([dg.seed, 13, zlib.crc32(mf.label.encode())]))
+        log_prior, prior_note = log_prior_f_effective(mf.variants, dg.context, f_prior, mf.f_effective, rng=rng)
+        post["log_prior_f_effective"] = (("chain", "draw"), log_prior[None], {"description": prior_note})
         ll = {"block_elpd": (("block",), mf.elpd.pointwise),
               "calibration_elpd": (("calibration",), mf.elpd.calibration)}
         method = dg.posterior_method if mf is dg.final and dg.causes else "normal approximation (robust covariance)"

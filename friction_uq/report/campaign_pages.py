@@ -54,27 +54,41 @@ def _summary_page(ca: CampaignAnalysis, doc: dict[str, Any]):
 
 
 def _forest(ca: CampaignAnalysis):
-    fig, axes = figure("Per-test posteriors of the stationary analysis (90 % intervals) and the pooled population",
-                       nrows=1, ncols=2)
+    """Each test's 90 % interval and the pooled population, f and kappa. With a diagnosed pooled f (``basis``
+    "diagnosed") the f panel draws f under each test's diagnosed model, and the stationary f's medians and
+    pooled mean beside it in grey, each labelled."""
+    pf = ca.pooled.get("f")
+    diagnosed = pf is not None and pf.basis == "diagnosed"
+    what = "f under the diagnosed models" if diagnosed else "the stationary analysis"
+    fig, axes = figure(f"Per-test 90 % intervals and the pooled population: {what}", nrows=1, ncols=2)
     colors = {s: f"C{k}" for k, s in enumerate(sorted({t.setup for t in ca.tests}))}
     for ax, name in zip(axes, ("f", "kappa")):
         y = np.arange(len(ca.tests))[::-1]
+        use_model = diagnosed and name == "f"
         for yy, t in zip(y, ca.tests):
-            d = getattr(t, name)
+            d = t.f_model if use_model else getattr(t, name)
             q = np.quantile(d, [0.05, 0.5, 0.95])
             ax.plot(q[[0, 2]], [yy, yy], color=colors[t.setup], lw=2)
             ax.plot(q[1], yy, "o", color=colors[t.setup])
+            if use_model:
+                ax.plot(np.median(t.f), yy - 0.25, "x", color="0.5",
+                        label="stationary analysis, median" if yy == y[0] else None)
         p = ca.pooled.get(name)
+        basis = "diagnosed models" if p is not None and p.basis == "diagnosed" else "stationary analysis"
         if p is not None and not p.refused:
-            ax.axvspan(p.mu["q05"], p.mu["q95"], color="k", alpha=0.15, label="population mean (90 %)")
+            ax.axvspan(p.mu["q05"], p.mu["q95"], color="k", alpha=0.15, label=f"population mean (90 %), {basis}")
             ax.axvline(p.mu["q50"] - p.sigma["q50"], color="k", ls=":", lw=1)
             ax.axvline(p.mu["q50"] + p.sigma["q50"], color="k", ls=":", lw=1, label="mean +- scatter")
-            ax.set_title(f"{name}: mean {p.mu['q50']:.4g}, scatter {p.sigma['q50']:.2g}", loc="left")
+            ax.set_title(f"{name} ({basis}): mean {p.mu['q50']:.4g}, scatter {p.sigma['q50']:.2g}", loc="left")
         elif p is not None:
-            ax.set_title(f"{name}: pooling refused (see summary)", loc="left")
+            ax.set_title(f"{name} ({basis}): pooling refused (see summary)", loc="left")
+        ps = ca.pooled_stationary.get(name) if use_model else None
+        if ps is not None and not ps.refused:
+            ax.axvline(ps.mu["q50"], color="0.5", ls="--", lw=1,
+                       label=f"population mean, stationary analysis ({ps.mu['q50']:.4g})")
         ax.set_yticks(y, [t.label for t in ca.tests])
-        ax.set_xlabel(name)
-        ax.legend(loc="lower right", fontsize=8)
+        ax.set_xlabel("f under the diagnosed model" if use_model else name)
+        ax.legend(loc="best", fontsize=8)
     return fig
 
 

@@ -1,0 +1,95 @@
+"""Each analysed test's draws as the campaign reads them from the record's ``.nc``, and the campaign's pooled
+f and kappa from them (:mod:`.pooling`).
+
+With ``--diagnose`` each record's ``.nc`` names the group of the model its headline f comes from
+(``discrepancy_final_group``); that group holds the draws of f_effective and, beside them, the log
+density of the prior they were drawn under (``log_prior_f_effective``, written by the run:
+friction_uq.discrepancy.effective_prior). The campaign reads both and divides that prior out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FrictionUQError
+from ..priors import load_priors
+from .job import RecordResult
+from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin
+
+
+@dataclass
+class RecordPosterior:
+    """One analysed test's draws (thinned) read back from its ``.nc``."""
+
+    label: str
+    setup: str
+    f: np.ndarray
+    kappa: np.ndarray
+    nu: np.ndarray
+    p_mean: np.ndarray
+    V: dict[str, float]
+    prior_file: str
+    #: f under the model the record's diagnosis chose (its headline f): the extended model's f_effective
+    #: when a cause was named, the stationary posterior's f when none was; None without a diagnosis
+    f_model: np.ndarray | None = None
+    #: log density at each of ``f_model``'s draws of the prior they were drawn under: the model's prior on
+    #: f_effective as the run stored it beside them, or the prior file's f prior for the stationary f; None
+    #: when the record's version stored no prior (the diagnosed f is then not pooled)
+    f_model_log_prior: np.ndarray | None = None
+
+
+def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
+    """Thinned posterior draws of f, kappa, nu and p_mean from the record's ``.nc``."""
+    import xarray as xr
+
+    nc = records_dir / r.outputs.get("netcdf", "")
+    try:
+        dt = xr.open_datatree(nc, engine="h5netcdf")
+        post = dt["posterior"]
+        draws = {k: thin(post[k].values) for k in ("f", "kappa", "nu", "p_mean")}
+        f_model = f_log_prior = None
+        final = dt.attrs.get("discrepancy_final_group")  # diagnosed (absent: no diagnosis, or an older version)
+        if final:
+            group = dt[f"{final}/posterior"]
+            f_model = thin(group["f_effective"].values)
+            if "log_prior_f_effective" in group:
+                f_log_prior = thin(group["log_prior_f_effective"].values)
+        elif final is not None:  # diagnosed, no cause named: the stationary f, under the prior file's f prior
+            f_model = draws["f"]
+            f_log_prior = np.asarray(load_priors(r.prior_file)["f"].logpdf(f_model), float)
+        dt.close()
+    except (OSError, KeyError, ValueError) as exc:
+        raise FrictionUQError(f"{nc}: cannot read the posterior draws of {r.label} ({exc})") from None
+    if f_log_prior is not None and not np.all(np.isfinite(f_log_prior)):
+        raise FrictionUQError(f"{nc}: group {final or 'posterior'}: the log prior of f under the diagnosed model is "
+                              "not finite at some draws (a draw where its prior has no density cannot be pooled)")
+    return RecordPosterior(r.label, str(r.campaign), draws["f"], draws["kappa"], draws["nu"], draws["p_mean"],
+                           r.summary["V"], str(r.prior_file), f_model, f_log_prior)
+
+
+def pool_tests(tests: Sequence[RecordPosterior]) -> tuple[dict[str, Pooled], dict[str, Pooled], list[str]]:
+    """The campaign's pooled f and kappa, the stationary f's pooling when the pooled f is another, and a
+    sentence when some tests were diagnosed but the diagnosed f could not be pooled.
+
+    When every test carries f under its diagnosed model with the log prior its draws were made under,
+    the pooled f is that f, the prior divided out (``basis`` "diagnosed"); the stationary f's pooling
+    is returned beside it. kappa is the stationary analysis's in every case."""
+    if not tests:
+        return {}, {}, []
+    priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
+    f_stat = pool([StoredDraws(t.label, t.setup, t.f, priors[t.prior_file]["f"].logpdf(t.f)) for t in tests], "f")
+    kappa = pool([StoredDraws(t.label, t.setup, t.kappa, implied_kappa_log_prior(t.kappa, priors[t.prior_file]))
+                  for t in tests], "kappa")
+    n_diag = sum(t.f_model is not None and t.f_model_log_prior is not None for t in tests)
+    if n_diag < len(tests):
+        note = [] if not any(t.f_model is not None for t in tests) else [
+            f"pooled f: the stationary analysis's, since {n_diag} of {len(tests)} tests carry f under a diagnosed "
+            "model with the prior its draws were made under (pooling the diagnosed f needs every test)"]
+        return {"f": f_stat, "kappa": kappa}, {}, note
+    f_diag = pool([StoredDraws(t.label, t.setup, t.f_model, t.f_model_log_prior) for t in tests], "f",
+                  basis="diagnosed")
+    return {"f": f_diag, "kappa": kappa}, {"f": f_stat}, []

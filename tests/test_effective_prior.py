@@ -1,0 +1,108 @@
+"""The prior of f_effective under an extended model (what its draws were made under, stored beside them for a
+campaign to divide out): exact where the model leaves f as it is, against quadrature and Monte Carlo where a
+friction law replaces it, and written into each model's group of the DataTree."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from friction_uq.discrepancy import outcome
+from friction_uq.discrepancy.effective_prior import EXACT_NOTE, PUSHED_NOTE, log_prior_f_effective
+from friction_uq.discrepancy.extended import Variant
+from friction_uq.discrepancy.mechanisms import MECHANISMS, Context
+from friction_uq.priors import PRIORS_DIR, load_priors
+
+F_PRIOR = load_priors(PRIORS_DIR / "I1.toml")["f"]  # half-normal(0.3), as the run passes it
+F_SCIPY = F_PRIOR.frozen()  # the same law, for the quadratures
+CTX = Context(V=9.0, tau_mean=0.05 * 9e7, slip=2e-3)
+
+
+def _variants(*names: str) -> tuple[Variant, ...]:
+    return tuple(Variant(MECHANISMS[n]) for n in names)
+
+
+def test_a_model_that_leaves_f_as_it_is_has_the_prior_files_f_prior():
+    y = np.linspace(0.01, 0.3, 50)
+    lp, note = log_prior_f_effective(_variants("dispersion", "clearance", "plug_friction"), CTX, F_PRIOR, y,
+                                     rng=np.random.default_rng(0))
+    assert note == EXACT_NOTE
+    np.testing.assert_array_equal(lp, F_PRIOR.logpdf(y))
+
+
+def test_pressure_friction_prior_matches_quadrature_over_p0():
+    """f_effective = f - tau/p0 (f > tau/p0): pi(y) = E_p0[pi_f(y + tau / p0)], by 2e5 midpoints in p0's quantile."""
+    y = np.array([0.02, 0.05, 0.1, 0.2, 0.4])
+    lp, note = log_prior_f_effective(_variants("pressure_friction"), CTX, F_PRIOR, y, rng=np.random.default_rng(1))
+    assert note == PUSHED_NOTE
+    p0 = MECHANISMS["pressure_friction"].priors["p0"].ppf((np.arange(200_000) + 0.5) / 200_000)
+    exact = np.array([np.mean(F_SCIPY.pdf(v + CTX.tau_mean / p0)) for v in y])
+    np.testing.assert_allclose(np.exp(lp), exact, rtol=1e-3)
+    assert np.max(np.abs(lp - F_PRIOR.logpdf(y))) > 0.05  # not the f prior: dividing that out would be wrong
+
+
+def test_velocity_friction_prior_matches_quadrature():
+    """f_effective = (1 - e) f + e f_s, e = exp(-V / v_c), f and f_s half-normal(0.3), v_c from its prior: given e,
+    the density of a sum of two scaled half-normals by quadrature over the one whose scale is >= 1/2."""
+    y = np.array([0.01, 0.03, 0.06, 0.1, 0.2, 0.4])
+    lp, note = log_prior_f_effective(_variants("clearance", "velocity_friction"), CTX, F_PRIOR, y,
+                                     rng=np.random.default_rng(2))
+    assert note == PUSHED_NOTE
+    mech = MECHANISMS["velocity_friction"]
+    e = np.exp(-CTX.V / mech.priors["v_c"].ppf((np.arange(1000) + 0.5) / 1000))[:, None]
+    x = np.linspace(0.0, 2.0, 2001)  # the other coefficient, integrated out
+    fs = mech.priors["f_s"]
+    exact = np.array([np.trapezoid(np.where(e < 0.5, fs.pdf(x) * F_SCIPY.pdf((v - e * x) / (1 - e)) / (1 - e),
+                                            F_SCIPY.pdf(x) * fs.pdf((v - (1 - e) * x) / e) / e), x, axis=1).mean()
+                      for v in y])
+    np.testing.assert_allclose(np.exp(lp), exact, rtol=0.01)
+    # it falls where the f prior is highest: a sum of two half-normals has no density at 0
+    assert lp[0] < F_PRIOR.logpdf(0.01) - 0.1
+
+
+def test_same_seed_same_bits():
+    y = np.random.default_rng(3).normal(0.06, 0.01, 300)
+    a, _ = log_prior_f_effective(_variants("slip_friction"), CTX, F_PRIOR, y, rng=np.random.default_rng(7))
+    b, _ = log_prior_f_effective(_variants("slip_friction"), CTX, F_PRIOR, y, rng=np.random.default_rng(7))
+    c, _ = log_prior_f_effective(_variants("slip_friction"), CTX, F_PRIOR, y, rng=np.random.default_rng(8))
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_allclose(a, c, atol=0.02)  # another Sobol scramble: the same prior to Monte Carlo error
+
+
+def _model(label: str, names: tuple[str, ...], f: np.ndarray):
+    elpd = SimpleNamespace(pointwise=np.zeros(3), calibration=np.zeros(1), calibration_names=("hoop_gain",),
+                           total=0.0, se=0.0)
+    return SimpleNamespace(label=label, variants=_variants(*names), f_effective=f, hoop_gain=1.0, elpd=elpd,
+                           fit=SimpleNamespace(draws={"f": f, "nu": np.full(f.size, 0.4)}))
+
+
+def test_each_models_group_holds_the_log_prior_of_f_effective_beside_its_draws(tmp_path):
+    import xarray as xr
+
+    rng = np.random.default_rng(0)
+    base = _model("baseline", (), rng.normal(0.05, 0.002, 200))
+    vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
+    dg = SimpleNamespace(baseline=base, final=vel, causes=vel.variants, rounds=((SimpleNamespace(fit=vel),),),
+                         posterior_method="importance", context=CTX, seed=4)
+    dt = xr.DataTree()
+    outcome.add_to_datatree(dt, dg, F_PRIOR)
+    dt.to_netcdf(tmp_path / "d.nc", engine="h5netcdf")
+    with xr.open_datatree(tmp_path / "d.nc", engine="h5netcdf") as back:
+        assert back.attrs["discrepancy_final_group"] == "discrepancy_velocity_friction"
+        b = back["discrepancy_baseline/posterior"]
+        np.testing.assert_allclose(b["log_prior_f_effective"].values, F_PRIOR.logpdf(b["f_effective"].values))
+        assert b["log_prior_f_effective"].attrs["description"] == EXACT_NOTE
+        v = back["discrepancy_velocity_friction/posterior"]
+        want, _ = log_prior_f_effective(vel.variants, CTX, F_PRIOR, vel.f_effective, rng=np.random.default_rng(
+            np.random.SeedSequence([4, 13, __import__("zlib").crc32(b"velocity_friction")])))
+        np.testing.assert_array_equal(v["log_prior_f_effective"].values[0], want)
+        assert v["log_prior_f_effective"].attrs["description"] == PUSHED_NOTE
+
+
+def test_a_law_that_is_not_monotone_in_f_is_refused():
+    mech = SimpleNamespace(name="odd", parameters=(), priors={}, f_effective=lambda v, c: (v["f"] - 0.2) ** 2)
+    with pytest.raises(ValueError, match="decreases with f"):
+        log_prior_f_effective((SimpleNamespace(mechanism=mech, label="odd"),), CTX, F_PRIOR, np.array([0.05]),
+                              rng=np.random.default_rng(0))
