@@ -506,7 +506,10 @@ def test_ctrl_c_is_one_line_exit_130_and_keeps_the_checkpoint(tmp_path):
                                    campaign="fault")
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "friction_uq.cli", "run", str(rec), "--out", str(out), "--no-pdf", "--seed", "3"]
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    # as from a terminal: Ctrl-C handled, whatever this process inherited (a background job of a shell starts
+    # with SIGINT ignored, and the run then rightly ignores it)
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     err = []
     for line in p.stderr:  # wait until the sampler has made steps, then Ctrl-C the whole process group
         err.append(line)
@@ -515,7 +518,9 @@ def test_ctrl_c_is_one_line_exit_130_and_keeps_the_checkpoint(tmp_path):
     os.killpg(p.pid, signal.SIGINT)
     out_text, rest = p.communicate(timeout=120)
     err += rest.splitlines(keepends=True)
-    assert p.returncode == 130, "".join(err)[-2000:]
+    here = (f"this process: SIGINT handler {signal.getsignal(signal.SIGINT)!r}, blocked "
+            f"{sorted(signal.pthread_sigmask(signal.SIG_BLOCK, []))}")
+    assert p.returncode == 130, here + "\n" + "".join(err)[-2000:]
     assert out_text == "" and "Traceback" not in "".join(err) and "emcee" not in "".join(err)
     assert err[-1].strip() == "friction-uq: interrupted"
     names = sorted(q.name for q in out.iterdir())
@@ -548,7 +553,8 @@ def test_ctrl_c_stops_a_campaigns_dask_workers_quietly(tmp_path):
     """Ctrl-C (to the whole process group, as a terminal sends it) while Dask workers run records: one line, no
     traceback from the workers or the scheduler, every worker process gone."""
     p = subprocess.Popen([sys.executable, "-c", _CAMPAIGN_SCRIPT, str(tmp_path)], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+                         stderr=subprocess.PIPE, text=True, start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # as from a terminal
     deadline = time.monotonic() + 120
     while len(list(tmp_path.glob("*.started"))) < 2 and time.monotonic() < deadline:
         time.sleep(0.2)

@@ -59,8 +59,10 @@ def integrated_time(chain: np.ndarray, *, c: float = 5.0) -> np.ndarray:
 def _interrupt_between_steps() -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) while emcee steps and raise KeyboardInterrupt when the block of steps ends: emcee's
     wrapper of the log-probability prints the walkers' positions and a traceback for any exception raised in
-    it, KeyboardInterrupt included. Only in the main thread (elsewhere signals cannot be handled)."""
-    if threading.current_thread() is not threading.main_thread():
+    it, KeyboardInterrupt included. Only in the main thread (elsewhere signals cannot be handled), and not where
+    SIGINT is ignored (a background job of a shell: Ctrl-C is not meant for it, and catching it during the steps
+    only would stop the job at some moments and not at others)."""
+    if threading.current_thread() is not threading.main_thread() or signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
         yield
         return
     caught: list[int] = []
