@@ -37,7 +37,7 @@ THETA_DRAWS = 4096
 #: What the stored log prior is, as the netCDF's attribute says it.
 EXACT_NOTE = "the prior file's f prior: every mechanism of this model leaves f as it is (f_effective = f)"
 PUSHED_NOTE = ("the prior of f_effective implied by the prior file's f prior and the mechanisms' priors (push-forward "
-               "through f_effective, conditionally on the mechanisms' parameters, over 4096 Sobol points)")
+               f"through f_effective, conditionally on the mechanisms' parameters, over {THETA_DRAWS} Sobol points)")
 
 
 def _compose(variants: Sequence[Any], values: dict[str, Any], context: Context) -> Any:
