@@ -104,3 +104,19 @@ def test_hoop_prediction_matches_an_independent_trapezoid_quadrature(f, nu):
     N = F_io * (np.exp(fb) - np.exp(fb * (L - z_in) / L))
     ref = -(tb.lame_hoop_strain_per_pressure * p_mean * seen + tb.poisson_ratio * N / (tb.young_modulus * tb.area))
     np.testing.assert_allclose(got, ref, rtol=2e-3, atol=1e-3 * np.max(np.abs(ref)))
+
+
+@pytest.mark.parametrize("axial", [True, False])
+def test_weighted_hoop_prediction_is_the_knot_prediction_contracted(axial):
+    """The level likelihood's window mean of the hoop reading, computed without the knot values
+    (HoopPrediction.predict_weighted), equals the knot values times the weights, over f up to 0.5
+    and nu across (0.05, 0.49), gains either side of 1."""
+    from friction_uq.models.closed_form import HoopPrediction
+
+    d = record_data(0.05, 0.4, 1.0, seed=3)
+    hp = HoopPrediction(d, axial_poisson=axial)
+    rng = np.random.default_rng(7)
+    f, nu, g = rng.uniform(0.0, 0.5, 200), rng.uniform(0.05, 0.49, 200), rng.uniform(0.7, 1.3, 200)
+    w = rng.uniform(0.0, 1.0, len(hp.knots))
+    ref = hp.predict_knots(f, nu, g) @ w
+    np.testing.assert_allclose(hp.predict_weighted(f, nu, g, w), ref, rtol=1e-12, atol=1e-14 * np.max(np.abs(ref)))

@@ -124,12 +124,12 @@ class HoopTerm:
 
         "series": exact AR(1) log-likelihood of the residuals, offset error integrated out.
         """
-        c = self.predict_knots(f, nu, gain)
         if self.mode == "level":
-            mean_pred = (c @ self._b_sum) / self._n
+            mean_pred = self.prediction.predict_weighted(f, nu, gain, self._b_sum / self._n)
             sd = self.level_sd(mean_pred)
             z = (self._h_sum / self._n - mean_pred) / sd
             return -0.5 * (_LOG_2PI + z * z) - np.log(sd)
+        c = self.predict_knots(f, nu, gain)
         q = self._hh - 2.0 * (c @ self._hb) + np.einsum("wi,wi->w", c @ self._bb, c)
         out = self._const - q / self._scale
         if self.offset > 0.0:

@@ -1,17 +1,17 @@
 """What a run does beside its sampling: the other core's work (the whole-record check and the report's
-pages that need no posterior draw, in a forked process: :class:`friction_uq._parallel.Background`) and
-a thread that loads what the stages after the sampling would otherwise wait for."""
+pages that need no posterior draw, in a forked process: :class:`friction_uq._parallel.Background`).
+
+Nothing runs on a thread beside the sampling: the sampler's steps are small numpy operations that hold
+the interpreter's lock most of the time, so imports made on a thread meanwhile (dask's, about 1.5 s of
+the lock) slowed the sampling by as much as they saved later (measured: sampling 2.6 s with such a
+thread, 1.55 s without; the run 0.4 s shorter without)."""
 
 from __future__ import annotations
-
-import importlib
-import threading
 
 import numpy as np
 
 from ..analysis import Identification, Prepared
 from ..discrepancy.check import WholeRecordCheck
-from ..likelihood import ar1_pointwise
 
 
 def whole_record_start(lab: Identification, priors) -> dict[str, float]:
@@ -39,26 +39,3 @@ def alongside(prep: Prepared, priors, start: dict[str, float], *, hoop: bool, se
 
         part = render_record_part(prep, wrc, hoop=hoop)
     return wrc, part
-
-
-#: What later stages import on first use: xarray imports dask.array at its first array and dask.distributed
-#: when it writes a netCDF file (where dask is installed, as it is for campaigns); pypdf merges the report.
-LATER_IMPORTS = ("dask.array", "dask.distributed", "pypdf")
-
-
-def prepare_soon() -> threading.Thread:
-    """On a thread, while this one samples, what the stages after the sampling would otherwise wait for:
-    the :data:`LATER_IMPORTS` (three quarters of a second) and the compiled AR(1) densities of the
-    pointwise log-likelihood, loaded from numba's cache (a quarter of a second, the first time in a
-    process)."""
-    def load() -> None:
-        for module in LATER_IMPORTS:
-            try:
-                importlib.import_module(module)
-            except ImportError:
-                pass
-        ar1_pointwise(np.zeros((1, 3)), 1.0, 0.5, 1.0)
-
-    thread = threading.Thread(target=load, name="prepare", daemon=True)
-    thread.start()
-    return thread

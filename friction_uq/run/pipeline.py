@@ -46,7 +46,7 @@ from ..priors import default_prior_path, load_priors
 from ..record import read_record
 from ..sampler import PosteriorSamples, sample_posterior, stderr_progress
 from ..settings import AnalysisSettings
-from .alongside import alongside, prepare_soon, whole_record_start
+from .alongside import alongside, whole_record_start
 from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
 from .outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION, netcdf_bytes, quoted_f, safe_stem, sha256_hex, summary_table
 from .warnings import run_warnings
@@ -162,7 +162,6 @@ def run_file(
         if check:
             say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if side_job.forked
                                                                          else "(after the sampling)"))
-        loader = prepare_soon()
 
         t = time.perf_counter()
         try:
@@ -172,7 +171,6 @@ def run_file(
         except SamplingError as exc:  # the sampler knows the priors, not the record: name it
             raise SamplingError(f"{record.path}: {exc}") from None
         stages["sampling"] = time.perf_counter() - t
-        loader.join()  # no thread left running: later stages fork only where this process has one thread
         t = time.perf_counter()
         dt = build_datatree(samples, prep.data, priors, seed=seed, likelihood=likelihood)
         dt.attrs["analysis_settings"] = settings.to_attr()  # provenance: how the likelihood was built
