@@ -78,7 +78,7 @@ def page_propagation(
     ax.plot(band.nu, band.q50, color="C0", label="median of f given nu (eq. 17)")
     f, nu = samples.flat("f"), samples.flat("nu")
     step = max(1, len(f) // 2000)
-    ax.plot(nu[::step], f[::step], ".", ms=1.5, color="k", alpha=0.3, label="posterior draws (f, nu)")
+    ax.plot(nu[::step], f[::step], ".", ms=1.5, color="k", alpha=0.3, label="posterior draws (f, nu)", rasterized=True)
     ax.axvline(nu_assumed, color="0.5", ls=":", lw=1)
     ax.set_xlabel("Poisson ratio of the sample nu (-)")
     ax.set_ylabel("friction coefficient f (-)")
@@ -110,7 +110,7 @@ def _band_zoom(ax, band: FNuBand, nu: np.ndarray, f: np.ndarray, step: int) -> N
     ins = ax.inset_axes([0.55, 0.55, 0.42, 0.32])
     ins.fill_between(band.nu[keep], band.q05[keep], band.q95[keep], color="C0", alpha=0.35)
     ins.plot(band.nu[keep], band.q50[keep], color="C0", lw=1)
-    ins.plot(nu[::step], f[::step], ".", ms=1, color="k", alpha=0.2)
+    ins.plot(nu[::step], f[::step], ".", ms=1, color="k", alpha=0.2, rasterized=True)
     ins.set_title("zoom: the band, where the draws are", fontsize=7)
     ins.tick_params(labelsize=6)
 

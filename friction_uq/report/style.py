@@ -29,8 +29,10 @@ RC = {
 A4_LANDSCAPE = (11.69, 8.27)
 #: The PDF's text in the PDF standard's own fonts (Helvetica, Courier: every reader has them, nothing is
 #: embedded): a third less time per page than embedding a TrueType subset. Their encoding has no
-#: Unicode minus sign: tick labels use the ASCII hyphen-minus (else they read "?20").
-CORE_FONTS = {"pdf.use14corefonts": True, "axes.unicode_minus": False}
+#: Unicode minus sign: tick labels use the ASCII hyphen-minus (else they read "?20"). Dense clouds of
+#: points are drawn as images (``rasterized``: thousands of vector markers cost a PDF page half a second);
+#: at 200 dpi they print sharp.
+CORE_FONTS = {"pdf.use14corefonts": True, "axes.unicode_minus": False, "savefig.dpi": 200, "pdf.compression": 1}
 
 
 class _SameFontOtherWeight(logging.Filter):
