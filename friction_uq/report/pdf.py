@@ -147,19 +147,19 @@ def _render(builders: list[Callable[[], Figure]]) -> bytes:
     return buf.getvalue()
 
 
-#: Pages 1-3, the record's, open :func:`render_record_part`'s part; the check's pages follow them there.
-RECORD_PAGES = 3
+#: The record's pages that the run's other core renders (3 and 4; page 2, the raw gauges, is drawn with the
+#: posterior's pages: the two cores' shares of the work are then about equal).
+RECORD_PAGES = 2
 
 
 def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None, *, hoop: bool = True) -> bytes:
-    """The pages that need no posterior draw: the record's (pages 2-4) and the whole-record check's (from page
-    10, or 9 without the hoop page: ``hoop``). A run renders them on its other core, after the check, while it
-    samples (:func:`render_report` merges them)."""
+    """The pages that need no posterior draw, but for the raw gauges': pages 3-4 and the whole-record check's (from
+    page 10, or 9 without the hoop page: ``hoop``). A run renders them on its other core, after the check,
+    while it samples (:func:`render_report` merges them)."""
     from .whole_record_pages import pages_whole_record
 
     p = prepared
     builders: list[Callable[[], Figure]] = [
-        lambda: page_raw(p.record),
         lambda: page_forces(p.record, p.forces, p.window),
         lambda: page_window(p.record, p.forces, p.window),
     ]
@@ -171,10 +171,12 @@ def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None
 
 
 def render_posterior_part(r: ReportInputs) -> bytes:
-    """Pages 4-7 (and 8, the hoop gauge's, when its term was used): the posterior draws', which need
-    neither the whole-record check nor the diagnosis (a run renders them while it waits for those)."""
+    """Page 2 (the raw gauges) and pages 5-8 (and 9, the hoop gauge's, when its term was used): the posterior
+    draws', which need neither the whole-record check nor the diagnosis (a run renders them while it waits
+    for those)."""
     p = r.prepared
     builders: list[Callable[[], Figure]] = [
+        lambda: page_raw(p.record),
         lambda: page_corner(r.samples, r.datatree),
         lambda: page_propagation(r.samples, r.band, r.sensitivity, r.nu_share, nu_assumed=r.lab.nu),
         lambda: page_convergence(r.samples, r.convergence),
@@ -201,8 +203,8 @@ def render_report(r: ReportInputs, record_part: bytes | None = None, posterior_p
     summary, *diagnosis = PdfReader(io.BytesIO(_render(own))).pages
     record = PdfReader(io.BytesIO(record_part)).pages
     out = PdfWriter()
-    posterior = PdfReader(io.BytesIO(posterior_part)).pages
-    for page in [summary, *record[:RECORD_PAGES], *posterior, *record[RECORD_PAGES:], *diagnosis]:
+    raw, *posterior = PdfReader(io.BytesIO(posterior_part)).pages
+    for page in [summary, raw, *record[:RECORD_PAGES], *posterior, *record[RECORD_PAGES:], *diagnosis]:
         out.add_page(page)
     out.add_metadata({"/Title": f"friction-uq {p.record.campaign} {p.record.test_id}",
                       "/Creator": f"friction-uq {r.version}"})
