@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass
 
-from .likelihood import FORCE_MODES
+from .likelihood import FORCE_MODES, RATIO_MODEL_FORM
 from .likelihood.hoop import HOOP_DISCREPANCY, HOOP_MODES
 
 
@@ -34,6 +34,8 @@ class AnalysisSettings:
         Relative sd of the hoop model's error on the level.
     force_mode : {"level", "series"}
         How the force ratio enters the likelihood (:class:`friction_uq.likelihood.Likelihood`).
+    ratio_model_form : float
+        Relative sd of eq. 17's ratio against the world (the "level" force term's model-form term).
     """
 
     window: tuple[float, float] | None = None
@@ -43,6 +45,7 @@ class AnalysisSettings:
     axial_poisson: bool = True
     hoop_discrepancy: float = HOOP_DISCREPANCY
     force_mode: str = "level"
+    ratio_model_form: float = RATIO_MODEL_FORM
 
     def __post_init__(self) -> None:
         if self.hoop_mode not in HOOP_MODES:

@@ -27,14 +27,14 @@ from ..noise import ar1_noise
 from ..window import StationaryData
 from .ar1 import ar1_loglike, ar1_offset_correction, ar1_pointwise, offset_sd
 from .force import ForceTerm
-from .force_level import LevelForceTerm
+from .force_level import RATIO_MODEL_FORM, LevelForceTerm
 from .hoop import HOOP_DISCREPANCY, HOOP_MODES, HoopTerm
 
 #: How the force ratio enters the likelihood: by the window levels (default) or sample by sample.
 FORCE_MODES = ("level", "series")
 
 __all__ = [
-    "FORCE_MODES", "HOOP_DISCREPANCY", "HOOP_MODES", "ForceTerm", "HoopTerm", "LevelForceTerm", "Likelihood",
+    "FORCE_MODES", "HOOP_DISCREPANCY", "RATIO_MODEL_FORM", "HOOP_MODES", "ForceTerm", "HoopTerm", "LevelForceTerm", "Likelihood",
     "ar1_loglike", "ar1_noise", "ar1_offset_correction", "ar1_pointwise", "gauge_kernel", "offset_sd",
 ]
 
@@ -79,6 +79,9 @@ class Likelihood:
     model : ClosedFormModel or None
         The forward model over ``data``; None: ``ClosedFormModel(data, hoop=hoop,
         axial_poisson=axial_poisson)``.
+    ratio_model_form : float
+        Relative sd of the closed form's force ratio against the world ("level" force mode:
+        :data:`~.force_level.RATIO_MODEL_FORM`; the "series" mode has no such term).
 
     Attributes
     ----------
@@ -92,6 +95,7 @@ class Likelihood:
     def __init__(
         self, data: StationaryData, *, hoop: bool | None = None, axial_poisson: bool = True, hoop_mode: str = "level",
         model: ClosedFormModel | None = None, hoop_discrepancy: float = HOOP_DISCREPANCY, force_mode: str = "level",
+        ratio_model_form: float = RATIO_MODEL_FORM,
     ) -> None:
         if force_mode not in FORCE_MODES:
             raise ValueError(f"force mode {force_mode!r} is not understood, allowed values: {', '.join(FORCE_MODES)}")
@@ -107,7 +111,8 @@ class Likelihood:
             model = ClosedFormModel(data, hoop=bool(hoop), axial_poisson=axial_poisson)
         self.data = data
         self.model = model
-        self.force = LevelForceTerm(data) if force_mode == "level" else ForceTerm(data)
+        self.force = (LevelForceTerm(data, model_form=ratio_model_form) if force_mode == "level"
+                      else ForceTerm(data))
         self.force_mode = force_mode
         self.hoop = (HoopTerm(data, prediction=model.hoop, mode=hoop_mode, discrepancy=hoop_discrepancy)
                      if hoop else None)
@@ -169,7 +174,10 @@ class Likelihood:
         """Replicated data (posterior predictive) for parameter vectors, with AR(1) noise.
 
         True F_io(t) is taken as the latent estimate given r; F_eo = r F_io (eq. 5, 13). Each
-        replicate and channel also gets a constant offset error of the data's ``sd_offset_*``.
+        replicate and channel also gets a constant offset error of the data's ``sd_offset_*``. In the
+        "level" force mode each replicate's ratio is also r (1 + delta eta), eta standard normal and
+        delta the term's model-form sd (:mod:`.force_level`), drawn after every other number so that
+        the noise is the same draw with or without it.
         ``hoop=False``: the forces only (the same draws as a likelihood without the hoop term).
 
         Returns
@@ -193,4 +201,7 @@ class Likelihood:
             pred = self.hoop.predict(v["f"], v["nu"], v["hoop_gain"])
             out["hoop"] = pred + ar1_noise(shape, sd=self.hoop.sd, rho=self.hoop.rho, rng=rng) \
                 + rng.normal(0.0, self.hoop.offset, (len(x), 1))
+        delta = getattr(fo, "model_form", 0.0)
+        if delta > 0.0:
+            out["F_eo"] = out["F_eo"] + (delta * r * rng.standard_normal(len(x)))[:, None] * x
         return out

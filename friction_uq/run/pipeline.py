@@ -125,7 +125,7 @@ def run_file(
     # the likelihood of this analysis, built once and passed to every stage that needs it
     likelihood = Likelihood(prep.data, hoop=use_hoop, axial_poisson=settings.axial_poisson,
                             hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy,
-                            force_mode=settings.force_mode)
+                            force_mode=settings.force_mode, ratio_model_form=settings.ratio_model_form)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: --out must be a directory, and this is a file")
