@@ -119,7 +119,9 @@ def test_variance_share_matches_law_of_total_variance(run_force):
     share = dg.nu_variance_share(run_force)
     # estimator noise ~ 2 n_bins / n_draws of Var(f|nu) / Var(f) (1e-4 here: the share of Var(f|nu) is ~1 %)
     assert share == pytest.approx(ref, abs=0.001)
-    assert share > 0.95  # the force data fix kappa to ~1 %: nu dominates f's uncertainty
+    # the force data fix kappa to ~2.5 % (the ratio's model-form term), nu's prior sd 0.03 makes (1-nu)/nu
+    # uncertain by ~12 %: nu dominates f's uncertainty (share ~ 0.125^2 / (0.125^2 + 0.025^2) = 0.96)
+    assert share > 0.9
 
 
 def test_f_given_nu_band(run_force):

@@ -51,7 +51,7 @@ def test_analysis_settings_are_in_the_provenance(paper_run):
     """The frozen settings the likelihood was built from, in the JSON and the DataTree's root attrs."""
     _, out, _ = paper_run
     want = {"window": None, "dispersion": False, "hoop": True, "hoop_mode": "level", "axial_poisson": True,
-            "hoop_discrepancy": 0.03, "force_mode": "level"}
+            "hoop_discrepancy": 0.03, "force_mode": "level", "ratio_model_form": 0.025}
     assert json.loads((out / "paper_P-01.json").read_text())["analysis_settings"] == want
     dt = xr.open_datatree(out / "paper_P-01.nc", engine="h5netcdf")
     assert json.loads(dt.attrs["analysis_settings"]) == want

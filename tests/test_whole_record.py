@@ -105,3 +105,19 @@ def test_the_check_of_a_dispersion_corrected_analysis_has_dispersive_bars(tmp_pa
     plain, disp = _check(path), _check(path, dispersion=True)
     assert plain.decision.detected
     assert disp.decision.statistic < 0.5 * plain.decision.statistic
+
+
+def test_the_check_uses_a_cells_own_tolerance_where_one_is_set(tmp_path, monkeypatch):
+    """CHECK_TOLERANCE (set on axisymmetric records) widens the tolerance of its channel and phase only: the
+    worst cell of a plug-friction record drops, every other cell is the same number as before."""
+    from friction_uq.discrepancy import misfit
+
+    path = tmp_path / "plug.h5"
+    simulate_to_file(noisy_config(plug_friction_force=400.0, plug_friction_coefficient=0.02), path, seed=4)
+    chk = _check(path)
+    before = {(c.channel, c.phase): c.statistic for c in chk.decision.cells}
+    worst = max(before, key=before.get)
+    monkeypatch.setitem(misfit.CHECK_TOLERANCE, worst, (0.10, 0.5e-6))
+    after = {(c.channel, c.phase): c.statistic for c in misfit.decide(chk.comparison).cells}
+    assert after[worst] < before[worst]
+    assert {k: v for k, v in after.items() if k != worst} == {k: v for k, v in before.items() if k != worst}

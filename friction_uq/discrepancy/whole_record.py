@@ -50,11 +50,13 @@ TOLERANCE = {"input_bar": 0.01, "internal_output_bar": 0.01, "external_output_ba
 TIMING_TOLERANCE = 0.2e-6
 
 
-def tolerance_sd(measured: np.ndarray, channel: str, *, sample_rate: float) -> np.ndarray:
+def tolerance_sd(measured: np.ndarray, channel: str, *, sample_rate: float, relative: float | None = None,
+                 timing: float | None = None) -> np.ndarray:
     """Standard deviation of the model's tolerated error at each sample (strain).
 
     sqrt((delta_c m_t)^2 + (tau m'_t)^2): m_t the measured |signal| averaged over 2 us, m'_t its
-    largest slope within +-1 us, delta_c :data:`TOLERANCE`, tau :data:`TIMING_TOLERANCE`.
+    largest slope within +-1 us, delta_c :data:`TOLERANCE` (or ``relative``), tau :data:`TIMING_TOLERANCE`
+    (or ``timing``, s).
     """
     from scipy.ndimage import maximum_filter1d, uniform_filter1d
 
@@ -63,7 +65,9 @@ def tolerance_sd(measured: np.ndarray, channel: str, *, sample_rate: float) -> n
     level = uniform_filter1d(np.abs(m), width, mode="nearest")
     slope = maximum_filter1d(np.abs(np.gradient(uniform_filter1d(m, 3, mode="nearest"))) * sample_rate, width,
                              mode="nearest")
-    return np.hypot(TOLERANCE.get(channel, 0.0) * level, TIMING_TOLERANCE * slope)
+    delta = TOLERANCE.get(channel, 0.0) if relative is None else float(relative)
+    tau = TIMING_TOLERANCE if timing is None else float(timing)
+    return np.hypot(delta * level, tau * slope)
 
 
 @dataclass(frozen=True)
