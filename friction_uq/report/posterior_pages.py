@@ -60,9 +60,12 @@ def page_corner(samples: PosteriorSamples, dt: xr.DataTree, *, number: int = 5) 
 
                 handles = [Line2D([], [], color="k", lw=1.2), Line2D([], [], color="k", ls="--", lw=1.0),
                            Line2D([], [], color="C1", lw=1.2)]
-                ax.legend(handles, ["posterior", "posterior 5, 50, 95 %", "prior"], fontsize=8, loc="upper right")
+                # in the empty corner of the grid, above the priors' text: on the diagonal it hid the histogram
+                fig.legend(handles, ["posterior (black: histograms, 50 % and 90 % regions)",
+                                     "posterior 5, 50, 95 % quantiles", "prior (orange)"],
+                           fontsize=8, loc="upper left", bbox_to_anchor=(0.52, 0.93))
         fig.suptitle(f"{number}. Joint posterior of f and nu (90 % and 50 % regions) against the priors", y=0.995)
-        fig.text(0.52, 0.80, "priors (orange):\n" + "\n".join(_prior_lines(samples.prior_description)),
+        fig.text(0.52, 0.83, "priors (orange):\n" + "\n".join(_prior_lines(samples.prior_description)),
                  fontsize=8, va="top")
     return fig
 
