@@ -166,6 +166,12 @@ class Model:
         return scale
 
 
+#: The laws each law holds as special cases (:func:`law_mean`): velocity's is constant where s = d, pressure's where
+#: c = 0; pressure+velocity is velocity where c = 0 and pressure (a = d) where s = d.
+SPECIAL_CASES = {"velocity": ("constant",), "pressure": ("constant",),
+                 "pressure+velocity": ("velocity", "pressure", "constant")}
+
+
 def law_mean(law: str, theta: dict[str, np.ndarray], V: np.ndarray, p_rel: np.ndarray) -> np.ndarray:
     """y for parameter arrays of shape (W, 1) and data of shape (n,); returns (W, n)."""
     if law in ("velocity", "pressure+velocity"):

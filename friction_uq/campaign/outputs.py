@@ -36,7 +36,7 @@ import numpy as np
 
 from .. import __version__
 from .._atomic import atomic_path, write_bytes
-from .analysis import WEIGHT_RULE, CampaignAnalysis, f_law_draws
+from .analysis import CampaignAnalysis, f_law_draws, supported_laws
 from .job import RecordResult
 
 SCHEMA = "friction-uq/campaign"
@@ -135,7 +135,7 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
         "pooled": {k: p.to_json() for k, p in ca.pooled.items()},
         "pooled_stationary": {k: p.to_json() for k, p in ca.pooled_stationary.items()},
         "friction_law": {"best": ca.best, "chosen_model": ca.chosen, "ranking": ca.ranking,
-                         "weights": ca.weights, "supported": WEIGHT_RULE.supported(ca.weights) if ca.weights else [],
+                         "weights": ca.weights, "supported": supported_laws(ca.weights, ca.ranking) if ca.weights else [],
                          "posterior": ca.law_posterior, "models": models,
                          "meanings": {k: parameter_words(k) for m in models.values() for k in m},
                          "next_tests": [{"setup": c.setup, "V": c.V, "p": c.p, "information_nats": c.information}
