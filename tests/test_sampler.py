@@ -196,6 +196,10 @@ def test_progress_callback_and_stderr_line(paper_data, capsys):
     assert done.done and done.line().startswith("sampling: done at step 600 (tau 10.0, steady within 1.0 %)")
     early = Progress(100, 20000, 10.0, float("inf"), 10.0, 0.3, 1.0, 50.0, 0.05)
     assert "20 % of the steps the stopping rule needs (100 of ~500, tau 10.0 not yet measured twice)" in early.line()
+    # long enough but tau not yet steady: not "100 %" of a rule that is not met
+    settling = Progress(600, 20000, 10.0, 0.07, 60.0, 0.3, 1.0, 50.0, 0.05)
+    assert settling.line().startswith("sampling: 600 steps, more than 50 tau (500); waiting for tau 10.0 to settle "
+                                      "(still moving 7.0 %, needs < 5 %)")
 
 
 def test_hoop_without_hoop_gain_prior_is_refused(paper_data):

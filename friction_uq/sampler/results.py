@@ -42,6 +42,10 @@ class Progress:
         share = min(1.0, self.steps / max(need, 1))
         steady = ("steady" if self.tau_change < self.tau_rtol else f"still moving {100 * self.tau_change:.0f} %"
                   if math.isfinite(self.tau_change) else "not yet measured twice")
+        if self.steps >= need and need < self.max_steps:  # long enough; the rule waits for tau to settle
+            return (f"sampling: {self.steps} steps, more than {self.tau_factor:g} tau ({need}); waiting for tau "
+                    f"{self.tau_max:.1f} to settle (still moving {100 * self.tau_change:.1f} %, needs < "
+                    f"{100 * self.tau_rtol:g} %), acceptance {self.acceptance:.2f}, {self.seconds:.1f} s")
         return (f"sampling: {100 * share:.0f} % of the steps the stopping rule needs ({self.steps} of ~{need}, "
                 f"tau {self.tau_max:.1f} {steady}), acceptance {self.acceptance:.2f}, {self.seconds:.1f} s")
 
