@@ -22,7 +22,7 @@ import numpy as np
 from ..priors import load_priors
 from .flags import outlier_tests, setup_flags, tally_causes
 from .job import RecordResult
-from ..stats import WeightRule, stacking_weights
+from ..stats import RULE, WeightRule, stacking_weights
 from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, decisive, law_mean, loo, rank
 from .next_test import Candidate, advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
@@ -124,7 +124,7 @@ def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object
     behind = {law: float(r["d_elpd"]) for law, r in rows.items()}
     richer = {law for law in kept for simple in SPECIAL_CASES.get(law, ())
               if simple != "constant" and simple in kept and law in behind and simple in behind
-              and behind[simple] - behind[law] <= 4.0}
+              and behind[simple] - behind[law] <= RULE.min_delpd}
     return sorted(kept - richer, key=lambda law: (len(LAW_PARAMS.get(law, ())), law))
 
 

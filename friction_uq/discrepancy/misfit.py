@@ -152,14 +152,22 @@ def check_tolerance(channel: str, phase: str) -> tuple[float | None, float | Non
     return CHECK_TOLERANCE.get((channel, phase), (None, None))
 
 
-def cell_test(wr: WholeRecord, channel: str, phase: str, a: int, b: int, *, relative: float | None = None,
-              timing: float | None = None) -> CellTest:
-    """Level and shape z of ``channel`` over samples [a, b) (``phase``), with the relative tolerance ``relative``
-    and the timing tolerance ``timing`` (s) (None: the channel's, :func:`~.whole_record.tolerance_sd`)."""
+def channel_tolerance(wr: WholeRecord, channel: str, *, relative: float | None = None,
+                      timing: float | None = None) -> np.ndarray:
+    """The tolerance over the whole channel (its 2 us filters see across the phase edges), strain."""
     fs = 1.0 / float(wr.time[1] - wr.time[0])
+    return tolerance_sd(wr.measured[channel], channel, sample_rate=fs, relative=relative, timing=timing)
+
+
+def cell_test(wr: WholeRecord, channel: str, phase: str, a: int, b: int, *, relative: float | None = None,
+              timing: float | None = None, tolerance: np.ndarray | None = None) -> CellTest:
+    """Level and shape z of ``channel`` over samples [a, b) (``phase``), with the relative tolerance ``relative``
+    and the timing tolerance ``timing`` (s) (None: the channel's, :func:`~.whole_record.tolerance_sd`), or the
+    channel's tolerance ``tolerance`` computed already (:func:`channel_tolerance`)."""
     resid = wr.measured[channel][a:b] - wr.predicted[channel][:, a:b].mean(axis=0)
-    # the tolerance's level and slope over the whole channel (its 2 us filters see across the phase edges)
-    tol = tolerance_sd(wr.measured[channel], channel, sample_rate=fs, relative=relative, timing=timing)[a:b]
+    if tolerance is None:
+        tolerance = channel_tolerance(wr, channel, relative=relative, timing=timing)
+    tol = tolerance[a:b]
     nz = wr.noise[channel]
     n = b - a
     e = tolerated(resid, tol)
@@ -181,7 +189,13 @@ def phase_spans(wr: WholeRecord, channel: str) -> list[tuple[str, int, int]]:
 
 def decide(wr: WholeRecord, *, threshold: float = THRESHOLD) -> MisfitDecision:
     """Misfit statistic and decision for a whole-record comparison (module docstring)."""
-    cells = [cell_test(wr, ch, phase, a, b, relative=check_tolerance(ch, phase)[0], timing=check_tolerance(ch, phase)[1])
-             for ch in wr.phase_bounds for phase, a, b in phase_spans(wr, ch)]
+    cells = []
+    for ch in wr.phase_bounds:
+        tols: dict[tuple[float | None, float | None], np.ndarray] = {}  # one per tolerance the channel's phases use
+        for phase, a, b in phase_spans(wr, ch):
+            rel, tim = check_tolerance(ch, phase)
+            if (rel, tim) not in tols:
+                tols[(rel, tim)] = channel_tolerance(wr, ch, relative=rel, timing=tim)
+            cells.append(cell_test(wr, ch, phase, a, b, tolerance=tols[(rel, tim)]))
     stat = max((c.statistic for c in cells), default=0.0)
     return MisfitDecision(statistic=stat, threshold=threshold, cells=tuple(cells))
