@@ -13,7 +13,7 @@ import pytest
 
 from friction_uq.analysis import prepare
 from friction_uq.discrepancy import outcome
-from friction_uq.discrepancy.diagnose import beyond, candidates, diagnose
+from friction_uq.discrepancy.diagnose import candidates, diagnose
 from friction_uq.discrepancy.mechanisms import MECHANISMS, Mechanism, register
 from friction_uq.models.parameters import F, HOOP_GAIN, NU
 from friction_uq.priors import default_prior_path, load_priors
@@ -55,39 +55,77 @@ def test_one_friction_law_at_a_time():
     assert len(candidates()) == len(MECHANISMS) + 2  # gauge_gain once per bar gauge
 
 
-def test_decisive_rule():
-    assert not beyond(3.9, 0.1, 40)  # below 4: never
-    assert beyond(10.0, 4.0, 40)  # > 2 SE
-    assert not beyond(10.0, 6.0, 40)
-    assert beyond(500.0, 400.0, 40)  # strong, concentrated evidence
-    assert not beyond(49.0, 61.0, 40)  # strong but within one SE: a clean record's model differences
-    assert not beyond(500.0, 400.0, None)  # the one-SE route is closed until the misfit check finds a misfit
-    assert beyond(500.0, 200.0, None)
-
-
-def _ranked(name, channel, blocks):
+def _fit(name, channel, blocks, f=0.05):
     from types import SimpleNamespace
 
-    from friction_uq.discrepancy.diagnose import Ranked
     from friction_uq.discrepancy.elpd import Elpd
     from friction_uq.discrepancy.extended import Variant
 
-    fit = SimpleNamespace(elpd=Elpd(np.asarray(blocks, float), float("nan")),
-                          variants=(Variant(MECHANISMS[name], channel),))
-    return Ranked(fit, float(np.sum(blocks)), 1.0)
+    label = name if channel is None else f"{name}[{channel}]"
+    return SimpleNamespace(elpd=Elpd(np.asarray(blocks, float), float("nan")), label=label,
+                           variants=(Variant(MECHANISMS[name], channel),) if name != "reference" else (),
+                           f_effective=np.full(100, f))
 
 
-def test_the_same_mechanism_on_another_gauge_is_a_gauge_not_a_mechanism_not_separable():
+def _round(reference, fits):
+    from friction_uq.discrepancy.diagnose import Ranked
+    from friction_uq.discrepancy.elpd import elpd_difference
+
+    return tuple(sorted((Ranked(f, *elpd_difference(f.elpd, reference.elpd)) for f in fits), key=lambda r: -r.delpd))
+
+
+def _noise(n=200, seed=0):
+    return np.random.default_rng(seed).normal(0.0, 0.3, n)
+
+
+def test_evidence_in_a_few_blocks_names_nothing_and_spread_evidence_names_the_cause():
+    from friction_uq.discrepancy.verdict import NamingRule
+
+    base = _fit("reference", None, _noise())
+    few = _noise(seed=1)
+    few[:8] += 40.0  # 320 nats (> 2 SE) from eight blocks of 200: a front a simulator places differently
+    spread = _noise(seed=2) + 0.5  # 100 nats, every block a little better
+    rule = NamingRule(drop_fraction=0.05)
+    v = rule.judge(base, _round(base, [_fit("plug_friction", None, few)]), misfit=True)
+    assert v.candidates[0].decisive and not v.candidates[0].spread
+    assert v.kind == "unexplained" and v.named is None
+    assert rule.judge(base, _round(base, [_fit("plug_friction", None, few)]), misfit=False).kind == "none"
+    v = rule.judge(base, _round(base, [_fit("clearance", None, spread), _fit("plug_friction", None, few)]), misfit=True)
+    assert v.kind == "named" and v.named == "clearance"
+    assert set(v.weights) == {"reference", "clearance", "plug_friction"}
+    assert v.weights["clearance"] > 0.5
+
+
+def test_two_mechanisms_the_record_does_not_separate_are_candidates_and_a_gain_on_another_gauge_is_named():
     from friction_uq.discrepancy.diagnose import separability
+    from friction_uq.discrepancy.verdict import NamingRule
 
-    best = _ranked("gauge_gain", "external_output_bar", [3.0, 3.0, 3.0, 3.0])
-    same = _ranked("gauge_gain", "input_bar", [3.0, 2.9, 3.1, 3.0])
-    other = _ranked("plug_friction", None, [3.0, 3.1, 2.9, 3.0])
-    far = _ranked("clearance", None, [0.5, 0.4, 0.6, 0.5])
-    assert separability([best, same, far]) == ((), ("input_bar",), None)
-    names, channels, how = separability([best, same, other, far])
-    assert names == ("gauge_gain", "plug_friction") and channels == ("input_bar",) and how
-    assert separability([best, far]) == ((), (), None)
+    base = _fit("reference", None, _noise())
+    a = _noise(seed=3) + 0.5
+    b = a + np.random.default_rng(4).normal(0.0, 0.05, a.size)  # about as good, block by block
+    rule = NamingRule()
+    v = rule.judge(base, _round(base, [_fit("velocity_friction", None, a), _fit("pressure_friction", None, b)]),
+                   misfit=True)
+    assert v.kind == "candidates" and {v.named, *v.rivals} == {"velocity_friction", "pressure_friction"}
+    names, channels, how = separability(v)
+    assert set(names) == {"velocity_friction", "pressure_friction"} and channels == () and how
+    v = rule.judge(base, _round(base, [_fit("gauge_gain", "external_output_bar", a),
+                                       _fit("gauge_gain", "input_bar", b)]), misfit=True)
+    assert v.kind == "named"
+    assert separability(v)[:2] == ((), ("input_bar",) if v.named.endswith("[external_output_bar]")
+                                   else ("external_output_bar",))
+
+
+def test_the_mixture_takes_each_model_in_proportion_to_its_weight():
+    from friction_uq.discrepancy.verdict import mixture_draws
+
+    draws = {"a": np.zeros(500), "b": np.ones(500), "c": np.full(10, 2.0)}
+    x, which = mixture_draws(draws, {"a": 0.25, "b": 0.70, "c": 0.05}, n=1000, seed=1)
+    assert x.size == 1000 and np.count_nonzero(x == 0) == 250 and np.count_nonzero(x == 1) == 700
+    assert np.count_nonzero(x == 2) == 50  # more than c has: drawn with replacement
+    assert np.array_equal(which, np.repeat([0, 1, 2], [250, 700, 50]))
+    y, _ = mixture_draws(draws, {"a": 0.25, "b": 0.70, "c": 0.05}, n=1000, seed=1)
+    assert np.array_equal(x, y)
 
 
 def test_extended_models_fitted_on_two_processes_are_the_same_bits(tmp_path):

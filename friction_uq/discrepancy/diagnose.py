@@ -1,24 +1,20 @@
-"""Name the cause of a misfit: rank the extended models (:mod:`.extended`) by block-LOO ELPD.
+"""Name the cause of a misfit: rank the extended models (:mod:`.extended`) by block-LOO ELPD, and read
+each round's verdict with the naming rule of :mod:`.verdict`.
 
-Rule (documented in README.md):
-
-* a mechanism is *decisive* when its dELPD over the reference model exceeds 4 (below that the
-  normal approximation of its error is unreliable) and either twice its standard error, or, when
-  the reference model misses the record (the misfit decision of :mod:`.misfit` on the reference's
-  posterior predictive, calibrated to 1 % false alarms on clean records), both 40 and one standard
-  error. A strong effect lives in a few blocks, the fronts, the rise: its pointwise differences
-  are heavy-tailed and their SE, which assumes exchangeable blocks, overstates chance; but on a
-  clean record the differences between two simulators of the test, which a mechanism with a few
-  parameters can partly absorb, give dELPD about equal to its SE, up to ~40 +- 40 in the
-  calibration study: one SE is accepted only once the misfit check has said the reference model
-  is wrong beyond its tolerance;
-* the cause is the decisive mechanism with the largest dELPD; every other decisive mechanism whose
-  dELPD is within the same margin of it (4, and 2 SE of the pairwise difference, or one SE and
-  max(40, 10 % of the best dELPD)) explains the record about as well: the two are named together
-  as ``not_separable`` from this record, with what would separate them;
-* then the search goes on with the named cause in the model (the reference becomes baseline +
-  cause), for at most four causes (the bundled set-up B hides four mechanisms), so that a record
-  with several effects gets them in order of evidence.
+* a mechanism is named only when its dELPD over the reference model is decisive by the package's rule
+  (above 4 and 2 standard errors), when it stays decisive with the blocks that favour it most left out
+  (the evidence is spread over the record, not a few blocks at a front where two simulators of the same
+  test differ), and when it beats every other such mechanism by the same rule;
+* several mechanisms that pass but do not beat each other are *candidates*: the record does not tell
+  them apart (``not_separable``, with what would separate them), and f is then the stacking mixture of
+  the models that carry the weight; the same mechanism on another gauge (a gain) is named, its gauge
+  listed as uncertain;
+* a misfit of the reference model (the whole-record check's decision, :mod:`.misfit`) that no mechanism
+  explains by that rule is *unexplained*: the candidates are listed with their stacking weights and f is
+  their mixture's;
+* after a named cause the search goes on with it in the model (the reference becomes baseline + cause),
+  for at most four causes, so that a record with several effects gets them in order of evidence; it stops
+  at the first round that names nothing.
 """
 
 from __future__ import annotations
@@ -28,16 +24,22 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
 from ..analysis import Prepared
 from ..stats import RULE
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide
+from .verdict import NamingRule, Verdict, mixture_draws
 from .whole_record import WholeRecord, compare_whole_record
 
-#: After a misfit, the shared rule's strong route (:class:`friction_uq.stats.DecisionRule`) opens above this dELPD.
-STRONG_ELPD = 40.0
+#: The naming rule of every round (:mod:`.verdict`).
+NAMING = NamingRule()
+#: Draws of the stacking mixture that gives f when no single cause is named.
+MIXTURE_DRAWS = 1000
+
 MAX_CAUSES = 4
 #: Processes fitting one round's extended models by default.
 MAX_WORKERS = 4
@@ -68,13 +70,9 @@ class Ranked:
 
     @property
     def decisive(self) -> bool:
-        return beyond(self.delpd, self.se, STRONG_ELPD if self.misfit else None)
-
-
-def beyond(d: float, se: float, strong: float | None) -> bool:
-    """dELPD d (with SE se) is decisive evidence under the package's rule (:data:`friction_uq.stats.RULE`);
-    ``strong`` None: no strong route."""
-    return RULE.decisive(d, se, strong=strong)
+        """Decisive against the round's reference by the package's rule (the naming rule also asks that the
+        evidence be spread over the record and beat every rival: :mod:`.verdict`)."""
+        return RULE.decisive(self.delpd, self.se)
 
 
 @dataclass(frozen=True)
@@ -107,6 +105,17 @@ class Diagnosis:
     #: f_effective (:mod:`.effective_prior`) is computed from when the draws are written
     context: Context | None = None
     seed: int = 0
+    #: each round's verdict (:mod:`.verdict`): the first says whether a cause was named, or candidates, or an
+    #: unexplained misfit
+    verdicts: tuple[Verdict, ...] = ()
+    #: no cause named but candidates or an unexplained misfit: f's draws from the stacking mixture of the models
+    #: that carry the weight, their labels and weights ("reference": the model without causes)
+    mixture_f: np.ndarray | None = None
+    mixture_weights: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def verdict(self) -> Verdict | None:
+        return self.verdicts[0] if self.verdicts else None
 
     @property
     def cause(self) -> Variant | None:
@@ -122,23 +131,18 @@ def rank(reference: ModelFit, fits: list[ModelFit], *, misfit: bool = False) -> 
     return tuple(sorted(out, key=lambda r: -r.delpd))
 
 
-def separability(decisive: list[Ranked]) -> tuple[tuple[str, ...], tuple[str, ...], str | None]:
-    """Who explains the record about as well as the best of the ``decisive`` (module docstring): the
-    mechanisms not separable from it (with it first; empty when none), the other gauges on which the same
-    mechanism does (a gauge_gain: the mechanism is named, its gauge is not certain), and what would
-    separate the mechanisms."""
-    best = decisive[0]
-    named = best.fit.variants[-1]
-    close = []
-    for r in decisive[1:]:
-        d, se = elpd_difference(best.fit.elpd, r.fit.elpd)
-        if not beyond(d, se, max(STRONG_ELPD, 0.1 * best.delpd) if best.misfit else None):
-            close.append(r.fit.variants[-1])
-    channels = tuple(v.channel for v in close if v.mechanism is named.mechanism and v.channel)
-    others = [v.mechanism.name for v in close if v.mechanism is not named.mechanism]
+def separability(verdict: Verdict) -> tuple[tuple[str, ...], tuple[str, ...], str | None]:
+    """Who explains the record about as well as the named model (the verdict's rivals): the mechanisms not
+    separable from it (with it first; empty when none), the other gauges on which the same mechanism does (a
+    gauge_gain: the mechanism is named, its gauge is not certain), and what would separate the mechanisms."""
+    by = {c.label: c for c in verdict.candidates}
+    best = by[verdict.named]
+    close = [by[label] for label in verdict.rivals]
+    channels = tuple(c.channel for c in close if c.mechanism == best.mechanism and c.channel)
+    others = [c.mechanism for c in close if c.mechanism != best.mechanism]
     if not others:
         return (), channels, None
-    names = tuple(dict.fromkeys([named.mechanism.name, *others]))
+    names = tuple(dict.fromkeys([best.mechanism, *others]))
     return names, channels, SEPARATE_BY.get(frozenset(names[:2]), DEFAULT_SEPARATION)
 
 
@@ -163,6 +167,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     reference = base
     causes: list[Variant] = []
     rounds: list[tuple[Ranked, ...]] = []
+    verdicts: list[Verdict] = []
     misfits: list[MisfitDecision] = []
     not_sep: tuple[str, ...] = ()
     other_channels: tuple[str, ...] = ()
@@ -187,12 +192,14 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         fitted += len(jobs)
         ranked = rank(reference, fits, misfit=misfits[-1].detected)
         rounds.append(ranked)
-        decisive = [r for r in ranked if r.decisive]
-        if not decisive:
+        verdict = NAMING.judge(reference, ranked, misfit=misfits[-1].detected, seed=seed + k)
+        verdicts.append(verdict)
+        say(f"round {k + 1}: {verdict.kind}" + (f" ({verdict.named})" if verdict.named else ""))
+        if verdict.named is not None and k == 0:
+            not_sep, other_channels, separate_by = separability(verdict)
+        if verdict.kind != "named":
             break
-        best = decisive[0]
-        if k == 0:
-            not_sep, other_channels, separate_by = separability(decisive)
+        best = next(r for r in ranked if r.fit.label == verdict.named)
         causes.append(best.fit.variants[-1])
         reference = best.fit
     final = reference
@@ -203,6 +210,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     b = compare_whole_record(prep, final.predicted)
     k = ess = float("nan")
     method = None
+    mix, mix_w = (None, {}) if causes or not verdicts else mixture(base, rounds[0], verdicts[0], seed)
     if causes:
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final)
@@ -211,7 +219,22 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
                      not_separable=not_sep, channels_not_separable=other_channels, separate_by=separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
-                     posterior_method=method, context=dg.context, seed=seed)
+                     posterior_method=method, context=dg.context, seed=seed, verdicts=tuple(verdicts),
+                     mixture_f=mix, mixture_weights=mix_w)
+
+
+def mixture(base: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict,
+            seed: int) -> tuple[np.ndarray | None, dict[str, float]]:
+    """f's draws from the stacking mixture of the models that carry the weight (:mod:`.verdict`), when the first
+    round named no single cause but found candidates or an unexplained misfit; (None, {}) otherwise."""
+    if verdict.kind not in ("candidates", "unexplained"):
+        return None, {}
+    fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
+    keep = verdict.supported
+    w = {k: verdict.weights[k] for k in keep}
+    draws, _ = mixture_draws({k: fits[k].f_effective for k in keep}, w, n=MIXTURE_DRAWS, seed=seed)
+    total = sum(w.values())
+    return draws, {k: v / total for k, v in w.items()}
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

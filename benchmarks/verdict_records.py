@@ -1,0 +1,175 @@
+"""Records for calibrating ``diagnose``'s verdict on what the 1-D likelihood did not make, and the first
+round of ``diagnose`` on each, stored so that a naming rule can be evaluated without fitting again.
+
+Groups (f, nu, striker speed, rise time and noise drawn as in ``bench_misfit.py``, both bundled set-ups):
+
+* ``clean_axisymmetric``: the clean test in the axisymmetric simulation (plug, sample and tube in r-z);
+* ``clean_perturbed``: the clean test in the 1-D simulation perturbed in a way no mechanism of the catalogue
+  describes, one of: another mesh (8 or 60 sample elements), the hoop gauge's influence kernel 20 % off
+  (its decay rate) or without its axial term, an incident pulse rising in 8-40 us, gauge noise coloured up to a
+  lag-1 coefficient of 0.995, one channel's timing shifted by up to +-0.5 us (a gauge's position or a
+  trigger's skew);
+* one group per hidden mechanism of ``bench_diagnose.HIDDEN`` (1-D, at its documented strength), and
+  ``axisymmetric_<mechanism>`` for those the axisymmetric simulation also has (plug friction, clearance, the
+  friction laws).
+
+For each record: ``diagnose``'s first round (the baseline against every extended model), written as one
+``.npz`` per record: each model's pointwise block ELPD and calibration terms, its draws of f_effective, the
+misfit decision's flagged cells, and the truth.
+
+    python benchmarks/verdict_records.py OUT_DIR [--clean 20] [--per 4] [--seed 17] [--only GROUP,...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import sys
+import tempfile
+import time
+from types import MappingProxyType
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_diagnose import HIDDEN, analyse, true_f  # noqa: E402
+from bench_misfit import clean_config  # noqa: E402
+
+from friction_uq.errors import FrictionUQError  # noqa: E402
+from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+from friction_uq.record import write_record  # noqa: E402
+from friction_uq.simulate import simulate  # noqa: E402
+from friction_uq.simulate.simulation import MODEL_VERSION  # noqa: E402
+
+#: The mechanisms the axisymmetric simulation also has.
+AXISYMMETRIC_MECHANISMS = ("plug_friction", "clearance", "velocity_friction", "pressure_friction", "slip_friction")
+
+
+def _axisymmetric(c):
+    return dataclasses.replace(c, model=dataclasses.replace(c.model, fidelity="axisymmetric"))
+
+
+def _perturbation(c, r: np.random.Generator) -> tuple[object, str | None, str]:
+    """One perturbation no mechanism describes: (config, channel to shift or None, what it is)."""
+    kind = str(r.choice(["mesh", "kernel", "pulse", "coloured", "timing"]))
+    if kind == "mesh":
+        n = int(r.choice([8, 60]))
+        return dataclasses.replace(c, elements=n), None, f"mesh {n} elements"
+    if kind == "kernel":
+        if r.random() < 0.5:
+            return dataclasses.replace(c, hoop_axial_term=False), None, "hoop kernel without its axial term"
+        k = float(r.choice([0.8, 1.2]))
+        return dataclasses.replace(c, hoop_beta=c.hoop_beta * k), None, f"hoop kernel decay x{k:g}"
+    if kind == "pulse":
+        tr = float(r.uniform(8e-6, 40e-6))
+        return dataclasses.replace(c, rise_time=tr), None, f"rise time {tr * 1e6:.0f} us"
+    if kind == "coloured":
+        a = float(r.uniform(0.9, 0.995))
+        ch = {k: dataclasses.replace(s, ar1=s.ar1 * float(r.uniform(1.0, 2.0)), ar1_coef=a) for k, s in c.channels.items()}
+        return dataclasses.replace(c, channels=MappingProxyType(ch)), None, f"noise lag-1 {a:.3f}"
+    ch = str(r.choice(["input_bar", "internal_output_bar", "external_output_bar", "tube_hoop"]))
+    return c, ch, f"{ch} timing {float(r.uniform(-0.5, 0.5)):+.2f} us"
+
+
+def groups() -> list[str]:
+    return (["clean_axisymmetric", "clean_perturbed"] + list(HIDDEN)
+            + [f"axisymmetric_{m}" for m in AXISYMMETRIC_MECHANISMS])
+
+
+def make(group: str, k: int, r: np.random.Generator):
+    """The configuration of record ``k`` of ``group``, the channel to shift (and by how much, s) and a note."""
+    cfg = clean_config(r, "A" if k % 2 == 0 else "B")
+    shift, note = None, ""
+    if group == "clean_axisymmetric":
+        cfg, note = _axisymmetric(cfg), "axisymmetric"
+    elif group == "clean_perturbed":
+        cfg, ch, note = _perturbation(cfg, r)
+        if ch is not None:
+            shift = (ch, float(note.split("timing ")[1].split(" us")[0]) * 1e-6)
+    else:
+        mech = group.removeprefix("axisymmetric_")
+        cfg = HIDDEN[mech](cfg, r)
+        note = mech
+        if group.startswith("axisymmetric_"):
+            cfg, note = _axisymmetric(cfg), f"axisymmetric {mech}"
+    return cfg, shift, note
+
+
+def write(cfg, path: str, seed: int, shift) -> object:
+    sim = simulate(cfg, seed=seed)
+    noisy = dict(sim.noisy)
+    if shift is not None:  # the channel read dt later (or earlier) than its neighbours
+        ch, dt = shift
+        t = sim.time
+        noisy[ch] = np.interp(t - dt, t, noisy[ch])
+    spv = {n: float(s.strain_per_volt) for n, s in cfg.channels.items()
+           if n in noisy and s.units == "V" and s.strain_per_volt is not None}
+    write_record(path, test_id=os.path.basename(path)[:-3], campaign="V", sample_rate=cfg.sample_rate, strains=noisy,
+                 apparatus=cfg.apparatus, t0=float(sim.time[0]),
+                 units={n: s.units for n, s in cfg.channels.items() if n in noisy}, strain_per_volt=spv,
+                 striker_velocity=cfg.striker_velocity, truth=sim.truth,
+                 provenance={"simulator_model_version": MODEL_VERSION, "seed": int(sim.seed)})
+    return sim
+
+
+def dump(out: str, name: str, group: str, note: str, cfg, prep, dg) -> None:
+    """Round 1 of ``dg`` (a Diagnosis) as ``out/name.npz`` (module docstring)."""
+    base = dg.baseline
+    arrays = {"base_pointwise": base.elpd.pointwise, "base_calibration": base.elpd.calibration,
+              "base_calibration_mean": base.elpd.calibration_mean, "base_calibration_var": base.elpd.calibration_var,
+              "base_f": base.f_effective[:400]}
+    models = []
+    for i, rk in enumerate(dg.rounds[0]):
+        e = rk.fit.elpd
+        arrays |= {f"m{i}_pointwise": e.pointwise, f"m{i}_calibration": e.calibration,
+                   f"m{i}_calibration_mean": e.calibration_mean, f"m{i}_calibration_var": e.calibration_var,
+                   f"m{i}_f": rk.fit.f_effective[:400]}
+        v = rk.fit.variants[-1]
+        models.append({"label": rk.fit.label, "mechanism": v.mechanism.name, "channel": v.channel,
+                       "calibration_names": list(e.calibration_names), "delpd": rk.delpd, "se": rk.se})
+    m = dg.misfits[0]
+    meta = {"group": group, "note": note, "truth_f": true_f(cfg, prep), "misfit": bool(m.detected),
+            "flagged": [[c.channel, c.phase, c.statistic] for c in m.flagged()],
+            "base_calibration_names": list(base.elpd.calibration_names), "models": models,
+            "named_now": dg.cause.mechanism.name if dg.cause else None}
+    np.savez_compressed(os.path.join(out, f"{name}.npz"), meta=json.dumps(meta), **arrays)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out")
+    ap.add_argument("--clean", type=int, default=20, help="records of each clean group")
+    ap.add_argument("--per", type=int, default=4, help="records of each mechanism group")
+    ap.add_argument("--seed", type=int, default=17)
+    ap.add_argument("--only", help="comma-separated groups")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    only = set(a.only.split(",")) if a.only else None
+    priors = load_priors(default_prior_path("I1"))
+    rng = np.random.default_rng(a.seed)
+    tmp = tempfile.mkdtemp()
+    jobs = [(g, k) for g in groups() for k in range(a.clean if g.startswith("clean") else a.per)]
+    for g, k in jobs:
+        cfg, shift, note = make(g, k, rng)
+        sim_seed = int(rng.integers(2**31))
+        name = f"{g}-{k}"
+        if (only is not None and g not in only) or os.path.exists(os.path.join(a.out, f"{name}.npz")):
+            continue
+        path = os.path.join(tmp, f"{name}.h5")
+        t = time.perf_counter()
+        try:
+            write(cfg, path, sim_seed, shift)
+            prep, dg = analyse(path, priors, seed=k, max_causes=1)
+        except FrictionUQError as exc:
+            print(f"{name}: refused: {exc}", flush=True)
+            continue
+        dump(a.out, name, g, note, cfg, prep, dg)
+        os.remove(path)
+        print(f"{name} ({note}): misfit {dg.misfits[0].detected}, named {dg.cause.mechanism.name if dg.cause else None}, "
+              f"{time.perf_counter() - t:.0f} s", flush=True)
+
+
+if __name__ == "__main__":
+    main()
