@@ -13,7 +13,7 @@ import pytest
 
 from friction_uq.analysis import prepare
 from friction_uq.discrepancy import outcome
-from friction_uq.discrepancy.diagnose import beyond, candidates, diagnose
+from friction_uq.discrepancy.diagnose import Ranked, candidates, diagnose
 from friction_uq.discrepancy.mechanisms import MECHANISMS, Mechanism, register
 from friction_uq.models.parameters import F, HOOP_GAIN, NU
 from friction_uq.priors import default_prior_path, load_priors
@@ -56,13 +56,16 @@ def test_one_friction_law_at_a_time():
 
 
 def test_decisive_rule():
-    assert not beyond(3.9, 0.1, 40)  # below 4: never
-    assert beyond(10.0, 4.0, 40)  # > 2 SE
-    assert not beyond(10.0, 6.0, 40)
-    assert beyond(500.0, 400.0, 40)  # strong, concentrated evidence
-    assert not beyond(49.0, 61.0, 40)  # strong but within one SE: a clean record's model differences
-    assert not beyond(500.0, 400.0, None)  # the one-SE route is closed until the misfit check finds a misfit
-    assert beyond(500.0, 200.0, None)
+    def decisive(d: float, se: float, misfit: bool) -> bool:  # a ranked candidate's verdict (its fit is not read)
+        return Ranked(None, d, se, misfit=misfit).decisive
+
+    assert not decisive(3.9, 0.1, True)  # below 4: never
+    assert decisive(10.0, 4.0, True)  # > 2 SE
+    assert not decisive(10.0, 6.0, True)
+    assert decisive(500.0, 400.0, True)  # strong, concentrated evidence
+    assert not decisive(49.0, 61.0, True)  # strong but within one SE: a clean record's model differences
+    assert not decisive(500.0, 400.0, False)  # the one-SE route is closed until the misfit check finds a misfit
+    assert decisive(500.0, 200.0, False)
 
 
 def _ranked(name, channel, blocks):

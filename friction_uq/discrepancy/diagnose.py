@@ -68,13 +68,7 @@ class Ranked:
 
     @property
     def decisive(self) -> bool:
-        return beyond(self.delpd, self.se, STRONG_ELPD if self.misfit else None)
-
-
-def beyond(d: float, se: float, strong: float | None) -> bool:
-    """dELPD d (with SE se) is decisive evidence under the package's rule (:data:`friction_uq.stats.RULE`);
-    ``strong`` None: no strong route."""
-    return RULE.decisive(d, se, strong=strong)
+        return RULE.decisive(self.delpd, self.se, strong=STRONG_ELPD if self.misfit else None)
 
 
 @dataclass(frozen=True)
@@ -132,7 +126,7 @@ def separability(decisive: list[Ranked]) -> tuple[tuple[str, ...], tuple[str, ..
     close = []
     for r in decisive[1:]:
         d, se = elpd_difference(best.fit.elpd, r.fit.elpd)
-        if not beyond(d, se, max(STRONG_ELPD, 0.1 * best.delpd) if best.misfit else None):
+        if not RULE.decisive(d, se, strong=max(STRONG_ELPD, 0.1 * best.delpd) if best.misfit else None):
             close.append(r.fit.variants[-1])
     channels = tuple(v.channel for v in close if v.mechanism is named.mechanism and v.channel)
     others = [v.mechanism.name for v in close if v.mechanism is not named.mechanism]
