@@ -31,7 +31,8 @@ from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
 from ..stats.exact import ExactDraws, exact_draws
-from .elpd import Elpd, ar1_block_loo, calibration_loo, takeuchi_block_loo, with_calibration
+from ..stats.ar1 import ar1_block_loo
+from .elpd import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record, robust_covariance
 from .mechanisms import MECHANISMS, Context, Mechanism
 

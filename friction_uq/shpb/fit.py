@@ -9,7 +9,7 @@ normal density (Pareto-smoothed, arviz-stats PSIS; the k of those weights is rep
 says the normal approximation is poor).
 
 ELPD. The residual of each draw is cut into blocks of ``BLOCK`` seconds; each block's exact
-Gaussian AR(1) density given the rest of the residual (:func:`~friction_uq.discrepancy.elpd.ar1_block_loo`)
+Gaussian AR(1) density given the rest of the residual (:func:`~friction_uq.stats.ar1.ar1_block_loo`)
 is integrated over the posterior by PSIS-LOO (:func:`~friction_uq.discrepancy.elpd.psis_loo`).
 5 us is 50 samples at 10 MS/s, tens of the noise's correlation times, and leaves ~16 blocks over
 the LANL record's 80 us span. A model with no free parameter is scored at its one prediction.
@@ -41,10 +41,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from ..discrepancy.elpd import Elpd, ar1_block_loo, psis_loo
-from ..stats import psis
-from ..likelihood import ar1_loglike
+from ..discrepancy.elpd import Elpd, psis_loo
 from ..models.parameters import Parameter
+from ..stats import psis
+from ..stats.ar1 import ar1_block_loo, ar1_loglike
 from .balance import BalanceObservation, Misfit
 from .mechanisms import CombinedModel
 
