@@ -50,6 +50,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..stats import RULE, paired_difference
+from ..stats.streams import legacy_state
 from .kernels import draw_kernels, log_kernel_mixture
 
 LAWS = ("constant", "velocity", "pressure", "pressure+velocity")
@@ -268,7 +269,7 @@ class Fit:
         rng = np.random.default_rng(seed)
         start = self._start(rng, nwalkers) if start is None else np.asarray(start, float)
         sampler = emcee.EnsembleSampler(nwalkers, start.shape[1], self._log_prob, vectorize=True)
-        state = emcee.State(start, random_state=np.random.RandomState(int(rng.integers(2**31))).get_state())
+        state = emcee.State(start, random_state=legacy_state(rng).get_state())
         sampler.run_mcmc(state, nsteps)
         return sampler.get_chain(discard=burn, thin=5, flat=True)
 

@@ -24,7 +24,7 @@ also for a misspecified model):
 
 g_b the gradient of the block's log density in the unbounded parameters (from the Jacobian of the
 whitened residuals that the fit already has: g_b = -J_b^T w_b) and Sigma the posterior covariance
-(Laplace). PSIS over importance-weighted draws (:func:`psis_loo`) is the alternative when draws
+(Laplace). PSIS over importance-weighted draws (:func:`friction_uq.stats.elpd.psis_loo`) is the alternative when draws
 are affordable; with tens of draws of a posterior this narrow its Pareto k exceeded 0.7 on most
 blocks, which is why the first-order form is the default.
 
@@ -103,17 +103,6 @@ class Elpd:
     @property
     def se(self) -> float:
         return float(math.sqrt(len(self.pointwise)) * np.std(self.pointwise, ddof=1))
-
-
-def psis_loo(log_lik: np.ndarray, log_weights: np.ndarray) -> Elpd:
-    """PSIS-LOO from per-draw pointwise log densities (S, P) and the draws' log importance weights (S,)."""
-    from ..stats import psis
-
-    ll = np.asarray(log_lik, float)
-    lw = (np.asarray(log_weights, float)[:, None] - ll).T  # leave-one-out importance ratios, (P, S)
-    res = psis(lw)
-    point = np.logaddexp.reduce(res.log_weights + ll.T, axis=-1)
-    return Elpd(pointwise=point, pareto_k_max=float(np.nanmax(res.pareto_k)))
 
 
 def takeuchi_block_loo(log_density_mode: np.ndarray, jacobian: np.ndarray, whitened: np.ndarray,
