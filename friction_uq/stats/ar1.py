@@ -13,7 +13,6 @@ import math
 import numpy as np
 
 from .._jit import njit
-from ..signals import ar1_mean_sd
 
 #: log(2 pi), the normal density's constant.
 LOG_2PI = math.log(2.0 * math.pi)
@@ -83,9 +82,18 @@ def ar1_loglike(
     return out
 
 
+def ar1_mean_sd(sd: float, rho: float, n: int) -> float:
+    """Standard deviation of the mean of ``n`` AR(1) samples, sd sqrt((1 + rho) / ((1 - rho) n)) (large n).
+
+    >>> round(ar1_mean_sd(2.0, 0.0, 100), 6)
+    0.2
+    """
+    return sd * math.sqrt((1.0 + rho) / ((1.0 - rho) * max(n, 1)))
+
+
 def offset_sd(sd: float, rho: float, n_baseline: int) -> float:
     """Standard deviation of the mean of ``n_baseline`` AR(1) samples: the error of an offset removed
-    with the mean of a pre-pulse segment (:func:`friction_uq.signals.ar1_mean_sd`)."""
+    with the mean of a pre-pulse segment (:func:`ar1_mean_sd`)."""
     return ar1_mean_sd(sd, rho, n_baseline)
 
 
