@@ -1,7 +1,7 @@
 """Optional compilation with numba.
 
 The time loop of the cell (:mod:`.simulate.cell`), the hoop gauge (:mod:`.simulate.hoop`) and the AR(1)
-conditional densities with an offset (:mod:`.likelihood.ar1`) are written as plain
+conditional densities with an offset (:mod:`.stats.ar1`) are written as plain
 Python loops over scalars and compiled with ``numba.njit`` when numba is installed (about 1 ms
 per record instead of seconds). Without numba the same functions run as ordinary Python: results
 are identical, only slower. Compiled code is cached on disk (``cache=True``) next to the modules.

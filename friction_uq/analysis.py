@@ -17,7 +17,8 @@ from .physics import cell
 from .errors import NoStationaryPhase, SignalError
 from .gauge_check import gauge_findings
 from .record import Record
-from .signals import ar1_mean_sd, moving_average
+from .signals import moving_average
+from .stats.ar1 import ar1_mean_sd
 from .window import (
     StationaryData,
     Window,

@@ -27,7 +27,7 @@ import numpy as np
 
 from .forces import Forces
 from .record import Apparatus, Record
-from .signals import ar1_mean_sd
+from .stats.ar1 import ar1_mean_sd
 
 #: Largest |S - 1| of a sound record's force balance over the loading.
 BALANCE_TOL = 0.05

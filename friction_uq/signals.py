@@ -32,6 +32,7 @@ import scipy.fft as scipy_fft
 
 from .dispersion import propagate
 from .errors import SignalError
+from .stats.ar1 import ar1_mean_sd
 
 #: Threshold, in noise standard deviations, for the first crossing that starts an arrival search.
 ARRIVAL_SIGMAS = 8.0
@@ -83,15 +84,6 @@ class NoiseEstimate:
         constant over the window.
         """
         return scale * math.hypot(ar1_mean_sd(self.sd, self.rho_eff, n), self.offset_sd)
-
-
-def ar1_mean_sd(sd: float, rho: float, n: int) -> float:
-    """Standard deviation of the mean of ``n`` AR(1) samples, sd sqrt((1 + rho) / ((1 - rho) n)) (large n).
-
-    >>> round(ar1_mean_sd(2.0, 0.0, 100), 6)
-    0.2
-    """
-    return sd * math.sqrt((1.0 + rho) / ((1.0 - rho) * max(n, 1)))
 
 
 def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate:

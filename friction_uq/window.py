@@ -31,7 +31,8 @@ import numpy as np
 from .errors import NoStationaryPhase, SignalError
 from .forces import Forces
 from .record import Apparatus, Tube
-from .signals import ar1_mean_sd, moving_average
+from .signals import moving_average
+from .stats.ar1 import ar1_mean_sd
 
 
 @dataclass(frozen=True)

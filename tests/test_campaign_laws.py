@@ -247,7 +247,15 @@ def test_with_two_setups_the_causes_name_the_one_that_is_off():
 
 
 def test_decisive_uses_students_t_for_few_tests():
-    from friction_uq.campaign.laws import decisive
+    """The law chosen: constant, unless velocity (the top) is decisively ahead of it over the tests."""
+    from friction_uq.campaign.laws import LAWS, best_law
+
+    def decisive(d: float, se: float, n: int | None = None) -> bool:
+        rows = [{"model": "velocity", "d_elpd": 0.0, "d_se": 0.0}, {"model": "constant", "d_elpd": d, "d_se": se}]
+        if n is not None:
+            for r in rows:
+                r["n_tests"] = n
+        return best_law(rows, LAWS) == "velocity"
 
     assert decisive(4.3, 2.1)  # 2 SE when the number of tests is not given
     assert not decisive(4.3, 2.1, 10)  # t(0.975, 9) = 2.26: 4.75 needed

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from friction_uq.discrepancy.elpd import (CALIBRATION_FLOOR, Elpd, ar1_block_loo, calibration_loo, elpd_difference,
-                                         psis_loo, with_calibration)
+from friction_uq.discrepancy.elpd import CALIBRATION_FLOOR, Elpd, calibration_loo, elpd_difference, with_calibration
+from friction_uq.stats.ar1 import ar1_block_loo
+from friction_uq.stats.elpd import psis_loo
 
 
 @pytest.mark.parametrize("n,block", [(23, 5), (20, 5), (7, 7), (9, 4)])

@@ -14,7 +14,7 @@ from test_sbc import closed_form_data
 from friction_uq.likelihood import Likelihood
 from friction_uq.likelihood.force_level import RATIO_MODEL_FORM, LevelForceTerm, batch_count, batch_means
 from friction_uq.physics import cell
-from friction_uq.signals import ar1_mean_sd
+from friction_uq.stats.ar1 import ar1_mean_sd
 
 
 def _posterior_of_r(term, lo=1e-3, hi=1.0, n=200_001):

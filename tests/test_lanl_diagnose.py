@@ -31,7 +31,7 @@ from friction_uq.shpb import (
     fit_balance,
     read_lanl_raw,
 )
-from friction_uq.shpb.diagnose import decisive
+from friction_uq.shpb.diagnose import Candidate
 
 RECORD = (Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "real" / "lanl-hoppybar-cu"
           / "20061201_1148HE_CuOFE_273K.raw")
@@ -114,6 +114,9 @@ def test_unknown_mechanism_is_refused() -> None:
 
 
 def test_decision_rule() -> None:
+    def decisive(d: float, se: float) -> bool:  # a selection step's verdict on a candidate (its fit is not read)
+        return Candidate("gauge_gain", None, d, se).decisive
+
     assert decisive(4.1, 2.0) and not decisive(4.0, 1.0) and not decisive(50.0, 25.1)
 
 

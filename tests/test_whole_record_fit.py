@@ -10,7 +10,8 @@ import pytest
 from scipy import stats
 
 from friction_uq.analysis import prepare
-from friction_uq.discrepancy.fit import GAIN_SD, WholeRecordLikelihood, robust_covariance
+from friction_uq.discrepancy.fit import GAIN_SD, WholeRecordLikelihood
+from friction_uq.stats.laplace import robust_covariance
 from friction_uq.discrepancy.record_likelihood import HOOP_GAIN_SD
 from friction_uq.models import SimulatorModel, measured_loading
 from friction_uq.record import read_record

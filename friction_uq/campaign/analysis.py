@@ -23,7 +23,7 @@ from ..priors import load_priors
 from .flags import outlier_tests, setup_flags, tally_causes
 from .job import RecordResult
 from ..stats import RULE, WeightRule, stacking_weights
-from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, decisive, law_mean, loo, rank
+from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, law_mean, loo, rank
 from .next_test import Candidate, advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
 from .pooling import Pooled, implied_kappa_log_prior, thin
@@ -110,7 +110,7 @@ def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None
 
 def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
     """The laws the comparison cannot set apart: those that carry the stacking weight (:data:`WEIGHT_RULE`) and
-    every law whose ELPD is not decisively behind the best's (:func:`~.laws.decisive`: dELPD > 4 and beyond
+    every law whose ELPD is not decisively behind the best's (:data:`friction_uq.stats.RULE`: dELPD > 4 and beyond
     t(0.975, n - 1) SE over the n tests), less a law that holds another of them as a special case
     (:data:`~.laws.SPECIAL_CASES`, constant excepted) without predicting the tests more than 4 better than it:
     its extra term is not asked for by the data. Stacking puts its weight on one of several laws that predict the
@@ -118,8 +118,8 @@ def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object
     of each other took weights 0.83, 0.65 and 0.96 in turn over seeds 1-3); the set of laws not ruled out does
     not. Simplest first (fewest parameters, then name), so that the same set reads the same."""
     rows = {str(r.get("law", r["model"])): r for r in ranking}
-    close = [law for law, r in rows.items() if law in weights and not decisive(
-        float(r["d_elpd"]), float(r["d_se"]), int(r["n_tests"]) if r.get("n_tests") else None)]
+    close = [law for law, r in rows.items() if law in weights and not RULE.decisive(
+        float(r["d_elpd"]), float(r["d_se"]), n=int(r["n_tests"]) if r.get("n_tests") else None)]
     kept = set(WEIGHT_RULE.supported(weights)) | set(close)
     behind = {law: float(r["d_elpd"]) for law, r in rows.items()}
     richer = {law for law in kept for simple in SPECIAL_CASES.get(law, ())

@@ -19,7 +19,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from .job import RecordResult
-from .laws import Elpd, decisive, difference
+from ..stats import RULE, paired_difference
+from .laws import Elpd
 
 TEST_OUTLIER_ELPD = 4.0
 
@@ -61,8 +62,8 @@ def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]
     flags = []
     pair = len(setups) == 2
     for s, (e, delta) in with_offset.items():
-        d, se = difference(e, base)
-        if not decisive(d, se, e.pointwise.size):
+        d, se = paired_difference(e.pointwise, base.pointwise)
+        if not RULE.decisive(d, se, n=e.pointwise.size):
             continue
         other = [x for x in setups if x != s]
         entry: dict[str, object] = {

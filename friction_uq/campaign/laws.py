@@ -50,6 +50,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..stats import RULE, paired_difference
+from ..stats.streams import legacy_state
 from .kernels import draw_kernels, log_kernel_mixture
 
 LAWS = ("constant", "velocity", "pressure", "pressure+velocity")
@@ -268,7 +269,7 @@ class Fit:
         rng = np.random.default_rng(seed)
         start = self._start(rng, nwalkers) if start is None else np.asarray(start, float)
         sampler = emcee.EnsembleSampler(nwalkers, start.shape[1], self._log_prob, vectorize=True)
-        state = emcee.State(start, random_state=np.random.RandomState(int(rng.integers(2**31))).get_state())
+        state = emcee.State(start, random_state=legacy_state(rng).get_state())
         sampler.run_mcmc(state, nsteps)
         return sampler.get_chain(discard=burn, thin=5, flat=True)
 
@@ -312,24 +313,13 @@ def _one(d: LawData, i: int) -> LawData:
     return d.select(np.arange(d.n) == i)
 
 
-def decisive(d_elpd: float, se: float, n: int | None = None) -> bool:
-    """The package's rule (:data:`friction_uq.stats.RULE`) over ``n`` tests: dELPD > 4 and beyond t(0.975, n - 1)
-    standard errors (2 when ``n`` is None)."""
-    return RULE.decisive(d_elpd, se, n=n)
-
-
-def difference(a: Elpd, b: Elpd) -> tuple[float, float]:
-    """ELPD(a) - ELPD(b) and its standard error, paired over tests (:func:`friction_uq.stats.paired_difference`)."""
-    return paired_difference(a.pointwise, b.pointwise)
-
-
 def rank(elpds: Sequence[Elpd]) -> list[dict[str, float | str]]:
     """Models by ELPD, each with dELPD and SE against the top one."""
     order = sorted(elpds, key=lambda e: -e.elpd)
     top = order[0]
     out = []
     for e in order:
-        d, se = difference(top, e)
+        d, se = paired_difference(top.pointwise, e.pointwise)
         out.append({"model": e.model, "elpd": e.elpd, "se": e.se, "d_elpd": d, "d_se": se, "n_tests": int(e.pointwise.size),
                     "pareto_k_max": float(np.max(e.pareto_k)), "refits": e.refits})
     return out
@@ -337,7 +327,7 @@ def rank(elpds: Sequence[Elpd]) -> list[dict[str, float | str]]:
 
 def best_law(ranking: Sequence[dict], laws: Sequence[str]) -> str | None:
     """The simplest law that every law not decisively worse than the top contains; None if there is none."""
-    contenders = [r["model"] for r in ranking if not decisive(r["d_elpd"], r["d_se"], r.get("n_tests"))]
+    contenders = [r["model"] for r in ranking if not RULE.decisive(r["d_elpd"], r["d_se"], n=r.get("n_tests"))]
     contenders = [m for m in contenders if m in laws]
     for law in sorted(contenders, key=lambda m: len(LAW_PARAMS[m])):
         if all(other in NESTS[law] for other in contenders):

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..analysis import Prepared
 from ..models import SimulatorModel, measured_loading
+from ..stats.streams import stream
 from .extended import NU_STARTS
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .misfit import MisfitDecision, decide
@@ -58,7 +59,7 @@ def check_whole_record(prep: Prepared, log_prior: Callable[[Mapping[str, float]]
                            dispersion=disp,
                            dispersive_loading=measured_loading(rec, prep.forces, dispersion=True) if disp else None)
     lik = WholeRecordLikelihood(prep, model)
-    rng = np.random.default_rng(np.random.SeedSequence([seed, 8]))
+    rng = stream(seed, "whole-record check")
     fit = fit_whole_record(lik, log_prior, {"f": start["f"], "nu": start["nu"]}, n_draws=n_draws, rng=rng,
                            extra_starts=tuple({"nu": nu} for nu in NU_STARTS))
     gain = lik.strains(fit.mode)[1]

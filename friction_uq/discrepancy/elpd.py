@@ -24,7 +24,7 @@ also for a misspecified model):
 
 g_b the gradient of the block's log density in the unbounded parameters (from the Jacobian of the
 whitened residuals that the fit already has: g_b = -J_b^T w_b) and Sigma the posterior covariance
-(Laplace). PSIS over importance-weighted draws (:func:`psis_loo`) is the alternative when draws
+(Laplace). PSIS over importance-weighted draws (:func:`friction_uq.stats.elpd.psis_loo`) is the alternative when draws
 are affordable; with tens of draws of a posterior this narrow its Pareto k exceeded 0.7 on most
 blocks, which is why the first-order form is the default.
 
@@ -54,60 +54,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..stats.ar1 import LOG_2PI as _LOG_2PI
 from ..stats.decision import paired_difference
-
-_LOG_2PI = math.log(2.0 * math.pi)
-
-
-def _block_constants(length: int, rho: float, first: bool, last: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """Diagonal of T_bb, rho T_bb^-1 u_first, rho T_bb^-1 u_last and log det T_bb for one block."""
-    diag = np.full(length, 1.0 + rho * rho)
-    if first:
-        diag[0] = 1.0
-    if last:
-        diag[-1] = 1.0
-    if length == 1 and first and last:
-        diag[0] = 1.0 - rho * rho  # a one-sample series: its marginal
-    T = np.diag(diag) - rho * (np.eye(length, k=1) + np.eye(length, k=-1))
-    inv = np.linalg.inv(T)
-    sign, logdet = np.linalg.slogdet(T)
-    return diag, rho * inv[:, 0], rho * inv[:, -1], float(logdet)
-
-
-def ar1_block_loo(resid: np.ndarray, *, sd: float, rho: float, block: int) -> np.ndarray:
-    """log p(e_b | e_-b) for consecutive blocks of an AR(1) residual series (module docstring).
-
-    Parameters
-    ----------
-    resid : array, shape (S, n)
-        Residual series (one row per posterior draw).
-    sd, rho : float
-        Marginal standard deviation and lag-1 coefficient of the noise.
-    block : int
-        Block length (samples); the last block takes what is left.
-
-    Returns
-    -------
-    array, shape (S, ceil(n / block))
-    """
-    e = np.atleast_2d(np.asarray(resid, float))
-    S, n = e.shape
-    var_c = sd * sd * (1.0 - rho * rho)
-    starts = np.arange(0, n, block)
-    out = np.empty((S, len(starts)))
-    for k, a in enumerate(starts):
-        L = min(block, n - a)
-        diag, g, h, logdet = _block_constants(L, rho, a == 0, a + L == n)
-        mu = np.zeros((S, L))
-        if a > 0:
-            mu += e[:, a - 1, None] * g
-        if a + L < n:
-            mu += e[:, a + L, None] * h
-        r = e[:, a:a + L] - mu
-        quad = np.sum(diag * r * r, axis=1) - 2.0 * rho * np.sum(r[:, 1:] * r[:, :-1], axis=1)
-        out[:, k] = -0.5 * L * (_LOG_2PI + math.log(var_c)) + 0.5 * logdet - 0.5 * quad / var_c
-    return out
-
 
 #: The smallest share of a calibration datum's variance s^2 taken as not yet told by the record (s^2 - v >=
 #: this s^2): where the record says nothing of the quantity, its posterior is the datum and the left-out
@@ -155,17 +103,6 @@ class Elpd:
     @property
     def se(self) -> float:
         return float(math.sqrt(len(self.pointwise)) * np.std(self.pointwise, ddof=1))
-
-
-def psis_loo(log_lik: np.ndarray, log_weights: np.ndarray) -> Elpd:
-    """PSIS-LOO from per-draw pointwise log densities (S, P) and the draws' log importance weights (S,)."""
-    from ..stats import psis
-
-    ll = np.asarray(log_lik, float)
-    lw = (np.asarray(log_weights, float)[:, None] - ll).T  # leave-one-out importance ratios, (P, S)
-    res = psis(lw)
-    point = np.logaddexp.reduce(res.log_weights + ll.T, axis=-1)
-    return Elpd(pointwise=point, pareto_k_max=float(np.nanmax(res.pareto_k)))
 
 
 def takeuchi_block_loo(log_density_mode: np.ndarray, jacobian: np.ndarray, whitened: np.ndarray,

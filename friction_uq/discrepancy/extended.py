@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 import multiprocessing
-import zlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
@@ -30,9 +29,12 @@ from .._parallel import can_fork, end_with_parent
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
+from ..stats.ar1 import ar1_block_loo
 from ..stats.exact import ExactDraws, exact_draws
-from .elpd import Elpd, ar1_block_loo, calibration_loo, takeuchi_block_loo, with_calibration
-from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record, robust_covariance
+from ..stats.laplace import robust_covariance
+from ..stats.streams import stream
+from .elpd import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
+from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
 
 #: Block of the leave-one-block-out ELPD (s).
@@ -122,7 +124,7 @@ class Diagnoser:
             for p in v.mechanism.parameters:
                 st[p.name] = start.get(p.name, v.mechanism.start[p.name])
         # seeded by the model's label: the same draws whichever process fits it, in whatever order
-        rng = np.random.default_rng(np.random.SeedSequence([self.seed, 9, zlib.crc32(label.encode())]))
+        rng = stream(self.seed, "extended fit", label)
         scales = {"sample_modulus": self.modulus.gaussian_stand_in(self.modulus_prior), **self.base_scales}
         for v in variants:
             scales.update(v.mechanism.prior_z())
@@ -194,7 +196,7 @@ class Diagnoser:
             except ValueError:  # parameters the simulator cannot run
                 return -np.inf
 
-        rng = np.random.default_rng(np.random.SeedSequence([self.seed, 11, zlib.crc32(mf.label.encode())]))
+        rng = stream(self.seed, "exact posterior", mf.label)
         ex = exact_draws(log_post, mode, cov, robust, rng=rng, n_importance=n, n_out=EXACT_DRAWS)
         draws = {p.name: np.asarray(p.from_unbounded(ex.z_adjusted[:, i]), float) for i, p in enumerate(params)}
         f_eff = np.array([self._f_effective(mf.variants, {k: float(v[s]) for k, v in draws.items()})

@@ -21,10 +21,10 @@ import numpy as np
 from scipy import optimize
 
 from ..models.parameters import summarize_draws
-from ..stats import psis
+from ..stats.laplace import central_jacobian, importance_weights, normal_draws, robust_covariance, sym_cholesky
 from .record_likelihood import GAIN_SD, WholeRecordLikelihood
 
-__all__ = ["GAIN_SD", "WholeRecordFit", "WholeRecordLikelihood", "fit_whole_record", "robust_covariance"]
+__all__ = ["GAIN_SD", "WholeRecordFit", "WholeRecordLikelihood", "fit_whole_record"]
 
 LogPrior = Callable[[Mapping[str, float]], float]
 #: Step (unbounded coordinate) of the central differences giving the Laplace precision.
@@ -34,8 +34,6 @@ JACOBIAN_STEP = 1e-3
 #: nats, far below what the ELPD's SE resolves, where a stick-slip model's cost is a staircase in f that a
 #: stricter tolerance chased for thousands of simulator runs.
 FTOL, XTOL = 1e-8, 1e-8
-#: Blocks apart whose scores are taken as correlated in :func:`robust_covariance` (Bartlett weights).
-ROBUST_LAGS = 4
 
 
 @dataclass(frozen=True)
@@ -58,31 +56,6 @@ class WholeRecordFit:
         return summarize_draws(self.draws[name])
 
 
-def robust_covariance(jacobian: np.ndarray, whitened: np.ndarray, cov: np.ndarray, blocks: np.ndarray, *,
-                      lags: int = ROBUST_LAGS) -> np.ndarray:
-    """Posterior covariance widened for a model that misses the record: the Laplace covariance ``cov``
-    plus the positive part of (sandwich - cov).
-
-    The sandwich H^-1 B H^-1 (H^-1 = ``cov``) is the spread of the best-fitting parameters when the
-    model is wrong (Huber; White 1982); B is the covariance of the score summed per block of the
-    record (``blocks``: the block of each whitened residual), with the products of blocks up to
-    ``lags`` apart weighted by Bartlett's kernel (Newey-West), since a model's error is correlated
-    over longer than one block. When the model is right, B ~ H and nothing changes; where it
-    misses, the residual's structure that the parameters had to absorb widens their posterior
-    (Muller 2013, "Risk of Bayesian inference in misspecified models").
-    """
-    g = jacobian * whitened[:, None]
-    G = np.zeros((int(blocks.max()) + 1, jacobian.shape[1]))
-    np.add.at(G, blocks, g)
-    B = G.T @ G
-    for lag in range(1, lags + 1):
-        C = G[:-lag].T @ G[lag:]
-        B += (1.0 - lag / (lags + 1.0)) * (C + C.T)
-    D = cov @ B @ cov - cov
-    w, V = np.linalg.eigh(0.5 * (D + D.T))
-    return cov + (V * np.clip(w, 0.0, None)) @ V.T
-
-
 def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Mapping[str, float], *,
                      n_draws: int = 30, rng: np.random.Generator,
                      prior_scale: Mapping[str, tuple[float, float]] | None = None,
@@ -99,7 +72,7 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     best mode is kept (the rise of the record pins the sample's confined modulus, which a low nu with
     a stiff sample matches as well as the right nu: two modes). ``score_blocks`` (the block of each
     whitened residual, :meth:`WholeRecordLikelihood.whitened`): the draws are taken from
-    :func:`robust_covariance` (the normal approximation's are kept in ``laplace_draws``).
+    :func:`~friction_uq.stats.laplace.robust_covariance` (the normal approximation's are kept in ``laplace_draws``).
     """
     params = [lik.model.parameters[n] for n in start if n != "hoop_gain"]
     names = tuple(p.name for p in params)
@@ -137,12 +110,11 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     # the precision from central differences over JACOBIAN_STEP: the explicit stick-slip integration makes
     # the prediction jump by a time step's worth where a slip starts one step earlier or later, and a
     # derivative over the optimiser's 1e-6 step can read such a jump as information
-    J = np.stack([(residuals(zm + JACOBIAN_STEP * e) - residuals(zm - JACOBIAN_STEP * e)) / (2.0 * JACOBIAN_STEP)
-                  for e in np.eye(len(zm))], axis=1)
+    J = central_jacobian(residuals, zm, JACOBIAN_STEP)
     H = J.T @ J  # Gauss-Newton precision in z (data and the Gaussian stand-ins of the priors)
     try:
         cov = np.linalg.inv(H)
-        chol = np.linalg.cholesky(0.5 * (cov + cov.T))
+        chol = sym_cholesky(cov)
     except np.linalg.LinAlgError:
         cov, chol = None, np.diag(np.full(len(zm), 1e-3))
 
@@ -163,12 +135,9 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
             chol = np.linalg.cholesky(robust_covariance(J[:n_data], res.fun[:n_data], cov, score_blocks))
         except np.linalg.LinAlgError:
             pass
-    z = zm + eps @ chol.T
+    z, log_q = normal_draws(zm, chol, eps)
     if importance:
-        log_q = -0.5 * np.sum(eps * eps, axis=1)
-        log_p = np.array([log_post(zi) for zi in z])
-        log_w = log_p - log_q
-        smoothed = psis(np.where(np.isfinite(log_w), log_w, -np.inf))
+        smoothed = importance_weights(np.array([log_post(zi) for zi in z]), log_q)
         log_w, k = smoothed.log_weights, float(smoothed.pareto_k)
     else:
         log_w, k = np.full(n_draws, -math.log(n_draws)), math.nan

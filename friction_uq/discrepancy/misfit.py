@@ -51,7 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..signals import ar1_mean_sd
+from ..stats.ar1 import ar1_mean_sd
 from .whole_record import CHANNEL_LABELS, PHASES, WholeRecord, tolerance_sd, whiten
 
 #: Decision threshold on the statistic (standard-normal units).

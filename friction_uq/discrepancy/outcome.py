@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import zlib
-
 import numpy as np
 
 from ..models.parameters import effective_sample_size, summarize_draws
 from ..stats import khat_threshold
+from ..stats.streams import stream
 from .diagnose import Diagnosis, ModelFit, Ranked
 from .effective_prior import log_prior_f_effective
 from .extended import IMPORTANCE_DRAWS, Variant
@@ -206,7 +205,7 @@ def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
         key = group_key(mf.label)
         post = {n: (("chain", "draw"), v[None]) for n, v in mf.fit.draws.items()}
         post["f_effective"] = (("chain", "draw"), mf.f_effective[None])
-        rng = np.random.default_rng(np.random.SeedSequence([dg.seed, 13, zlib.crc32(mf.label.encode())]))
+        rng = stream(dg.seed, "effective prior", mf.label)
         log_prior, prior_note = log_prior_f_effective(mf.variants, dg.context, f_prior, mf.f_effective, rng=rng)
         post["log_prior_f_effective"] = (("chain", "draw"), log_prior[None], {"description": prior_note})
         ll = {"block_elpd": (("block",), mf.elpd.pointwise),

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis import Prepared
-from ..signals import ar1_mean_sd
+from ..stats.ar1 import ar1_mean_sd
 
 #: Channels compared and their labels in reports.
 CHANNEL_LABELS = {

@@ -10,7 +10,7 @@ eq. 13/17 and the tube-kernel hoop prediction); the observations a
 * the hoop term (:mod:`.hoop`): the tube gauge against the model, by its window level (default)
   or sample by sample;
 
-with the AR(1) algebra in :mod:`.ar1`. Parameter vectors are rows in the order of the model's
+with the AR(1) algebra in :mod:`friction_uq.stats.ar1`. Parameter vectors are rows in the order of the model's
 :class:`~friction_uq.models.ParameterSet` (``Likelihood.parameters``) and are read by name through it;
 SI units, forces in N, strains in strain.
 """
@@ -24,8 +24,8 @@ import numpy as np
 from ..errors import SignalError
 from ..models.closed_form import ClosedFormModel, gauge_kernel
 from ..noise import ar1_noise
+from ..stats.ar1 import ar1_loglike, ar1_offset_correction, ar1_pointwise, offset_sd
 from ..window import StationaryData
-from .ar1 import ar1_loglike, ar1_offset_correction, ar1_pointwise, offset_sd
 from .force import ForceTerm
 from .force_level import RATIO_MODEL_FORM, LevelForceTerm
 from .hoop import HOOP_DISCREPANCY, HOOP_MODES, HoopTerm

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..window import StationaryData
-from .ar1 import _LOG_2PI, ar1_offset_correction, ar1_pointwise
+from ..stats.ar1 import LOG_2PI as _LOG_2PI, ar1_offset_correction, ar1_pointwise
 
 
 @dataclass(frozen=True)

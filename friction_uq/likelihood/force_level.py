@@ -25,7 +25,7 @@ to the spread) is added:
     log L(r) = log t_{B-1}(u_bar(r) / s(r)) - log s(r).
 
 No floor. The noise model's own standard error of u_bar (AR(1) pre-pulse noise of both channels,
-:func:`friction_uq.signals.ar1_mean_sd`) is not used as a lower bound on se_batch: the t with B - 1
+:func:`friction_uq.stats.ar1.ar1_mean_sd`) is not used as a lower bound on se_batch: the t with B - 1
 degrees of freedom already pays for a batch spread that is small by chance, and flooring it made the
 90 % interval of the ratio cover 0.97 of records that are the model plus its noise (a scale mixture
 over the posterior of the variance truncated at the noise level; simulation-based calibration,
@@ -59,7 +59,7 @@ import math
 import numpy as np
 from scipy.special import gammaln
 
-from ..signals import ar1_mean_sd
+from ..stats.ar1 import ar1_mean_sd
 from ..window import StationaryData
 
 #: Relative standard deviation of eq. 17's ratio against a test it did not make (module docstring): the root

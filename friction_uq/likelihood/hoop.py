@@ -33,7 +33,7 @@ from ..errors import SignalError
 from ..models.closed_form import HoopPrediction
 from ..physics import tube
 from ..window import StationaryData
-from .ar1 import _LOG_2PI, _innovations, ar1_offset_correction, ar1_pointwise
+from ..stats.ar1 import LOG_2PI as _LOG_2PI, ar1_innovations, ar1_offset_correction, ar1_pointwise
 
 #: How the hoop reading enters the likelihood (HoopTerm).
 HOOP_MODES = ("level", "series")
@@ -92,8 +92,8 @@ class HoopTerm:
         basis = prediction.basis
 
         # AR(1) innovations of the data and of the basis
-        dh = _innovations(self.observed, self.rho)
-        dphi = _innovations(basis.T, self.rho).T  # (n, m)
+        dh = ar1_innovations(self.observed, self.rho)
+        dphi = ar1_innovations(basis.T, self.rho).T  # (n, m)
         self._hh = float(dh @ dh)
         self._hb = dphi.T @ dh  # (m,)
         self._bb = dphi.T @ dphi  # (m, m)

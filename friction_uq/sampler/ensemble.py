@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import PriorError, SamplingError
 from ..likelihood import Likelihood
 from ..priors import Priors
+from ..stats.streams import legacy_state
 from ..window import StationaryData
 from . import checkpoint
 from .model import LogPosterior, start_ball
@@ -190,7 +191,7 @@ def sample_posterior(
     else:
         backend = emcee.backends.Backend()
         z_map, ball = start_ball(log_post, prior, nwalkers=nwalkers, n_ensembles=n_ensembles, rng=rng_start)
-        rs = np.random.RandomState(np.random.default_rng(seeds[0]).integers(2**31))
+        rs = legacy_state(np.random.default_rng(seeds[0]))
         state = emcee.State(ball.reshape(n_all, ndim), random_state=rs.get_state())
     sampler = emcee.EnsembleSampler(n_all, ndim, log_post, vectorize=True, backend=backend, moves=move)
 

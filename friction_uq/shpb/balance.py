@@ -32,8 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..discrepancy.whole_record import longest_sign_run, whiten
-from ..likelihood import ar1_loglike
-from ..signals import ar1_mean_sd, transport
+from ..signals import transport
+from ..stats.ar1 import ar1_loglike, ar1_mean_sd
 from .record import BarProperties, TwoBarRecord
 from .waves import GaugeWaves, gauge_waves, stated_gain
 

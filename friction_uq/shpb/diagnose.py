@@ -27,14 +27,6 @@ from .balance import BalanceObservation
 from .fit import BLOCK, N_DRAWS, BalanceFit, fit_balance
 from .mechanisms import MECHANISMS, combine
 
-def decisive(delpd: float, se: float) -> bool:
-    """The package's rule (:data:`friction_uq.stats.RULE`): dELPD > 4 and > 2 SE.
-
-    >>> decisive(10.0, 3.0), decisive(10.0, 6.0), decisive(3.0, 0.5)
-    (True, False, False)
-    """
-    return RULE.decisive(delpd, se)
-
 
 @dataclass(frozen=True)
 class Candidate:
@@ -47,7 +39,7 @@ class Candidate:
 
     @property
     def decisive(self) -> bool:
-        return decisive(self.delpd, self.se)
+        return RULE.decisive(self.delpd, self.se)
 
 
 @dataclass(frozen=True)
@@ -108,7 +100,7 @@ def diagnose_balance(
             steps.append(Step(base, tuple(cands), None, ()))
             break
         tied = tuple(c.mechanism for c in cands[1:]
-                     if c.decisive and not decisive(*elpd_difference(best.fit.elpd, c.fit.elpd)))
+                     if c.decisive and not RULE.decisive(*elpd_difference(best.fit.elpd, c.fit.elpd)))
         steps.append(Step(base, tuple(cands), best.mechanism, tied))
         not_separable.extend(tied)
         current.append(best.mechanism)

@@ -9,8 +9,8 @@ normal density (Pareto-smoothed, arviz-stats PSIS; the k of those weights is rep
 says the normal approximation is poor).
 
 ELPD. The residual of each draw is cut into blocks of ``BLOCK`` seconds; each block's exact
-Gaussian AR(1) density given the rest of the residual (:func:`~friction_uq.discrepancy.elpd.ar1_block_loo`)
-is integrated over the posterior by PSIS-LOO (:func:`~friction_uq.discrepancy.elpd.psis_loo`).
+Gaussian AR(1) density given the rest of the residual (:func:`~friction_uq.stats.ar1.ar1_block_loo`)
+is integrated over the posterior by PSIS-LOO (:func:`~friction_uq.stats.elpd.psis_loo`).
 5 us is 50 samples at 10 MS/s, tens of the noise's correlation times, and leaves ~16 blocks over
 the LANL record's 80 us span. A model with no free parameter is scored at its one prediction.
 Where a block's PSIS Pareto k exceeds ``REFIT_K`` = 0.7 (the importance ratios cannot stand for
@@ -41,10 +41,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from ..discrepancy.elpd import Elpd, ar1_block_loo, psis_loo
-from ..stats import psis
-from ..likelihood import ar1_loglike
+from ..discrepancy.elpd import Elpd
 from ..models.parameters import Parameter
+from ..stats.ar1 import ar1_block_loo, ar1_loglike
+from ..stats.elpd import psis_loo, weighted_log_mean
+from ..stats.laplace import draw_normal, fd_hessian, importance_weights
 from .balance import BalanceObservation, Misfit
 from .mechanisms import CombinedModel
 
@@ -134,25 +135,6 @@ def _mode(obs: BalanceObservation, model: CombinedModel, params: tuple[Parameter
     return np.asarray(res.x)
 
 
-def _hessian(fun, z: np.ndarray) -> np.ndarray:
-    """Finite-difference Hessian, steps a tenth of each coordinate's sd (from a first pass)."""
-    k = len(z)
-    f0 = fun(z)
-    h = np.full(k, 1e-3)
-    for _ in range(2):
-        curv = np.array([(fun(z + h[i] * np.eye(k)[i]) - 2 * f0 + fun(z - h[i] * np.eye(k)[i])) / h[i] ** 2
-                         for i in range(k)])
-        h = 0.1 / np.sqrt(np.maximum(curv, 1e-12))
-    e = np.eye(k) * h
-    H = np.empty((k, k))
-    for i in range(k):
-        H[i, i] = (fun(z + e[i]) - 2.0 * f0 + fun(z - e[i])) / h[i] ** 2
-        for j in range(i + 1, k):
-            H[i, j] = H[j, i] = (fun(z + e[i] + e[j]) - fun(z + e[i] - e[j]) - fun(z - e[i] + e[j])
-                                 + fun(z - e[i] - e[j])) / (4.0 * h[i] * h[j])
-    return H
-
-
 def _evaluate(obs: BalanceObservation, model: CombinedModel, params: tuple[Parameter, ...], z: np.ndarray,
               blen: int) -> tuple[np.ndarray, np.ndarray]:
     """Log posterior (S,) and each block's log p(e_b | e_-b, theta) (S, B) at parameter vectors z (S, k)."""
@@ -174,24 +156,6 @@ def _evaluate(obs: BalanceObservation, model: CombinedModel, params: tuple[Param
     return np.array(lp), ll
 
 
-def _draws(zm: np.ndarray, cov: np.ndarray, rng: np.random.Generator, n_draws: int) -> tuple[np.ndarray, np.ndarray]:
-    """Normal draws around ``zm`` and their log density up to a constant."""
-    chol = np.linalg.cholesky(0.5 * (cov + cov.T))
-    eps = rng.standard_normal((n_draws, len(zm)))
-    return zm + eps @ chol.T, -0.5 * np.sum(eps * eps, axis=1)
-
-
-def _smoothed(log_w: np.ndarray) -> tuple[np.ndarray, float]:
-    """PSIS-smoothed, normalised log weights and their Pareto k."""
-    res = psis(log_w)
-    return res.log_weights, float(res.pareto_k)
-
-
-def _loo_k(ll: np.ndarray, log_w: np.ndarray) -> np.ndarray:
-    """Pareto k of each block's leave-one-out importance ratios (as in :func:`psis_loo`)."""
-    return np.asarray(psis((log_w[:, None] - ll).T).pareto_k)
-
-
 def fit_balance(obs: BalanceObservation, model: CombinedModel, *, rng: np.random.Generator,
                 n_draws: int = N_DRAWS, block: float = BLOCK, scaled_noise: bool = True,
                 refit_k: float | None = REFIT_K) -> BalanceFit:
@@ -205,19 +169,21 @@ def fit_balance(obs: BalanceObservation, model: CombinedModel, *, rng: np.random
     if not params:
         ll = _evaluate(obs, model, params, np.zeros((1, 0)), blen)[1]
         settings = model.settings({})
+        loo = psis_loo(ll, np.zeros(1))
         return BalanceFit(model, {}, {}, np.zeros(1), math.nan, obs.misfit(obs.residual(settings)),
-                          psis_loo(ll, np.zeros(1)), obs.loglike(settings), 0)
+                          Elpd(loo.pointwise, loo.pareto_k_max), obs.loglike(settings), 0)
 
     def fun(z: np.ndarray) -> float:
         return _neg_log_post(obs, model, params, z)
 
     zm = _mode(obs, model, params)
-    cov = np.linalg.inv(_hessian(fun, zm))
-    z, log_q = _draws(zm, cov, rng, n_draws)
+    cov = np.linalg.inv(fd_hessian(fun, zm))
+    z, log_q = draw_normal(zm, cov, rng, n_draws)
     lp, ll = _evaluate(obs, model, params, z, blen)
-    log_w, k_is = _smoothed(lp - log_q)
-    elpd = psis_loo(ll, log_w)
-    k_loo = _loo_k(ll, log_w)
+    weights = importance_weights(lp, log_q)
+    log_w, k_is = weights.log_weights, float(weights.pareto_k)
+    loo = psis_loo(ll, log_w)
+    elpd, k_loo = Elpd(loo.pointwise, loo.pareto_k_max), loo.pareto_k
     refits = np.flatnonzero(k_loo > refit_k) if refit_k is not None else np.zeros(0, int)
     if refits.size:
         point, k_loo = elpd.pointwise.copy(), k_loo.copy()
@@ -228,10 +194,10 @@ def fit_balance(obs: BalanceObservation, model: CombinedModel, *, rng: np.random
             grad = np.array([(_evaluate(obs, model, params, zm + hi * e, blen)[1][0, b]
                               - _evaluate(obs, model, params, zm - hi * e, blen)[1][0, b]) / (2 * hi)
                              for hi, e in zip(h, np.eye(len(zm)), strict=True)])
-            zb, log_qb = _draws(zm - cov @ grad, cov, rng, n_draws)
+            zb, log_qb = draw_normal(zm - cov @ grad, cov, rng, n_draws)
             lpb, llb = _evaluate(obs, model, params, zb, blen)
-            lwb, kb = _smoothed(lpb - llb[:, b] - log_qb)
-            point[b], k_loo[b] = float(np.logaddexp.reduce(lwb + llb[:, b])), kb
+            wb = importance_weights(lpb - llb[:, b], log_qb)
+            point[b], k_loo[b] = float(weighted_log_mean(llb[:, b], wb.log_weights)), float(wb.pareto_k)
         elpd = Elpd(pointwise=point, pareto_k_max=float(np.nanmax(k_loo)))
     draws = {p.name: np.asarray(p.from_unbounded(z[:, i]), float) for i, p in enumerate(params)}
     mode, mode_scale = _split(params, zm)

@@ -1,11 +1,25 @@
-"""Statistics shared by every consumer: Pareto-smoothed importance sampling (:mod:`.psis`), the exact
-posterior behind a Laplace approximation with its sandwich adjustment (:mod:`.exact`), and stacking
-weights with the rule that reads a verdict from them (:mod:`.weights`), and the rule that says when a
-difference in ELPD decides, with its standard error (:mod:`.decision`).
+"""The one statistics layer under the data flow: every stage that weighs evidence uses it, none has its own.
 
-One implementation, tested once, used by the whole-record fits, the leave-one-out ELPDs, the
-prior sensitivity, ``diagnose`` and the campaign's law comparison, so that the sign convention of the
-underlying library is handled in one place.
+* :mod:`.ar1`: stationary AR(1) Gaussian noise: exact log-likelihood, conditionals, an offset error
+  integrated out, a block's density given the rest of its series, the sd of a mean of AR(1) samples;
+* :mod:`.psis`: Pareto-smoothed importance sampling, the one wrapper of ``arviz_stats``' ``psislw``
+  (whose sign convention is handled there and nowhere else), weighted quantiles;
+* :mod:`.laplace`: a Laplace fit's pieces in unbounded coordinates: finite-difference Hessian,
+  central-difference Jacobian (Gauss-Newton), the robust sandwich covariance, normal draws and
+  their importance weights against the exact posterior;
+* :mod:`.exact`: the exact posterior behind a Laplace approximation (importance sampling, a second
+  proposal, emcee) with the sandwich adjustment;
+* :mod:`.elpd`: PSIS leave-one-out ELPD from per-draw pointwise log densities, and the weighted mean
+  of a density over draws;
+* :mod:`.decision`: the rule that says when an ELPD difference decides (:data:`RULE`) and the standard
+  error of a paired difference;
+* :mod:`.weights`: stacking weights and the rule that reads a verdict from them;
+* :mod:`.streams`: named random streams (one seeded Generator per purpose and model) and the
+  legacy seeding emcee needs.
+
+Used by the stationary likelihood, the whole-record fits, the leave-one-out ELPDs, the prior
+sensitivity, ``diagnose``, the two-bar diagnosis and the campaign's law comparison. What is physics
+(forward models, mechanisms, priors of a test) stays with them.
 """
 
 from .decision import RULE, DecisionRule, paired_difference

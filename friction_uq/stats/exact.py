@@ -30,9 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from .psis import khat_threshold, psis
-
-
+from .laplace import importance_weights, sym_cholesky
+from .psis import khat_threshold
+from .streams import legacy_state
 
 @dataclass(frozen=True)
 class ExactDraws:
@@ -50,16 +50,12 @@ class ExactDraws:
 
 def sandwich_map(mode: np.ndarray, cov_laplace: np.ndarray, cov_robust: np.ndarray) -> np.ndarray:
     """Omega of the open-faced sandwich adjustment (module docstring): Omega cov_laplace Omega^T = cov_robust."""
-    lo = np.linalg.cholesky(0.5 * (cov_laplace + cov_laplace.T))
-    hi = np.linalg.cholesky(0.5 * (cov_robust + cov_robust.T))
-    return hi @ np.linalg.inv(lo)
+    return sym_cholesky(cov_robust) @ np.linalg.inv(sym_cholesky(cov_laplace))
 
 
 def _weighted(log_post: Callable[[np.ndarray], float], dist, n: int, rng: np.random.Generator):
     z = np.atleast_2d(dist.rvs(size=n, random_state=rng)).reshape(n, -1)
-    lp = np.array([log_post(zi) for zi in z])
-    log_r = np.where(np.isfinite(lp), lp - dist.logpdf(z), -np.inf)
-    res = psis(log_r)
+    res = importance_weights(np.array([log_post(zi) for zi in z]), dist.logpdf(z))
     return z, res.log_weights, float(res.pareto_k), float(res.ess)
 
 
@@ -76,7 +72,7 @@ def _emcee(log_post: Callable[[np.ndarray], float], z: np.ndarray, log_w: np.nda
     nwalkers = max(16, 4 * ndim)
     start = z[np.argsort(log_w)[::-1][:nwalkers]]
     start = start + 1e-4 * rng.standard_normal(start.shape)  # distinct walkers even where draws repeat
-    rs = np.random.RandomState(int(rng.integers(2**31)))  # emcee's own stream, seeded from ours
+    rs = legacy_state(rng)  # emcee's own stream, seeded from ours
     sampler = emcee.EnsembleSampler(nwalkers, ndim, log_post)
     sampler.run_mcmc(emcee.State(start, random_state=rs.get_state()), steps, progress=False)
     chain = sampler.get_chain(discard=burn, flat=True)
