@@ -90,10 +90,16 @@ def test_evidence_in_a_few_blocks_names_nothing_and_spread_evidence_names_the_ca
     assert v.candidates[0].decisive and not v.candidates[0].spread
     assert v.kind == "unexplained" and v.named is None
     assert rule.judge(base, _round(base, [_fit("plug_friction", None, few)]), misfit=False).kind == "none"
-    v = rule.judge(base, _round(base, [_fit("clearance", None, spread), _fit("plug_friction", None, few)]), misfit=True)
+    small = _noise(seed=1)
+    small[:8] += 5.0  # 40 nats from eight blocks: not decisive
+    v = rule.judge(base, _round(base, [_fit("clearance", None, spread), _fit("plug_friction", None, small)]),
+                   misfit=True)
     assert v.kind == "named" and v.named == "clearance"
     assert set(v.weights) == {"reference", "clearance", "plug_friction"}
     assert v.weights["clearance"] > 0.5
+    # a rival that predicts the record better, if only in a few blocks, is not ruled out: the two are candidates
+    v = rule.judge(base, _round(base, [_fit("clearance", None, spread), _fit("plug_friction", None, few)]), misfit=True)
+    assert v.kind == "candidates" and v.named == "clearance" and v.rivals == ("plug_friction",)
 
 
 def test_two_mechanisms_the_record_does_not_separate_are_candidates_and_a_gain_on_another_gauge_is_named():
@@ -120,11 +126,11 @@ def test_the_mixture_takes_each_model_in_proportion_to_its_weight():
     from friction_uq.discrepancy.verdict import mixture_draws
 
     draws = {"a": np.zeros(500), "b": np.ones(500), "c": np.full(10, 2.0)}
-    x, which = mixture_draws(draws, {"a": 0.25, "b": 0.70, "c": 0.05}, n=1000, seed=1)
+    x, which = mixture_draws(draws, {"a": 0.25, "b": 0.70, "c": 0.05}, n=1000, rng=np.random.default_rng(1))
     assert x.size == 1000 and np.count_nonzero(x == 0) == 250 and np.count_nonzero(x == 1) == 700
     assert np.count_nonzero(x == 2) == 50  # more than c has: drawn with replacement
     assert np.array_equal(which, np.repeat([0, 1, 2], [250, 700, 50]))
-    y, _ = mixture_draws(draws, {"a": 0.25, "b": 0.70, "c": 0.05}, n=1000, seed=1)
+    y, _ = mixture_draws(draws, {"a": 0.25, "b": 0.70, "c": 0.05}, n=1000, rng=np.random.default_rng(1))
     assert np.array_equal(x, y)
 
 
@@ -212,13 +218,16 @@ def test_plug_friction_is_named_and_f_recovered(tmp_path):
     assert f"f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] with them (the f to quote)" in doc["sentence"]
 
 
-def test_external_gauge_gain_is_named_with_its_channel(tmp_path):
+def test_an_external_gauge_gain_the_check_cannot_see_is_not_named(tmp_path):
+    """A 12 % gain on the external output gauge is, over the stationary phase, a 12 % higher f (eq. 17 reads
+    F_eo / F_io): only the fronts could tell it, by a few nats (about 8 here), less than two simulators of the
+    same test differ by (30 on clean axisymmetric records). The whole-record check finds no misfit, so nothing
+    is named and the record's f is the stationary analysis' (docs/trust.md: what slips past)."""
     prep, dg = _diagnose(tmp_path, noisy_config(channels={"external_output_bar": ChannelSpec(
         white=1e-6, ar1=1e-6, ar1_coef=0.6, gain=1.12)}), seed=23)
-    assert dg.cause is not None
-    assert (dg.cause.mechanism.name, dg.cause.channel) == ("gauge_gain", "external_output_bar")
-    g = dg.final.fit.draws["gain"]
-    assert np.quantile(g, 0.005) <= 1.12 <= np.quantile(g, 0.995)
+    assert not dg.misfits[0].detected
+    assert dg.cause is None and dg.verdict.kind == "none" and dg.mixture_f is None
+    assert outcome.headline(dg) is None
 
 
 def test_clearance_is_named_and_the_gap_measured(tmp_path):

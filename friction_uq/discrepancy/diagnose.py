@@ -28,6 +28,7 @@ import numpy as np
 
 from ..analysis import Prepared
 from ..stats import RULE
+from ..stats.streams import stream
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
@@ -112,6 +113,8 @@ class Diagnosis:
     #: that carry the weight, their labels and weights ("reference": the model without causes)
     mixture_f: np.ndarray | None = None
     mixture_weights: dict[str, float] = field(default_factory=dict)
+    #: for each mixture draw, the index (in mixture_weights' order) of the model it was drawn from
+    mixture_source: np.ndarray | None = None
 
     @property
     def verdict(self) -> Verdict | None:
@@ -210,7 +213,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     b = compare_whole_record(prep, final.predicted)
     k = ess = float("nan")
     method = None
-    mix, mix_w = (None, {}) if causes or not verdicts else mixture(base, rounds[0], verdicts[0], seed)
+    mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else mixture(base, rounds[0], verdicts[0], seed)
     if causes:
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final)
@@ -220,21 +223,23 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
                      posterior_method=method, context=dg.context, seed=seed, verdicts=tuple(verdicts),
-                     mixture_f=mix, mixture_weights=mix_w)
+                     mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src)
 
 
 def mixture(base: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict,
-            seed: int) -> tuple[np.ndarray | None, dict[str, float]]:
-    """f's draws from the stacking mixture of the models that carry the weight (:mod:`.verdict`), when the first
-    round named no single cause but found candidates or an unexplained misfit; (None, {}) otherwise."""
+            seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+    """f's draws from the stacking mixture of the models that carry the weight (:mod:`.verdict`), their weights
+    and each draw's model, when the first round named no single cause but found candidates or an unexplained
+    misfit; (None, {}, None) otherwise."""
     if verdict.kind not in ("candidates", "unexplained"):
-        return None, {}
+        return None, {}, None
     fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
-    keep = verdict.supported
+    keep = [k for k in verdict.supported if verdict.weights[k] > 0.0]
     w = {k: verdict.weights[k] for k in keep}
-    draws, _ = mixture_draws({k: fits[k].f_effective for k in keep}, w, n=MIXTURE_DRAWS, seed=seed)
+    draws, which = mixture_draws({k: fits[k].f_effective for k in keep}, w, n=MIXTURE_DRAWS,
+                                  rng=stream(seed, "mixture"))
     total = sum(w.values())
-    return draws, {k: v / total for k, v in w.items()}
+    return draws, {k: v / total for k, v in w.items()}, which
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

@@ -36,17 +36,32 @@ def kappa_draws(mf: ModelFit) -> np.ndarray:
     return mf.f_effective * nu / (1.0 - nu)
 
 
+def mixture_label(dg: Diagnosis) -> str:
+    """'mixture of clearance (0.61), dispersion (0.33)': the models whose stacking mixture gives f, with their
+    weights ("reference": the model without causes, written as "no cause")."""
+    parts = [f"{'no cause' if k == 'reference' else k} ({w:.2f})" for k, w in dg.mixture_weights.items()]
+    return "mixture of " + ", ".join(parts)
+
+
 def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
-    """The headline f of a diagnosed record: the final model's label and its f when a cause was named; None
-    when none was (the headline is then the stationary analysis' f)."""
-    return (dg.final.label, dg.final.f_summary()) if dg.causes else None
+    """The headline f of a diagnosed record: the final model's label and its f when a cause was named; the
+    stacking mixture's when the record named candidates or an unexplained misfit (:mod:`.verdict`); None when
+    nothing needed explaining (the headline is then the stationary analysis' f)."""
+    if dg.causes:
+        return dg.final.label, dg.final.f_summary()
+    if dg.mixture_f is not None:
+        return mixture_label(dg), summarize_draws(dg.mixture_f)
+    return None
 
 
-def _entry(r: Ranked) -> dict[str, object]:
+def _entry(r: Ranked, verdict=None) -> dict[str, object]:
     v = r.fit.variants[-1]
     params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
+    judged = {} if verdict is None else next(({"weight": c.weight, "delpd_trimmed": c.delpd_trimmed,
+                                               "se_trimmed": c.se_trimmed, "spread": c.spread}
+                                              for c in verdict.candidates if c.label == r.fit.label), {})
     return {"name": v.mechanism.name, "channel": v.channel, "model": r.fit.label, "delpd": r.delpd, "se": r.se,
-            "decisive": r.decisive, "parameters": params,
+            "decisive": r.decisive, **judged, "parameters": params,
             "calibration_elpd": dict(zip(r.fit.elpd.calibration_names, map(float, r.fit.elpd.calibration))),
             "f_effective": summarize_draws(r.fit.f_effective),
             "draws": int(len(r.fit.f_effective)), "ess": _ess(r.fit.fit.log_weights)}
@@ -95,6 +110,8 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     """One line for the terminal and the summary page, in an experimentalist's words: the causes, the one that
     moves f most first, with f before and after each; then f to quote; then where the simple model missed."""
     fx = dg.final.f_summary()
+    if not dg.causes and dg.mixture_f is not None:
+        return _mixture_sentence(dg, f_without)
     if not dg.causes:
         return (f"No cause of the catalogue explains the record clearly better than the simple model (closest: "
                 f"{dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f} "
@@ -113,6 +130,38 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
             f"{fx['q95']:.3f}] with them (the f to quote), {f_without['q50']:.3f} from the stationary analysis "
             f"without them. Why: {_describe(dg)}; the first cause's evidence is {first.delpd:.0f} +- {first.se:.0f} "
             f"nats.{sep}{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
+
+
+def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
+    """The sentence of a record whose misfit no single cause explains (candidates, or unexplained)."""
+    fm = summarize_draws(dg.mixture_f)
+    shares = ", ".join(f"{'no cause' if k == 'reference' else _words_of(dg, k)} {100 * w:.0f} %"
+                       for k, w in dg.mixture_weights.items())
+    v = dg.verdict
+    if v.kind == "candidates":
+        what = (f"This record does not tell apart {', '.join(dg.not_separable) or 'the candidates'}"
+                f"{'; ' + dg.separate_by + ' would' if dg.separate_by else ''}.")
+    else:
+        where = _where(dg)
+        what = (f"Unexplained misfit{where}: no cause of the catalogue explains it clearly, over the whole record "
+                "and better than every other.")
+    return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the candidates weighted by how well "
+            f"each predicts the record ({shares}; the f to quote, wide enough for whichever is right), "
+            f"{f_without['q50']:.3f} from the stationary analysis.")
+
+
+def _words_of(dg: Diagnosis, label: str) -> str:
+    fit = next((r.fit for r in dg.ranking if r.fit.label == label), None)
+    return label if fit is None else _cause_words(fit.variants[-1])
+
+
+def _where(dg: Diagnosis) -> str:
+    """' on the internal transmitted gauge, rise phase': the first cell the whole-record check flagged."""
+    cells = dg.misfits[0].flagged() if dg.misfits else []
+    if not cells:
+        return ""
+    c = cells[0]
+    return f" on the {CHANNEL_LABELS.get(c.channel, c.channel)} gauge, {c.phase} phase"
 
 
 def baseline_hoop_gain(dg: Diagnosis) -> float:
@@ -145,15 +194,21 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
     """The JSON ``discrepancy`` block."""
     cause = dg.cause
     hoop = dg.final.hoop_gain
+    v = dg.verdict
     return {
+        "verdict": v.kind if v is not None else None,
+        "stacking_weights": dict(v.weights) if v is not None else {},
+        "mixture": None if dg.mixture_f is None else {"weights": dict(dg.mixture_weights),
+                                                      "f": summarize_draws(dg.mixture_f)},
         "cause": cause.mechanism.name if cause else None,
         "cause_channel": cause.channel if cause else None,
         "cause_channel_not_separable": list(dg.channels_not_separable),
         "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.causes],
         "not_separable": list(dg.not_separable),
         "separate_by": dg.separate_by,
-        "ranking": [_entry(r) for r in dg.ranking],
-        "rounds": [[_entry(r) for r in rnd] for rnd in dg.rounds[1:]],
+        "ranking": [_entry(r, v) for r in dg.ranking],
+        "rounds": [[_entry(r, dg.verdicts[k + 1] if k + 1 < len(dg.verdicts) else None) for r in rnd]
+                   for k, rnd in enumerate(dg.rounds[1:])],
         "model": dg.final.label,
         "f_extended": dg.final.f_summary(),
         "posterior_method": dg.posterior_method,
@@ -171,10 +226,12 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
                                  "whole-record fit: its most probable value under a 5 % prior"},
         "residual_rms": {ch: {ph: {"before": b, "after": a} for ph, (b, a) in phases.items()}
                          for ch, phases in dg.rms.items()},
-        "rule": "a mechanism is decisive when its dELPD exceeds 4 and either 2 SE or, when the reference model's misfit "
-                "is detected, both 40 and 1 SE; the cause is the decisive one with the largest dELPD; others within "
-                "the same margin of it (40 replaced by max(40, 10 % of the best)) are not separable from it; then the "
-                "search goes on with the cause in the model",
+        "rule": "a cause is named only of a misfit the whole-record check found, when its dELPD over the model without "
+                "it exceeds 4 and 2 SE, still does with the 5 % of blocks that favour it most left out (spread over "
+                "the record), and beats every other extended model by the same margin; several that pass but do not "
+                "beat each other are candidates, a misfit none explains is unexplained, and f is then the stacking "
+                "mixture of the models that carry the weight; after a named cause the search goes on with it in the "
+                "model",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "
@@ -190,6 +247,29 @@ def group_key(label: str) -> str:
     return label.replace("[", "_").replace("]", "").replace("+", "__")
 
 
+def _mixture_dataset(dg: Diagnosis, f_prior):
+    """The stacking mixture's draws of f_effective, each with the log density of the prior of the model it was
+    drawn from (what a campaign divides out when it pools the f this record quotes)."""
+    import xarray as xr
+
+    fits = {"reference": dg.baseline} | {r.fit.label: r.fit for r in dg.ranking}
+    labels = list(dg.mixture_weights)
+    log_prior = np.empty(len(dg.mixture_f))
+    notes = []
+    for i, label in enumerate(labels):
+        at = dg.mixture_source == i
+        rng = stream(dg.seed, "effective prior", f"mixture {label}")
+        log_prior[at], note = log_prior_f_effective(fits[label].variants, dg.context, f_prior, dg.mixture_f[at],
+                                                    rng=rng)
+        notes.append(f"{label}: {note}")
+    return xr.Dataset({"f_effective": (("chain", "draw"), dg.mixture_f[None]),
+                       "model": (("chain", "draw"), np.asarray(labels, dtype=object)[dg.mixture_source][None].astype(str)),
+                       "log_prior_f_effective": (("chain", "draw"), log_prior[None],
+                                                 {"description": "; ".join(notes)})},
+                      attrs={"model": mixture_label(dg), "verdict": dg.verdict.kind,
+                             "posterior_method": "stacking mixture of the candidates' normal approximations"})
+
+
 def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
     """One group per fitted model under ``discrepancy``: the draws (posterior: the normal approximation's, and
     for the model the headline f comes from its exact posterior's, :meth:`Diagnoser.exact_posterior`), beside
@@ -201,6 +281,9 @@ def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
                                             for rnd in dg.rounds for r in rnd]
     # the group of the model the headline f comes from (empty: no cause named, the stationary posterior's f)
     dt.attrs["discrepancy_final_group"] = f"discrepancy_{group_key(dg.final.label)}" if dg.causes else ""
+    if not dg.causes and dg.mixture_f is not None:
+        dt.attrs["discrepancy_final_group"] = "discrepancy_mixture"
+        dt["discrepancy_mixture/posterior"] = xr.DataTree(_mixture_dataset(dg, f_prior))
     for mf in fits:
         key = group_key(mf.label)
         post = {n: (("chain", "draw"), v[None]) for n, v in mf.fit.draws.items()}

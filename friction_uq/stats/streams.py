@@ -18,6 +18,7 @@ PURPOSES = {
     "extended fit": 9,  # one extended model's whole-record fit (discrepancy.extended)
     "exact posterior": 11,  # importance sampling / emcee behind the final model's Laplace fit
     "effective prior": 13,  # the prior of f_effective, computed by simulation when the draws are written
+    "mixture": 14,  # the stacking mixture's draws of f when diagnose names no single cause (discrepancy.verdict)
 }
 
 

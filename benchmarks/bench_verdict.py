@@ -1,0 +1,134 @@
+"""The naming rule of ``diagnose`` (:mod:`friction_uq.discrepancy.verdict`) on records the 1-D likelihood did
+not make: how often it names a cause on clean records, the right cause on records with one, and whether f's
+interval then holds the truth.
+
+Reads the first rounds stored by ``benchmarks/verdict_records.py`` (each model's pointwise block ELPD, its
+draws of f and the whole-record check's decision) and applies the package's rule, and variants of it for
+comparison, without fitting again:
+
+    python benchmarks/verdict_records.py RECORDS [--clean 16 --per 3 --seed 17]   # about 1 min a record
+    python benchmarks/bench_verdict.py RECORDS
+
+Prints per group: records, verdicts (named / candidates / unexplained / none), the exact cause named, f's
+90 % interval holding the truth (named: the named model's f; candidates or unexplained: the stacking
+mixture's; none: the baseline's), and the confusion of first named causes. f here is the normal
+approximation's (``diagnose`` then takes the named model's exact posterior).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import glob
+import json
+import os
+import sys
+from collections import Counter, defaultdict
+from types import SimpleNamespace
+
+import numpy as np
+
+from friction_uq.discrepancy.diagnose import Ranked
+from friction_uq.discrepancy.elpd import Elpd, elpd_difference
+from friction_uq.discrepancy.extended import Variant
+from friction_uq.discrepancy.mechanisms import MECHANISMS
+from friction_uq.discrepancy.verdict import NamingRule, mixture_draws
+
+
+def _elpd(a: dict, key: str, names) -> Elpd:
+    return Elpd(a[f"{key}_pointwise"], float("nan"), a[f"{key}_calibration"], a[f"{key}_calibration_mean"],
+                a[f"{key}_calibration_var"], tuple(names))
+
+
+def load(folder: str) -> list[dict]:
+    """The stored records: meta, the reference fit and the ranked candidates as the rule reads them."""
+    out = []
+    for path in sorted(glob.glob(os.path.join(folder, "*.npz"))):
+        with np.load(path) as d:
+            a = {k: d[k] for k in d.files}
+        meta = json.loads(str(a.pop("meta")))
+        ref = SimpleNamespace(label="reference", elpd=_elpd(a, "base", meta["base_calibration_names"]),
+                              f_effective=a["base_f"], variants=())
+        fits = [SimpleNamespace(label=m["label"], elpd=_elpd(a, f"m{i}", m["calibration_names"]),
+                                f_effective=a[f"m{i}_f"], variants=(Variant(MECHANISMS[m["mechanism"]], m["channel"]),))
+                for i, m in enumerate(meta["models"])]
+        ranked = tuple(sorted((Ranked(f, *elpd_difference(f.elpd, ref.elpd)) for f in fits), key=lambda r: -r.delpd))
+        out.append(meta | {"name": os.path.basename(path)[:-4], "reference": ref, "ranked": ranked})
+    return out
+
+
+def outcome(rec: dict, rule: NamingRule) -> dict:
+    """The rule's verdict on one stored record, the f it would quote and whether that holds the truth."""
+    v = rule.judge(rec["reference"], rec["ranked"], misfit=rec["misfit"], seed=0)
+    fits = {"reference": rec["reference"]} | {r.fit.label: r.fit for r in rec["ranked"]}
+    if v.kind == "named":
+        f = fits[v.named].f_effective
+    elif v.kind == "none":
+        f = rec["reference"].f_effective
+    else:
+        keep = v.supported
+        f, _ = mixture_draws({k: fits[k].f_effective for k in keep}, {k: v.weights[k] for k in keep}, n=1000,
+                             rng=np.random.default_rng(0))
+    q05, q95 = np.quantile(f, [0.05, 0.95])
+    named = None if v.named is None or v.kind != "named" else v.named.split("[")[0]
+    return {"kind": v.kind, "named": named, "covered": bool(q05 <= rec["truth_f"] <= q95),
+            "candidates": [v.named, *v.rivals] if v.kind == "candidates" else []}
+
+
+def hidden(group: str) -> str | None:
+    return None if group.startswith("clean") else group.removeprefix("axisymmetric_")
+
+
+def table(records: list[dict], rule: NamingRule) -> str:
+    rows = defaultdict(Counter)
+    confusion = defaultdict(Counter)
+    for rec in records:
+        o = outcome(rec, rule)
+        c = rows[rec["group"]]
+        c["n"] += 1
+        c[o["kind"]] += 1
+        c["exact"] += o["named"] is not None and o["named"] == hidden(rec["group"])
+        c["in_candidates"] += hidden(rec["group"]) in [x.split("[")[0] for x in o["candidates"] if x]
+        c["covered"] += o["covered"]
+        confusion[rec["group"]][o["named"] or f"({o['kind']})"] += 1
+    head = (f"{'group':<32} {'n':>3} {'named':>5} {'cand.':>5} {'unexpl.':>7} {'none':>4} {'exact':>5} "
+            f"{'in cand.':>8} {'f cov.':>6}  first named cause (or verdict)")
+    lines = [head]
+    for g in sorted(rows):
+        c = rows[g]
+        conf = ", ".join(f"{k} {v}" for k, v in confusion[g].most_common())
+        lines.append(f"{g:<32} {c['n']:>3} {c['named']:>5} {c['candidates']:>5} {c['unexplained']:>7} {c['none']:>4} "
+                     f"{c['exact']:>5} {c['in_candidates']:>8} {c['covered']:>6}  {conf}")
+    clean = [g for g in rows if g.startswith("clean")]
+    effect = [g for g in rows if not g.startswith("clean")]
+
+    def share(groups, key):
+        n = sum(rows[g]["n"] for g in groups)
+        return f"{sum(rows[g][key] for g in groups)}/{n}"
+
+    lines.append(f"clean records with a cause named: {share(clean, 'named')}; single effects with the exact cause: "
+                 f"{share(effect, 'exact')}; f covered on effect records: {share(effect, 'covered')}, on clean: "
+                 f"{share(clean, 'covered')}")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("records")
+    a = ap.parse_args()
+    records = load(a.records)
+    rule = NamingRule()
+    variants = {
+        "the package's rule": rule,
+        "without the misfit gate": dataclasses.replace(rule, require_misfit=False),
+        "against passing rivals only": dataclasses.replace(rule, against_all=False),
+        "no spread test": dataclasses.replace(rule, drop_fraction=0.0),
+        "spread test 10 %": dataclasses.replace(rule, drop_fraction=0.10),
+    }
+    for name, r in variants.items():
+        print(f"\n== {name}: {r}")
+        print(table(records, r))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
