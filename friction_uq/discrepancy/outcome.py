@@ -112,6 +112,11 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     fx = dg.final.f_summary()
     if not dg.causes and dg.mixture_f is not None:
         return _mixture_sentence(dg, f_without)
+    if not dg.causes and dg.misfits and not dg.misfits[0].detected:
+        return (f"The simulated test reproduces every gauge within what two simulators of the same test differ by: "
+                f"nothing to explain (closest cause: {dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- "
+                f"{dg.ranking[0].se:.1f} nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
+                f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     if not dg.causes:
         return (f"No cause of the catalogue explains the record clearly better than the simple model (closest: "
                 f"{dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f} "

@@ -31,13 +31,17 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    rows, labels, named, seps = [], [], [], []
+    rows, labels, named, seps, colours = [], [], [], [], []
     for k, rnd in enumerate(dg.rounds):
         cause = dg.causes[k] if k < len(dg.causes) else None
+        judged = {c.label: c for c in dg.verdicts[k].candidates} if k < len(dg.verdicts) else {}
         for r in rnd:
+            c = judged.get(r.fit.label)
             rows.append(r)
-            labels.append(f"{k + 1}: {r.fit.variants[-1].label}")
+            labels.append(f"{k + 1}: {r.fit.variants[-1].label}" + (f" (w {c.weight:.2f})" if c is not None else ""))
             named.append(cause is not None and r.fit.variants[-1] is cause)
+            colours.append("tab:red" if (c.passes if c is not None else r.decisive) else
+                           "tab:orange" if r.decisive else "0.6")
         seps.append(len(rows))
     y = np.arange(len(rows))[::-1]
     d = np.array([r.delpd for r in rows])
@@ -45,7 +49,7 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
     shown = np.sign(d) * np.log10(1.0 + np.abs(d))
     lo = np.sign(d - 2 * se) * np.log10(1.0 + np.abs(d - 2 * se))
     hi = np.sign(d + 2 * se) * np.log10(1.0 + np.abs(d + 2 * se))
-    ax.barh(y, shown, color=["tab:red" if r.decisive else "0.6" for r in rows])
+    ax.barh(y, shown, color=colours)
     ax.errorbar(shown, y, xerr=[shown - lo, hi - shown], fmt="none", ecolor="k", lw=0.8)
     ax.axvline(np.log10(1.0 + RULE.min_delpd), color="tab:blue", ls="--", lw=0.8)
     ax.axvline(0.0, color="k", lw=0.6)
@@ -57,9 +61,13 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
     ax.set_xlabel("dELPD over the round's reference model, sign(d) log10(1 + |d|), bars +- 2 SE;\n"
                   "left of 0: predicts the record worse than the reference (its parameters cost more "
                   "than they explain)", fontsize=8)
-    ax.legend([Patch(color="tab:red"), Patch(color="0.6"), Line2D([], [], color="tab:blue", ls="--")],
-              ["decisive (bold: the cause named in that round)", "not decisive", "dELPD = 4"],
+    ax.legend([Patch(color="tab:red"), Patch(color="tab:orange"), Patch(color="0.6"),
+               Line2D([], [], color="tab:blue", ls="--")],
+              ["decisive and spread over the record (bold: the cause named in that round)",
+               "decisive, but carried by a few blocks (5 % left out: not decisive)", "not decisive", "dELPD = 4"],
               loc="lower right", fontsize=7)
+    ax.text(0.0, -0.16, "w: stacking weight, the share of the record's predictions the model carries against the "
+            "round's reference and the other mechanisms", transform=ax.transAxes, fontsize=7)
     ax.set_title("rounds 1, 2, ...: each mechanism added to the model of the round before", fontsize=9)
 
 
@@ -85,10 +93,15 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
             q = np.quantile(x, [0.05, 0.5, 0.95])
             lines.append(f"   {p.name} = {q[1]:.4g} [{q[0]:.4g}, {q[2]:.4g}] {p.unit}: {p.meaning}")
     m0 = dg.misfits[0] if dg.misfits else None
-    lines += ["", "Rule: decisive when dELPD > 4 and either > 2 SE or, once the reference model's misfit is "
-                  "detected, > max(40, 1 SE); the cause is the decisive one with the largest dELPD; others as "
-                  "close to it are not separable from this record; then the search goes on with the cause in "
-                  "the model."]
+    if dg.mixture_f is not None:
+        fm = np.quantile(dg.mixture_f, [0.05, 0.5, 0.95])
+        lines.insert(6, f"f, stacking mixture ({', '.join(f'{k} {w:.2f}' for k, w in dg.mixture_weights.items())}): "
+                        f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (the f to quote)")
+    lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
+                  "round's reference is > 4 and > 2 SE, still is with the 5 % of blocks most in its favour left "
+                  "out, and beats every other mechanism by the same margin; several that pass but do not beat each "
+                  "other are candidates, a misfit none explains is unexplained (f then from the stacking mixture); "
+                  "after a named cause the search goes on with it in the model."]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")

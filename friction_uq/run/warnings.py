@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
 from scipy import stats
 
 from ..analysis import Identification
@@ -65,6 +66,13 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     """What to do about a misfit: diagnose it, or (diagnosed) quote f under the causes it named."""
     if diagnosis is None:
         return "`friction-uq diagnose` names the cause and gives f under it."
+    if not diagnosis.causes and diagnosis.mixture_f is not None:
+        fm = diagnosis.mixture_f
+        q05, q50, q95 = (float(x) for x in np.quantile(fm, [0.05, 0.5, 0.95]))
+        what = "no single cause explains it" if diagnosis.verdict.kind == "unexplained" else \
+            "the record does not tell its candidate causes apart"
+        return (f"`diagnose`: {what}; f from their stacking mixture is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the "
+                "JSON's f), wide enough for whichever is right: quote that, with this warning.")
     if not diagnosis.causes:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
     fx = diagnosis.final.f_summary()
