@@ -180,8 +180,9 @@ def test_clean_record_names_no_cause(tmp_path):
     fx = dg.final.f_summary()
     assert fx["q05"] <= 0.06 <= fx["q95"]
     doc = outcome.to_json(dg, {"mean": 0.06, "sd": 0.003, "q05": 0.055, "q50": 0.06, "q95": 0.065})
-    assert doc["cause"] is None and doc["not_separable"] == []
-    assert doc["sentence"].startswith("No cause of the catalogue")
+    assert doc["cause"] is None and doc["not_separable"] == [] and doc["verdict"] == "none"
+    assert doc["mixture"] is None
+    assert doc["sentence"].startswith("The simulated test reproduces every gauge") and "nothing to explain" in doc["sentence"]
 
 
 def test_a_hoop_gauge_calibration_error_is_said_not_named(tmp_path):

@@ -200,8 +200,10 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         say(f"round {k + 1}: {verdict.kind}" + (f" ({verdict.named})" if verdict.named else ""))
         if verdict.named is not None and k == 0:
             not_sep, other_channels, separate_by = separability(verdict)
-        if verdict.kind != "named":
+        if verdict.kind not in ("named", "candidates"):
             break
+        # candidates: the best goes into the model all the same; a rival that is a second cause passes again in a
+        # later round, one that is an alternative does not (then f is the mixture of the two, below)
         best = next(r for r in ranked if r.fit.label == verdict.named)
         causes.append(best.fit.variants[-1])
         reference = best.fit
@@ -218,12 +220,37 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final)
         k, ess, method = ex.pareto_k, ex.ess, ex.method
+        mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed)
     return Diagnosis(baseline=base, rounds=tuple(rounds), misfits=tuple(misfits), causes=tuple(causes),
                      not_separable=not_sep, channels_not_separable=other_channels, separate_by=separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
                      posterior_method=method, context=dg.context, seed=seed, verdicts=tuple(verdicts),
                      mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src)
+
+
+def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
+                  seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+    """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
+    is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
+    fits, weighted by that round's stacking weights; (None, {}, None) when every rival was resolved."""
+    named = {v.mechanism.name for v in causes}
+    for k, verdict in enumerate(verdicts):
+        if verdict.kind != "candidates":
+            continue
+        by = {c.label: c for c in verdict.candidates}
+        left = [label for label in verdict.rivals if by[label].mechanism not in named]
+        if not left:
+            continue
+        fits = {r.fit.label: r.fit for r in rounds[k]}
+        draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
+        w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
+        if sum(w.values()) <= 0.0:
+            w = {label: 1.0 for label in w}
+        x, which = mixture_draws(draws, w, n=MIXTURE_DRAWS, rng=stream(seed, "mixture"))
+        total = sum(w.values())
+        return x, {label: v / total for label, v in w.items()}, which
+    return None, {}, None
 
 
 def mixture(base: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict,

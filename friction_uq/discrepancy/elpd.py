@@ -56,6 +56,7 @@ import numpy as np
 
 from ..stats.ar1 import LOG_2PI as _LOG_2PI
 from ..stats.decision import paired_difference
+from ..stats.trimmed import trimmed_difference
 
 #: The smallest share of a calibration datum's variance s^2 taken as not yet told by the record (s^2 - v >=
 #: this s^2): where the record says nothing of the quantity, its posterior is the datum and the left-out
@@ -134,10 +135,12 @@ def with_calibration(e: Elpd, terms: dict[str, tuple[float, float, float]]) -> E
                    calibration_names=tuple(terms))
 
 
-def elpd_difference(a: Elpd, b: Elpd) -> tuple[float, float]:
+def elpd_difference(a: Elpd, b: Elpd, *, drop: int = 0) -> tuple[float, float]:
     """elpd(a) - elpd(b) and its standard error (same pointwise layout; module docstring). Calibration data
-    count when both models have the same ones."""
-    total, se = paired_difference(a.pointwise, b.pointwise)
+    count when both models have the same ones. ``drop``: the blocks most in favour of ``a`` left out
+    (:func:`friction_uq.stats.trimmed.trimmed_difference`; the calibration data are kept)."""
+    total, se = (paired_difference(a.pointwise, b.pointwise) if drop == 0 else
+                 trimmed_difference(a.pointwise, b.pointwise, drop=drop))
     var = se * se
     if len(a.calibration) and a.calibration_names == b.calibration_names:
         total += float(np.sum(a.calibration - b.calibration))

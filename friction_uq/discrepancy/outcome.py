@@ -47,10 +47,10 @@ def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
     """The headline f of a diagnosed record: the final model's label and its f when a cause was named; the
     stacking mixture's when the record named candidates or an unexplained misfit (:mod:`.verdict`); None when
     nothing needed explaining (the headline is then the stationary analysis' f)."""
-    if dg.causes:
-        return dg.final.label, dg.final.f_summary()
     if dg.mixture_f is not None:
         return mixture_label(dg), summarize_draws(dg.mixture_f)
+    if dg.causes:
+        return dg.final.label, dg.final.f_summary()
     return None
 
 
@@ -130,9 +130,13 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     sep = ""
     if dg.not_separable:
         sep = (f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would.")
+    quote = "with them (the f to quote)"
+    if dg.mixture_f is not None:  # a first cause the record does not tell from an alternative: f from both
+        fx = summarize_draws(dg.mixture_f)
+        quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
     first = dg.ranking[0]
     return (f"Causes found, the one that moves f most first: {named}. f = {fx['q50']:.3f} [{fx['q05']:.3f}, "
-            f"{fx['q95']:.3f}] with them (the f to quote), {f_without['q50']:.3f} from the stationary analysis "
+            f"{fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from the stationary analysis "
             f"without them. Why: {_describe(dg)}; the first cause's evidence is {first.delpd:.0f} +- {first.se:.0f} "
             f"nats.{sep}{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
 
@@ -257,7 +261,8 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
     drawn from (what a campaign divides out when it pools the f this record quotes)."""
     import xarray as xr
 
-    fits = {"reference": dg.baseline} | {r.fit.label: r.fit for r in dg.ranking}
+    fits = ({"reference": dg.baseline} | {r.fit.label: r.fit for rnd in dg.rounds for r in rnd}
+            | {dg.final.label: dg.final})
     labels = list(dg.mixture_weights)
     log_prior = np.empty(len(dg.mixture_f))
     notes = []
@@ -286,7 +291,7 @@ def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
                                             for rnd in dg.rounds for r in rnd]
     # the group of the model the headline f comes from (empty: no cause named, the stationary posterior's f)
     dt.attrs["discrepancy_final_group"] = f"discrepancy_{group_key(dg.final.label)}" if dg.causes else ""
-    if not dg.causes and dg.mixture_f is not None:
+    if dg.mixture_f is not None:
         dt.attrs["discrepancy_final_group"] = "discrepancy_mixture"
         dt["discrepancy_mixture/posterior"] = xr.DataTree(_mixture_dataset(dg, f_prior))
     for mf in fits:

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..stats import RULE, WeightRule, stacking_weights
-from ..stats.trimmed import points_to_drop, trimmed_difference
+from ..stats.trimmed import points_to_drop
 
 #: The share of a record's blocks that the spread test leaves out (the most favourable to the mechanism):
 #: set on clean records of the axisymmetric simulation and of the perturbed 1-D one against records with one
@@ -97,10 +97,10 @@ class NamingRule:
 
     def candidate(self, fit, reference, delpd: float, se: float, weight: float) -> Candidate:
         """One model against the reference, with the spread test."""
+        from .elpd import elpd_difference
+
         drop = points_to_drop(len(reference.elpd.pointwise), self.drop_fraction)
-        dt, set_ = trimmed_difference(fit.elpd.pointwise, reference.elpd.pointwise, drop=drop)
-        cal = _calibration_difference(fit.elpd, reference.elpd)
-        dt += cal
+        dt, set_ = elpd_difference(fit.elpd, reference.elpd, drop=drop)
         v = fit.variants[-1]
         return Candidate(fit.label, v.mechanism.name, v.channel, delpd, se, dt, set_, weight,
                          RULE.decisive(delpd, se), RULE.decisive(dt, set_))
@@ -129,13 +129,6 @@ class NamingRule:
         others = [c for c in rivals if c.mechanism != best.mechanism]
         kind = "candidates" if others else "named"
         return Verdict(kind, cands, weights, named=best.label, rivals=tuple(c.label for c in rivals), dropped=drop)
-
-
-def _calibration_difference(a, b) -> float:
-    """The calibration data's share of ELPD(a) - ELPD(b) (when both models have the same data)."""
-    if len(a.calibration) and tuple(a.calibration_names) == tuple(b.calibration_names):
-        return float(np.sum(np.asarray(a.calibration) - np.asarray(b.calibration)))
-    return 0.0
 
 
 def _weights(reference, fits: Sequence, seed: int) -> dict[str, float]:

@@ -77,6 +77,11 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
     fx = diagnosis.final.f_summary()
     names = ", ".join(v.label for v in diagnosis.causes)
+    if diagnosis.mixture_f is not None:  # the first cause not told from an alternative: f from both
+        q05, q50, q95 = (float(x) for x in np.quantile(diagnosis.mixture_f, [0.05, 0.5, 0.95]))
+        return (f"`diagnose` names {names}, the first not told apart from {', '.join(diagnosis.not_separable[1:])}: "
+                f"f from the mixture of the two is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the JSON's f), which is the f "
+                "to quote.")
     return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "
             "(the JSON's f), which is the f to quote.")
 
