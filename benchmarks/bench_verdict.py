@@ -91,13 +91,14 @@ def table(records: list[dict], rule: NamingRule) -> str:
         c["in_candidates"] += hidden(rec["group"]) in [x.split("[")[0] for x in o["candidates"] if x]
         c["covered"] += o["covered"]
         confusion[rec["group"]][o["named"] or f"({o['kind']})"] += 1
-    head = (f"{'group':<32} {'n':>3} {'named':>5} {'cand.':>5} {'unexpl.':>7} {'none':>4} {'exact':>5} "
+    head = (f"{'group':<32} {'n':>3} {'named':>5} {'cand.':>5} {'unexpl.':>7} {'unconf.':>7} {'none':>4} {'exact':>5} "
             f"{'in cand.':>8} {'f cov.':>6}  first named cause (or verdict)")
     lines = [head]
     for g in sorted(rows):
         c = rows[g]
         conf = ", ".join(f"{k} {v}" for k, v in confusion[g].most_common())
-        lines.append(f"{g:<32} {c['n']:>3} {c['named']:>5} {c['candidates']:>5} {c['unexplained']:>7} {c['none']:>4} "
+        lines.append(f"{g:<32} {c['n']:>3} {c['named']:>5} {c['candidates']:>5} {c['unexplained']:>7} "
+                     f"{c['unconfirmed']:>7} {c['none']:>4} "
                      f"{c['exact']:>5} {c['in_candidates']:>8} {c['covered']:>6}  {conf}")
     clean = [g for g in rows if g.startswith("clean")]
     effect = [g for g in rows if not g.startswith("clean")]

@@ -11,7 +11,8 @@ each round's verdict with the naming rule of :mod:`.verdict`.
   listed as uncertain;
 * a misfit of the reference model (the whole-record check's decision, :mod:`.misfit`) that no mechanism
   explains by that rule is *unexplained*: the candidates are listed with their stacking weights and f is
-  their mixture's;
+  their mixture's; a mechanism that passes without such a misfit is *unconfirmed*: not named, f from the
+  mixture of it and the reference;
 * after a named cause the search goes on with it in the model (the reference becomes baseline + cause),
   for at most four causes, so that a record with several effects gets them in order of evidence; it stops
   at the first round that names nothing.
@@ -195,7 +196,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         fitted += len(jobs)
         ranked = rank(reference, fits, misfit=misfits[-1].detected)
         rounds.append(ranked)
-        verdict = NAMING.judge(reference, ranked, misfit=misfits[-1].detected, seed=seed + k)
+        verdict = NAMING.judge(reference, ranked, misfit=misfits[-1].detected, seed=seed + k, first=k == 0)
         verdicts.append(verdict)
         say(f"round {k + 1}: {verdict.kind}" + (f" ({verdict.named})" if verdict.named else ""))
         if verdict.named is not None and k == 0:
@@ -258,7 +259,7 @@ def mixture(base: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict,
     """f's draws from the stacking mixture of the models that carry the weight (:mod:`.verdict`), their weights
     and each draw's model, when the first round named no single cause but found candidates or an unexplained
     misfit; (None, {}, None) otherwise."""
-    if verdict.kind not in ("candidates", "unexplained"):
+    if verdict.kind not in ("candidates", "unexplained", "unconfirmed"):
         return None, {}, None
     fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
     keep = [k for k in verdict.supported if verdict.weights[k] > 0.0]

@@ -147,7 +147,10 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     shares = ", ".join(f"{'no cause' if k == 'reference' else _words_of(dg, k)} {100 * w:.0f} %"
                        for k, w in dg.mixture_weights.items())
     v = dg.verdict
-    if v.kind == "candidates":
+    if v.kind == "unconfirmed":
+        what = (f"{_words_of(dg, v.named)} predicts the record better than the simple model, but the simple model "
+                "already reproduces every gauge within what two simulators of the same test differ by: not named.")
+    elif v.kind == "candidates":
         what = (f"This record does not tell apart {', '.join(dg.not_separable) or 'the candidates'}"
                 f"{'; ' + dg.separate_by + ' would' if dg.separate_by else ''}.")
     else:
