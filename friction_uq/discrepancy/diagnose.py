@@ -209,6 +209,8 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         causes.append(best.fit.variants[-1])
         reference = best.fit
     final = reference
+    if not_sep and {m for m in not_sep[1:]} <= {v.mechanism.name for v in causes}:
+        not_sep, separate_by = (), None  # the rivals of round 1 were second causes, named in later rounds
     say("posterior predictive of the final model")
     if causes and len(next(iter(final.predicted.values()))) == 1:  # the mode only: a cause of the last round
         final = replace(final, predicted=dg.predictive(final))
