@@ -85,7 +85,7 @@ def test_each_models_group_holds_the_log_prior_of_f_effective_beside_its_draws(t
     base = _model("baseline", (), rng.normal(0.05, 0.002, 200))
     vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
     dg = SimpleNamespace(baseline=base, final=vel, causes=vel.variants, rounds=((SimpleNamespace(fit=vel),),),
-                         posterior_method="importance", context=CTX, seed=4)
+                         posterior_method="importance", context=CTX, seed=4, mixture_f=None)
     dt = xr.DataTree()
     outcome.add_to_datatree(dt, dg, F_PRIOR)
     dt.to_netcdf(tmp_path / "d.nc", engine="h5netcdf")
@@ -106,3 +106,29 @@ def test_a_law_that_is_not_monotone_in_f_is_refused():
     with pytest.raises(ValueError, match="decreases with f"):
         log_prior_f_effective((SimpleNamespace(mechanism=mech, label="odd"),), CTX, F_PRIOR, np.array([0.05]),
                               rng=np.random.default_rng(0))
+
+
+def test_the_mixture_group_holds_each_draws_prior_from_the_model_it_came_from(tmp_path):
+    """Under candidates or an unexplained misfit the f to quote is a stacking mixture: each of its draws keeps the
+    log prior of f_effective under the model it was drawn from, for a campaign to divide out."""
+    import xarray as xr
+
+    rng = np.random.default_rng(1)
+    base = _model("baseline", (), rng.normal(0.05, 0.002, 200))
+    vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
+    f = np.concatenate([base.f_effective[:30], vel.f_effective[:70]])
+    source = np.repeat([0, 1], [30, 70])
+    dg = SimpleNamespace(baseline=base, final=base, causes=(), rounds=((SimpleNamespace(fit=vel),),),
+                         ranking=(SimpleNamespace(fit=vel),), posterior_method=None, context=CTX, seed=4,
+                         mixture_f=f, mixture_source=source, mixture_weights={"reference": 0.3, "velocity_friction": 0.7},
+                         verdict=SimpleNamespace(kind="unexplained"))
+    dt = xr.DataTree()
+    outcome.add_to_datatree(dt, dg, F_PRIOR)
+    dt.to_netcdf(tmp_path / "d.nc", engine="h5netcdf")
+    with xr.open_datatree(tmp_path / "d.nc", engine="h5netcdf") as back:
+        assert back.attrs["discrepancy_final_group"] == "discrepancy_mixture"
+        m = back["discrepancy_mixture/posterior"]
+        lp = m["log_prior_f_effective"].values[0]
+        np.testing.assert_allclose(lp[:30], F_PRIOR.logpdf(f[:30]))  # the reference leaves f as it is
+        assert list(m["model"].values[0][[0, -1]]) == ["reference", "velocity_friction"]
+        assert np.all(np.isfinite(lp)) and not np.allclose(lp[30:], F_PRIOR.logpdf(f[30:]))
