@@ -208,7 +208,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
     hoop = dg.final.hoop_gain
     v = dg.verdict
     return {
-        "verdict": v.kind if v is not None else None,
+        # the record's: named when causes were (a first round's candidates resolved later, or not: then `mixture`)
+        "verdict": "named" if dg.causes else (v.kind if v is not None else None),
+        "round_verdicts": [r.kind for r in dg.verdicts],
         "stacking_weights": dict(v.weights) if v is not None else {},
         "mixture": None if dg.mixture_f is None else {"weights": dict(dg.mixture_weights),
                                                       "f": summarize_draws(dg.mixture_f)},
