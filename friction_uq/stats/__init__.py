@@ -13,6 +13,8 @@
   of a density over draws;
 * :mod:`.decision`: the rule that says when an ELPD difference decides (:data:`RULE`) and the standard
   error of a paired difference;
+* :mod:`.trimmed`: an ELPD difference with the points most in the first model's favour left out (is the
+  evidence spread over the data, or carried by a few points?);
 * :mod:`.weights`: stacking weights and the rule that reads a verdict from them;
 * :mod:`.streams`: named random streams (one seeded Generator per purpose and model) and the
   legacy seeding emcee needs.
