@@ -107,14 +107,19 @@ def make_record(cfg, path: str, seed: int, how: str | None, r: np.random.Generat
     sim = simulate(cfg, seed=seed)
     noisy = dict(sim.noisy)
     what = _edit_strains(noisy, how, r)
+    write_strains(cfg, path, sim, noisy, campaign="T")
+    return sim.model, what
+
+
+def write_strains(cfg, path: str, sim, noisy: dict, *, campaign: str) -> None:
+    """Write a simulated test with its measured strains as edited (``noisy``) to ``path``, named by the file."""
     spv = {n: float(s.strain_per_volt) for n, s in cfg.channels.items()
            if n in noisy and s.units == "V" and s.strain_per_volt is not None}
-    write_record(path, test_id=os.path.basename(path)[:-3], campaign="T", sample_rate=cfg.sample_rate, strains=noisy,
-                 apparatus=cfg.apparatus, t0=float(sim.time[0]),
+    write_record(path, test_id=os.path.basename(path)[:-3], campaign=campaign, sample_rate=cfg.sample_rate,
+                 strains=noisy, apparatus=cfg.apparatus, t0=float(sim.time[0]),
                  units={n: s.units for n, s in cfg.channels.items() if n in noisy}, strain_per_volt=spv,
                  striker_velocity=cfg.striker_velocity, truth=sim.truth,
                  provenance={"simulator_model_version": MODEL_VERSION, "seed": int(sim.seed)})
-    return sim.model, what
 
 
 def analyse_one(group: str, k: int, rng: np.random.Generator, tmp: str, seed: int) -> dict:

@@ -28,11 +28,11 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from friction_uq.discrepancy.diagnose import Ranked
+from friction_uq.discrepancy.diagnose import Ranked, mixture
 from friction_uq.discrepancy.elpd import Elpd, elpd_difference
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
-from friction_uq.discrepancy.verdict import NamingRule, mixture_draws
+from friction_uq.discrepancy.verdict import NamingRule
 
 
 def _elpd(a: dict, key: str, names) -> Elpd:
@@ -66,9 +66,7 @@ def outcome(rec: dict, rule: NamingRule) -> dict:
     elif v.kind == "none":
         f = rec["reference"].f_effective
     else:
-        keep = v.supported
-        f, _ = mixture_draws({k: fits[k].f_effective for k in keep}, {k: v.weights[k] for k in keep}, n=1000,
-                             rng=np.random.default_rng(0))
+        f, _, _ = mixture(rec["reference"], rec["ranked"], v, 0)
     q05, q95 = np.quantile(f, [0.05, 0.95])
     named = None if v.named is None or v.kind != "named" else v.named.split("[")[0]
     return {"kind": v.kind, "named": named, "covered": bool(q05 <= rec["truth_f"] <= q95),

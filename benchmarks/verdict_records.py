@@ -36,12 +36,11 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_diagnose import HIDDEN, analyse, true_f  # noqa: E402
 from bench_misfit import clean_config  # noqa: E402
+from bench_trust import write_strains  # noqa: E402
 
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
-from friction_uq.record import write_record  # noqa: E402
 from friction_uq.simulate import simulate  # noqa: E402
-from friction_uq.simulate.simulation import MODEL_VERSION  # noqa: E402
 
 #: The mechanisms the axisymmetric simulation also has.
 AXISYMMETRIC_MECHANISMS = ("plug_friction", "clearance", "velocity_friction", "pressure_friction", "slip_friction")
@@ -104,13 +103,7 @@ def write(cfg, path: str, seed: int, shift) -> object:
         ch, dt = shift
         t = sim.time
         noisy[ch] = np.interp(t - dt, t, noisy[ch])
-    spv = {n: float(s.strain_per_volt) for n, s in cfg.channels.items()
-           if n in noisy and s.units == "V" and s.strain_per_volt is not None}
-    write_record(path, test_id=os.path.basename(path)[:-3], campaign="V", sample_rate=cfg.sample_rate, strains=noisy,
-                 apparatus=cfg.apparatus, t0=float(sim.time[0]),
-                 units={n: s.units for n, s in cfg.channels.items() if n in noisy}, strain_per_volt=spv,
-                 striker_velocity=cfg.striker_velocity, truth=sim.truth,
-                 provenance={"simulator_model_version": MODEL_VERSION, "seed": int(sim.seed)})
+    write_strains(cfg, path, sim, noisy, campaign="V")
     return sim
 
 

@@ -78,18 +78,23 @@ def _model(label: str, names: tuple[str, ...], f: np.ndarray):
                            fit=SimpleNamespace(draws={"f": f, "nu": np.full(f.size, 0.4)}))
 
 
-def test_each_models_group_holds_the_log_prior_of_f_effective_beside_its_draws(tmp_path):
+def _written(dg, tmp_path):
+    """The diagnosis' groups as a run writes them to its .nc, opened again."""
     import xarray as xr
 
+    dt = xr.DataTree()
+    outcome.add_to_datatree(dt, dg, F_PRIOR)
+    dt.to_netcdf(tmp_path / "d.nc", engine="h5netcdf")
+    return xr.open_datatree(tmp_path / "d.nc", engine="h5netcdf")
+
+
+def test_each_models_group_holds_the_log_prior_of_f_effective_beside_its_draws(tmp_path):
     rng = np.random.default_rng(0)
     base = _model("baseline", (), rng.normal(0.05, 0.002, 200))
     vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
     dg = SimpleNamespace(baseline=base, final=vel, causes=vel.variants, rounds=((SimpleNamespace(fit=vel),),),
                          posterior_method="importance", context=CTX, seed=4, mixture_f=None)
-    dt = xr.DataTree()
-    outcome.add_to_datatree(dt, dg, F_PRIOR)
-    dt.to_netcdf(tmp_path / "d.nc", engine="h5netcdf")
-    with xr.open_datatree(tmp_path / "d.nc", engine="h5netcdf") as back:
+    with _written(dg, tmp_path) as back:
         assert back.attrs["discrepancy_final_group"] == "discrepancy_velocity_friction"
         b = back["discrepancy_baseline/posterior"]
         np.testing.assert_allclose(b["log_prior_f_effective"].values, F_PRIOR.logpdf(b["f_effective"].values))
@@ -111,8 +116,6 @@ def test_a_law_that_is_not_monotone_in_f_is_refused():
 def test_the_mixture_group_holds_each_draws_prior_from_the_model_it_came_from(tmp_path):
     """Under candidates or an unexplained misfit the f to quote is a stacking mixture: each of its draws keeps the
     log prior of f_effective under the model it was drawn from, for a campaign to divide out."""
-    import xarray as xr
-
     rng = np.random.default_rng(1)
     base = _model("baseline", (), rng.normal(0.05, 0.002, 200))
     vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
@@ -122,10 +125,7 @@ def test_the_mixture_group_holds_each_draws_prior_from_the_model_it_came_from(tm
                          ranking=(SimpleNamespace(fit=vel),), posterior_method=None, context=CTX, seed=4,
                          mixture_f=f, mixture_source=source, mixture_weights={"reference": 0.3, "velocity_friction": 0.7},
                          verdict=SimpleNamespace(kind="unexplained"))
-    dt = xr.DataTree()
-    outcome.add_to_datatree(dt, dg, F_PRIOR)
-    dt.to_netcdf(tmp_path / "d.nc", engine="h5netcdf")
-    with xr.open_datatree(tmp_path / "d.nc", engine="h5netcdf") as back:
+    with _written(dg, tmp_path) as back:
         assert back.attrs["discrepancy_final_group"] == "discrepancy_mixture"
         m = back["discrepancy_mixture/posterior"]
         lp = m["log_prior_f_effective"].values[0]

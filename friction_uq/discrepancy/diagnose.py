@@ -250,9 +250,7 @@ def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes
         w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
         if sum(w.values()) <= 0.0:
             w = {label: 1.0 for label in w}
-        x, which = mixture_draws(draws, w, n=MIXTURE_DRAWS, rng=stream(seed, "mixture"))
-        total = sum(w.values())
-        return x, {label: v / total for label, v in w.items()}, which
+        return _draw_mixture(draws, w, seed)
     return None, {}, None
 
 
@@ -266,10 +264,16 @@ def mixture(base: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict,
     fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
     keep = [k for k in verdict.supported if verdict.weights[k] > 0.0]
     w = {k: verdict.weights[k] for k in keep}
-    draws, which = mixture_draws({k: fits[k].f_effective for k in keep}, w, n=MIXTURE_DRAWS,
-                                  rng=stream(seed, "mixture"))
-    total = sum(w.values())
-    return draws, {k: v / total for k, v in w.items()}, which
+    return _draw_mixture({k: fits[k].f_effective for k in keep}, w, seed)
+
+
+def _draw_mixture(draws: dict[str, np.ndarray], weights: dict[str, float],
+                  seed: int) -> tuple[np.ndarray, dict[str, float], np.ndarray]:
+    """:data:`MIXTURE_DRAWS` draws of the mixture (the "mixture" stream of ``seed``), the weights normalised, and
+    each draw's model."""
+    x, which = mixture_draws(draws, weights, n=MIXTURE_DRAWS, rng=stream(seed, "mixture"))
+    total = sum(weights.values())
+    return x, {k: v / total for k, v in weights.items()}, which
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

@@ -146,7 +146,7 @@ def _weights(reference, fits: Sequence, seed: int) -> dict[str, float]:
     """Stacking weights of the reference ("reference") and each fit, over the blocks and the calibration data
     they share (the calibration data are left out where the models do not all have the same)."""
     same = all(tuple(f.elpd.calibration_names) == tuple(reference.elpd.calibration_names) for f in fits)
-    pts = (lambda e: _points(e)) if same else (lambda e: np.asarray(e.pointwise, float))
+    pts = _points if same else (lambda e: np.asarray(e.pointwise, float))
     pointwise = {"reference": pts(reference.elpd)} | {f.label: pts(f.elpd) for f in fits}
     # a record has hundreds of blocks: the plain stacking optimum is as steady as its Bayesian-bootstrap average
     # (within 0.03 on the calibration records), which a campaign of ten tests needs and which costs a minute here

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import numpy as np
 from scipy import stats
 
 from ..analysis import Identification
@@ -66,9 +65,11 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     """What to do about a misfit: diagnose it, or (diagnosed) quote f under the causes it named."""
     if diagnosis is None:
         return "`friction-uq diagnose` names the cause and gives f under it."
+    from ..discrepancy.outcome import headline
+
     if not diagnosis.causes and diagnosis.mixture_f is not None:
-        fm = diagnosis.mixture_f
-        q05, q50, q95 = (float(x) for x in np.quantile(fm, [0.05, 0.5, 0.95]))
+        fm = headline(diagnosis)[1]
+        q05, q50, q95 = fm["q05"], fm["q50"], fm["q95"]
         what = "no single cause explains it" if diagnosis.verdict.kind == "unexplained" else \
             "the record does not tell its candidate causes apart"
         return (f"`diagnose`: {what}; f from their stacking mixture is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the "
@@ -78,7 +79,8 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     fx = diagnosis.final.f_summary()
     names = ", ".join(v.label for v in diagnosis.causes)
     if diagnosis.mixture_f is not None:  # the first cause not told from an alternative: f from both
-        q05, q50, q95 = (float(x) for x in np.quantile(diagnosis.mixture_f, [0.05, 0.5, 0.95]))
+        fm = headline(diagnosis)[1]
+        q05, q50, q95 = fm["q05"], fm["q50"], fm["q95"]
         return (f"`diagnose` names {names}, the first not told apart from {', '.join(diagnosis.not_separable[1:])}: "
                 f"f from the mixture of the two is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the JSON's f), which is the f "
                 "to quote.")
