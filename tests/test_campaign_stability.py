@@ -28,20 +28,21 @@ def _verdict(ca) -> tuple:
             tuple(sorted({str(f["setup"]) for f in ca.flagged if "setup" in f})))
 
 
-@pytest.mark.slow  # five campaigns of the ten bundled records without PDF reports, about 8 minutes on 2 cores
-@pytest.mark.xfail(strict=False, reason=(
-    "issue 20 point 3 is not true on every machine: on this session's machine campaign seed 4 reads "
-    "('pressure+velocity',) with no set-up flagged (velocity 8.7 +- 0.6 behind) where seeds 1-3 and 5 read "
-    "('pressure', 'velocity') with B flagged, with the previous landed code as with this one (the per-record "
-    "results are bit-identical between the two); the flag of B, a threshold on B's offset, decides whether the "
-    "richer law absorbs it"))
+@pytest.mark.slow  # five campaigns of the ten bundled records without PDF reports, about 5 minutes on 2 cores
 def test_the_bundled_campaign_gives_one_verdict_over_five_seeds(tmp_path):
+    """The laws' fits are sampled in coordinates where their autocorrelation time is tens of steps
+    (friction_uq/campaign/law_coordinates.py); before, it was 200-250 steps against 700 kept, the fits' tails
+    followed the seed, and so did the verdict (seed 4 read pressure+velocity, the others pressure and velocity
+    with B flagged). Converged, every seed reads pressure+velocity, f not constant, and no set-up flagged: B's
+    offset under pressure+velocity is 3.3-3.5 nats (SE 0.8) over the law without it, short of decisive, since
+    the pressure term takes most of B's departure (B's bars put it at higher pressures). That B carries a plug
+    friction the stationary kappa cannot show; `campaign --diagnose` fits it (docs/campaigns.md)."""
     records = sorted(DATA.glob("[AB]/*.h5"))
     verdicts = [_verdict(run_campaign(records, tmp_path / f"s{seed}", seed=seed, pdf=False, progress=False).analysis)
                 for seed in range(1, 6)]
     assert len(set(verdicts)) == 1, verdicts
     laws, not_constant, flagged = verdicts[0]
-    assert not_constant and "constant" not in laws and flagged == ("B",)
+    assert not_constant and "constant" not in laws and flagged == ()
 
 
 def _two_setups(seed: int) -> list[RecordPosterior]:

@@ -26,7 +26,7 @@ from ..stats import RULE, WeightRule, stacking_weights
 from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, law_mean, loo, rank
 from .next_test import Candidate, advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
-from .pooling import Pooled, implied_kappa_log_prior, thin
+from .pooling import Pooled, implied_kappa_log_prior, strata
 
 __all__ = ["CampaignAnalysis", "RecordPosterior", "analyse", "analyse_tests", "read_test_posterior"]
 
@@ -83,24 +83,27 @@ def campaign_nu(tests: Sequence[RecordPosterior], prior_mean: float, prior_sd: f
 def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None) -> LawData:
     """The laws' data: f under each test's diagnosed model when every test was diagnosed (a cause such as
     a clearance or a plug friction biases the stationary kappa by a load-dependent amount that a law
-    in (p, V) would otherwise absorb), else the stationary kappa. Each test carries its draws (thinned
-    to :data:`LAW_DRAWS`) and their log prior: kappa's implied by the test's prior file; f's as the run stored
-    it beside the draws (the diagnosed model's prior on f_effective), else, for a record of a version that
+    in (p, V) would otherwise absorb), else the stationary kappa. Each test carries :data:`LAW_DRAWS` of its
+    draws (:func:`~.pooling.strata`: those at evenly spaced ranks, so that the comparison follows the test's
+    posterior, not which of its draws were kept) and their log prior: kappa's implied by the test's prior
+    file; f's as the run stored it beside the draws (the diagnosed model's prior on f_effective), else, for a record of a version that
     stored none, the file's f prior (the prior of the base f the mechanism starts from).
     ``diagnosed=False`` takes the stationary kappa whatever the tests carry."""
     if diagnosed is None:
         diagnosed = all(t.f_model is not None for t in tests)
-    y = [thin(t.f_model if diagnosed else t.kappa, LAW_DRAWS) for t in tests]
+    source = [np.asarray(t.f_model if diagnosed else t.kappa, float).ravel() for t in tests]
+    picks = [strata(x, LAW_DRAWS) for x in source]
+    y = [x[i] for x, i in zip(source, picks)]
     priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
 
-    def log_prior_of(t: RecordPosterior, v: np.ndarray) -> np.ndarray:
+    def log_prior_of(t: RecordPosterior, v: np.ndarray, i: np.ndarray) -> np.ndarray:
         if not diagnosed:
             return implied_kappa_log_prior(v, priors[t.prior_file])
         if t.f_model_log_prior is not None:
-            return thin(t.f_model_log_prior, LAW_DRAWS)  # the same draws as thin(t.f_model, LAW_DRAWS)
+            return np.asarray(t.f_model_log_prior, float).ravel()[i]  # the log prior of the same draws
         return priors[t.prior_file]["f"].logpdf(v)
 
-    log_prior = tuple(log_prior_of(t, v) for t, v in zip(tests, y))
+    log_prior = tuple(log_prior_of(t, v, i) for t, v, i in zip(tests, y, picks))
     return LawData([t.label for t in tests], [t.setup for t in tests],
                    np.array([np.mean(v) for v in y]), np.array([np.std(v) for v in y]),
                    np.array([t.V["mean"] for t in tests]), np.array([t.V["sd"] for t in tests]),

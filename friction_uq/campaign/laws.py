@@ -52,6 +52,7 @@ from scipy.special import logsumexp
 from ..stats import RULE, paired_difference
 from ..stats.streams import legacy_state
 from .kernels import draw_kernels, log_kernel_mixture
+from .law_coordinates import LawCoordinates
 
 LAWS = ("constant", "velocity", "pressure", "pressure+velocity")
 #: What the laws are fitted to, in words (``LawData.basis``).
@@ -264,14 +265,26 @@ class Fit:
         return ball
 
     def _sample(self, seed: int, nwalkers: int, nsteps: int, burn: int, start: np.ndarray | None) -> np.ndarray:
+        """Draws in the law's parameters, sampled in :class:`~.law_coordinates.LawCoordinates` (the same
+        posterior, with the change's Jacobian; a shape the ensemble crosses in a few tens of steps)."""
         import emcee
 
         rng = np.random.default_rng(seed)
         start = self._start(rng, nwalkers) if start is None else np.asarray(start, float)
-        sampler = emcee.EnsembleSampler(nwalkers, start.shape[1], self._log_prob, vectorize=True)
-        state = emcee.State(start, random_state=legacy_state(rng).get_state())
+        coords = LawCoordinates(self.model.params, self.data.V)
+
+        def log_prob(z: np.ndarray) -> np.ndarray:
+            x, log_jac = coords.to_law(z)
+            ok = np.all(np.isfinite(x), axis=1)
+            out = np.full(len(z), -np.inf)
+            if ok.any():
+                out[ok] = self._log_prob(x[ok]) + log_jac[ok]
+            return out
+
+        sampler = emcee.EnsembleSampler(nwalkers, start.shape[1], log_prob, vectorize=True)
+        state = emcee.State(coords.to_sampling(start), random_state=legacy_state(rng).get_state())
         sampler.run_mcmc(state, nsteps)
-        return sampler.get_chain(discard=burn, thin=5, flat=True)
+        return coords.to_law(sampler.get_chain(discard=burn, thin=5, flat=True))[0]
 
 
 @dataclass(frozen=True)
