@@ -147,36 +147,27 @@ def _render(builders: list[Callable[[], Figure]]) -> bytes:
     return buf.getvalue()
 
 
-#: The record's pages that the run's other core renders (3 and 4; page 2, the raw gauges, is drawn with the
-#: posterior's pages: the two cores' shares of the work are then about equal).
-RECORD_PAGES = 2
-
-
-def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck | None, *, hoop: bool = True) -> bytes:
-    """The pages that need no posterior draw, but for the raw gauges': pages 3-4 and the whole-record check's (from
-    page 10, or 9 without the hoop page: ``hoop``). A run renders them on its other core, after the check,
-    while it samples (:func:`render_report` merges them)."""
+def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck, *, hoop: bool = True) -> bytes:
+    """The whole-record check's pages (from page 10, or 9 without the hoop page: ``hoop``): a run renders them
+    on its other core, after the check, while it samples (:func:`render_report` merges them). The record's
+    own pages (2-4) are drawn with the posterior's: the check is the longer share of the work, and the two
+    cores then finish at about the same time (``benchmarks/bench_run.py``)."""
     from .whole_record_pages import pages_whole_record
 
     p = prepared
-    builders: list[Callable[[], Figure]] = [
-        lambda: page_forces(p.record, p.forces, p.window),
-        lambda: page_window(p.record, p.forces, p.window),
-    ]
-    assert len(builders) == RECORD_PAGES
-    if whole_record is not None:
-        builders += [lambda fig=fig: fig for fig in pages_whole_record(
-            whole_record, test=f"{p.record.campaign} {p.record.test_id}", first_page=10 if hoop else 9)]
-    return _render(builders)
+    return _render([lambda fig=fig: fig for fig in pages_whole_record(
+        whole_record, test=f"{p.record.campaign} {p.record.test_id}", first_page=10 if hoop else 9)])
 
 
 def render_posterior_part(r: ReportInputs) -> bytes:
-    """Page 2 (the raw gauges) and pages 5-8 (and 9, the hoop gauge's, when its term was used): the posterior
-    draws', which need neither the whole-record check nor the diagnosis (a run renders them while it waits
-    for those)."""
+    """Pages 2-4 (the raw gauges, the forces, the window) and 5-8 (and 9, the hoop gauge's, when its term was
+    used): everything but the summary, the whole-record check's and the diagnosis's pages (a run renders them
+    while it waits for those)."""
     p = r.prepared
     builders: list[Callable[[], Figure]] = [
         lambda: page_raw(p.record),
+        lambda: page_forces(p.record, p.forces, p.window),
+        lambda: page_window(p.record, p.forces, p.window),
         lambda: page_corner(r.samples, r.datatree),
         lambda: page_propagation(r.samples, r.band, r.sensitivity, r.nu_share, nu_assumed=r.lab.nu),
         lambda: page_convergence(r.samples, r.convergence),
@@ -195,16 +186,15 @@ def render_report(r: ReportInputs, record_part: bytes | None = None, posterior_p
     from pypdf import PdfReader, PdfWriter
 
     p = r.prepared
-    if record_part is None:
+    if record_part is None and r.whole_record is not None:
         record_part = render_record_part(p, r.whole_record, hoop=r.samples.hoop)
     if posterior_part is None:
         posterior_part = render_posterior_part(r)
     own = [lambda: page_summary(r)] + [lambda fig=fig: fig for fig in diagnosis_pages(r)]
     summary, *diagnosis = PdfReader(io.BytesIO(_render(own))).pages
-    record = PdfReader(io.BytesIO(record_part)).pages
+    check = PdfReader(io.BytesIO(record_part)).pages if record_part is not None else []
     out = PdfWriter()
-    raw, *posterior = PdfReader(io.BytesIO(posterior_part)).pages
-    for page in [summary, raw, *record[:RECORD_PAGES], *posterior, *record[RECORD_PAGES:], *diagnosis]:
+    for page in [summary, *PdfReader(io.BytesIO(posterior_part)).pages, *check, *diagnosis]:
         out.add_page(page)
     out.add_metadata({"/Title": f"friction-uq {p.record.campaign} {p.record.test_id}",
                       "/Creator": f"friction-uq {r.version}"})

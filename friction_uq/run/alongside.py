@@ -26,15 +26,14 @@ def whole_record_start(lab: Identification, priors) -> dict[str, float]:
 def alongside(prep: Prepared, priors, start: dict[str, float], *, hoop: bool, seed: int, check: bool,
               pages: bool) -> tuple[WholeRecordCheck | None, bytes | None]:
     """What a run computes on its other core while it samples: the whole-record check (``check``; it
-    needs no posterior draw) and the report's pages that need none either (``pages``: the record's and
-    the check's)."""
+    needs no posterior draw) and its pages of the report (``pages``)."""
     wrc = None
     if check:
         from ..discrepancy import pipeline
 
         wrc = pipeline.whole_record_check(prep, priors, start, hoop=hoop, seed=seed)
     part = None
-    if pages:
+    if pages and wrc is not None:
         from ..report.pdf import render_record_part
 
         part = render_record_part(prep, wrc, hoop=hoop)

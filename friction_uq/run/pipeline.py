@@ -147,7 +147,7 @@ def run_file(
         import matplotlib.figure  # noqa: F401
     # on the other core while this one samples: forked before the output lock is taken (the child holds
     # no lock), stopped on the way out
-    with (Background(alongside if check or pdf else None, prep, priors, whole_record_start(lab, priors),
+    with (Background(alongside if check else None, prep, priors, whole_record_start(lab, priors),
                      hoop=use_hoop, seed=seed, check=check, pages=pdf) as side_job,
           output_lock(out, stem)):
         backend = out / f".{stem}.checkpoint.npz"
@@ -203,7 +203,7 @@ def run_file(
             posterior_part = render_posterior_part(inputs)
         stages["pdf"] = time.perf_counter() - t
         t = time.perf_counter()  # whole_record: what is left of the check when this process gets to it, and diagnose
-        wrc, record_part = side_job.result() if check or pdf else (None, None)
+        wrc, record_part = side_job.result() if check else (None, None)
         diag = None
         if wrc is not None:
             from ..discrepancy import pipeline
