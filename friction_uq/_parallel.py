@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import multiprocessing
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from .errors import BackgroundError
@@ -131,3 +131,30 @@ class Background:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+_MAPPED: tuple[Callable[[Any], Any], list[Any]] | None = None
+
+
+def _mapped(i: int) -> Any:
+    fn, items = _MAPPED
+    return fn(items[i])
+
+
+def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int) -> list[Any]:
+    """``[fn(x) for x in items]`` on ``workers`` forked processes (where :func:`can_fork`; in turn where not):
+    the items reach the workers by the fork (they need not pickle), the values come back pickled, in order.
+    ``fn`` must give the same value in a child as in this process (a seed in each item, not a shared
+    generator), so that the results do not depend on ``workers``."""
+    global _MAPPED
+    items = list(items)
+    workers = min(workers, len(items))
+    if workers <= 1 or not can_fork():
+        return [fn(x) for x in items]
+    _MAPPED = (fn, items)
+    try:
+        with multiprocessing.get_context("fork").Pool(workers, initializer=end_with_parent) as pool:
+            return pool.map(_mapped, range(len(items)), chunksize=1)
+    finally:
+        _MAPPED = None
+

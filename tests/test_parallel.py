@@ -130,3 +130,47 @@ def test_the_child_ends_when_its_parent_is_killed(tmp_path):
             pass
         time.sleep(0.2)
     pytest.fail(f"the child {pid} still runs 20 s after its parent was killed")
+
+
+def _seeded(item):
+    seed, lam = item
+    return os.getpid(), np.random.default_rng(seed).exponential(lam, 3)
+
+
+def test_a_forked_map_gives_in_order_the_values_of_a_map_in_line():
+    items = [(s, 1.0 + s) for s in range(5)]
+    forked = _parallel.forked_map(_seeded, items, workers=2)
+    in_line = _parallel.forked_map(_seeded, items, workers=1)
+    for (_, a), (_, b) in zip(forked, in_line):
+        np.testing.assert_array_equal(a, b)
+    if can_fork():  # the work was done by other processes
+        assert {pid for pid, _ in forked} != {os.getpid()}
+    assert {pid for pid, _ in in_line} == {os.getpid()}
+
+
+def test_the_campaign_law_comparison_is_the_same_on_one_or_two_processes(monkeypatch):
+    from friction_uq.campaign import analysis
+
+    tests = _campaign_tests()
+    runs = []
+    for workers in (1, 2):
+        monkeypatch.setattr(analysis, "LAW_WORKERS", workers)
+        ca = analysis.analyse_tests(tests, {}, seed=3)
+        runs.append(({r["model"]: r["elpd"] for r in ca.ranking}, ca.weights))
+    assert runs[0] == runs[1]
+
+
+def _campaign_tests():
+    """Six tests of a velocity-weakening wall on one set-up, drawn once."""
+    from friction_uq.campaign.analysis import RecordPosterior
+    from friction_uq.priors import PRIORS_DIR
+
+    rng = np.random.default_rng(2)
+    out = []
+    for k, V in enumerate(np.linspace(6.0, 12.0, 6)):
+        kappa = (0.035 + 0.04 * np.exp(-V / 8)) * 0.4 / 0.6
+        kd, nu = rng.normal(kappa, 0.02 * kappa, 400), rng.normal(0.4, 0.013, 400)
+        out.append(RecordPosterior(f"A-{k}", "A", kd * (1 - nu) / nu, kd, nu, rng.normal(9e6 * V, 4e5, 400),
+                                   {"mean": V, "sd": 1e-3, "q05": V, "q50": V, "q95": V},
+                                   str(PRIORS_DIR / "I1.toml")))
+    return out

@@ -11,6 +11,7 @@ campaign's nu), and flags set-ups and tests (:mod:`.flags`).
 
 from __future__ import annotations
 
+import os
 import time
 
 from collections.abc import Callable, Sequence
@@ -19,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._parallel import forked_map
 from ..priors import load_priors
 from .flags import outlier_tests, setup_flags, tally_causes
 from .job import RecordResult
@@ -35,6 +37,9 @@ MIN_TESTS_FOR_LAWS = 5
 WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
 #: draws per test the laws' likelihood reads (a kernel density of them)
 LAW_DRAWS = 160
+#: processes the law models of one comparison are fitted on (forked where the process may fork; the
+#: results do not depend on it)
+LAW_WORKERS = min(2, os.cpu_count() or 1)
 
 
 @dataclass
@@ -226,6 +231,13 @@ def stationary_flags(tests: Sequence[RecordPosterior], law: str, offsets: Sequen
     return flags
 
 
+def _fit_and_loo(job: tuple[Model, LawData, float, float, int]) -> tuple[Fit, Elpd]:
+    """One law model fitted and its leave-one-test-out ELPD (a job of :func:`~friction_uq._parallel.forked_map`)."""
+    model, data, kbar, p_ref, seed = job
+    fit = Fit(model, data, kbar=kbar, p_ref=p_ref, seed=seed)
+    return fit, loo(fit, seed=seed)
+
+
 class _Laws:
     """The law fits of one campaign analysis: the comparison (fits, LOO, ranking, weights) and the flags."""
 
@@ -234,21 +246,24 @@ class _Laws:
         self.ca, self.data, self.kbar, self.p_ref, self.seed, self.say, self.t0 = ca, data, kbar, p_ref, seed, say, t0
         self.k = 0
 
-    def fit(self, m: Model) -> tuple[Fit, Elpd]:
-        self.say(f"friction law model {self.k + 1} ({m.name}): fit and leave-one-test-out; "
+    def fit_all(self, models: Sequence[Model]) -> list[tuple[Fit, Elpd]]:
+        """Each model fitted with its leave-one-test-out ELPD, on up to :data:`LAW_WORKERS` forked processes; the
+        k-th model of the analysis takes seed ``seed + 1000 k`` whichever process fits it."""
+        first = self.k + 1
+        self.k += len(models)
+        self.say(f"friction law model{'s' if len(models) > 1 else ''} {first}{f'-{self.k}' if len(models) > 1 else ''} "
+                 f"({', '.join(m.name for m in models)}): fit and leave-one-test-out; "
                  f"{time.perf_counter() - self.t0:.0f} s so far")
-        fit = Fit(m, self.data, kbar=self.kbar, p_ref=self.p_ref, seed=self.seed + 1000 * self.k)
-        e = loo(fit, seed=self.seed + 1000 * self.k)
-        self.k += 1
-        self.ca.fits[m.name] = fit
-        return fit, e
+        jobs = [(m, self.data, self.kbar, self.p_ref, self.seed + 1000 * (first - 1 + i)) for i, m in enumerate(models)]
+        out = forked_map(_fit_and_loo, jobs, workers=LAW_WORKERS)
+        for m, (fit, _) in zip(models, out):
+            self.ca.fits[m.name] = fit
+        return out
 
     def compare(self, cal: tuple[str, ...], freed: tuple[str, ...]) -> dict[str, Elpd]:
         """Every law with calibration offsets (and the ``freed`` set-ups' levels left out): ranking and weights."""
-        elpds = {}
-        for law in LAWS:
-            m = Model(law, None, cal, freed)
-            elpds[m.name] = self.fit(m)[1]
+        models = [Model(law, None, cal, freed) for law in LAWS]
+        elpds = {m.name: e for m, (_, e) in zip(models, self.fit_all(models))}
         self.ca.ranking = rank(list(elpds.values()))
         self.ca.weights = {Model(k.split(" + ")[0]).law: w
                            for k, w in stacking_weights({n: e.pointwise for n, e in elpds.items()}).items()}
@@ -268,11 +283,8 @@ class _Laws:
         freed: list[str] = []
         first: dict[str, tuple[Elpd, dict[str, float]]] = {}
         while True:
-            trial = {}
-            for s in offsets:
-                if s not in freed:
-                    fit, e = self.fit(Model(law, s, cal, tuple(freed)))
-                    trial[s] = (e, _summ(fit.draws[:, -2]))
+            models = [Model(law, s, cal, tuple(freed)) for s in offsets if s not in freed]
+            trial = {str(m.offset_setup): (e, _summ(fit.draws[:, -2])) for m, (fit, e) in zip(models, self.fit_all(models))}
             first = first or trial
             flags = setup_flags(base, trial, setups, tallies, quantity=self.data.basis) if trial else []
             if not flags:
