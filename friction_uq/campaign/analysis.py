@@ -22,9 +22,9 @@ import numpy as np
 
 from .._parallel import forked_map
 from ..priors import load_priors
-from .flags import outlier_tests, setup_flags, tally_causes
+from .flags import outlier_tests, setup_entry, setup_flags, tally_causes
 from .job import RecordResult
-from ..stats import RULE, WeightRule, stacking_weights
+from ..stats import RULE, WeightRule, paired_difference, stacking_weights
 from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, law_mean, loo, rank
 from .next_test import Candidate, advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
@@ -65,6 +65,9 @@ class CampaignAnalysis:
     law_models: dict[str, str] = field(default_factory=dict)
     #: the stationary analysis's pooled f when ``pooled["f"]`` is f under the diagnosed models (else empty)
     pooled_stationary: dict[str, Pooled] = field(default_factory=dict)
+    #: two set-ups, none flagged by the ELPD, a law with a pressure term named: every law with and without the
+    #: second set-up's offset, compared (:meth:`_Laws.offset_alternative`), and the sentence; else empty
+    pressure_or_setup: dict[str, object] = field(default_factory=dict)
 
     def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:
         """Draws of f along (V, p) for one set-up under a fitted model, at the campaign's nu: (draws, len(V))."""
@@ -296,6 +299,37 @@ class _Laws:
             if len(setups) == 2:  # with two set-ups one offset is all that can be told
                 return first, freed
 
+    def offset_alternative(self, setup: str, cal: tuple[str, ...],
+                           first: dict[str, tuple[Elpd, dict[str, float]]]) -> dict[str, object]:
+        """With two set-ups: every law with a free offset on ``setup`` (the flag's own was fitted already, in
+        ``first``) beside every law without, their stacking weights together, and the best with the offset
+        against the best without. A law with a pressure term can stand for a difference between the set-ups (a
+        plug friction or a gauge's calibration in one), since one set-up's bars put all its tests at other
+        pressures: the two readings are told apart only by the pressures within each set-up."""
+        done = {first[setup][0].model: first[setup]} if setup in first else {}
+        todo = [m for m in (Model(law, setup, cal) for law in LAWS) if m.name not in done]
+        done |= {m.name: (e, _summ(fit.draws[:, -2])) for m, (fit, e) in zip(todo, self.fit_all(todo))}
+        weights = stacking_weights({n: e.pointwise for n, e in (self.base | {k: v[0] for k, v in done.items()}).items()})
+        best = max(done, key=lambda k: done[k][0].elpd)
+        top = max(self.base.values(), key=lambda e: e.elpd)
+        d, se = paired_difference(done[best][0].pointwise, top.pointwise)
+        return {"setup": setup, "best_with_offset": best, "offset": done[best][1], "best_without": top.model,
+                "d_elpd": d, "d_se": se, "weight_with_offset": float(sum(weights[k] for k in done))}
+
+
+def _offset_sentence(alt: dict[str, object], flagged: bool) -> str:
+    delta = alt["offset"]
+    lead = (f"{alt['best_with_offset']} (set-up {alt['setup']} {delta['q50'] * 100:+.0f} % [{delta['q05'] * 100:+.0f}, "
+            f"{delta['q95'] * 100:+.0f}] off the shared law) predicts the tests {alt['d_elpd']:+.1f} +- {alt['d_se']:.1f} "
+            f"against {alt['best_without']}, and the laws with that offset carry {alt['weight_with_offset']:.2f} of "
+            "the weight of all eight")
+    head = "with two set-ups a pressure term and a difference between the set-ups are told apart only by the pressures "
+    if flagged:
+        return (head + f"within each: {lead}, so set-up {alt['setup']} is flagged and the laws compared with its level "
+                "left out; a third set-up, or `--diagnose` (a plug friction or a gauge's gain fitted per test), "
+                "tells the two readings apart")
+    return head + f"within each: {lead}; a third set-up, or `--diagnose`, tells them apart"
+
 
 def analyse(results: Sequence[RecordResult], records_dir: str | Path, *, seed: int = 20161,
             say: Callable[[str], None] | None = None) -> CampaignAnalysis:
@@ -334,6 +368,13 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     elpds = laws.compare(cal, ())
     law_for_flags = simplest_supported(ca.weights, ca.ranking)
     first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies)
+    if not freed and len(setups) == 2 and any("c" in LAW_PARAMS[law] for law in supported_laws(ca.weights, ca.ranking)):
+        alt = laws.offset_alternative(offsets[0], cal, first)
+        if alt["weight_with_offset"] >= WEIGHT_RULE.mass:  # the offset, not the pressure term, carries the weight
+            ca.flagged.append(setup_entry(offsets[0], alt["offset"], alt["d_elpd"], alt["d_se"], setups, tallies,
+                                          quantity=data.basis) | {"weight_with_offset": alt["weight_with_offset"]})
+            freed = [offsets[0]]
+        ca.pressure_or_setup = alt | {"sentence": _offset_sentence(alt, bool(freed))}
     if freed:  # the laws again, the flagged set-ups' levels left out (a free offset each): never fitted by them
         elpds = laws.compare(cal, tuple(freed))
         law_for_flags = simplest_supported(ca.weights, ca.ranking)
@@ -341,6 +382,8 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
                             "departs from the shared law beyond its calibration (3 %), a finding for diagnose to "
                             "explain, not a part of any law")
     ca.sentences += verdict(ca.weights, ca.ranking)
+    if ca.pressure_or_setup:
+        ca.sentences.append(str(ca.pressure_or_setup["sentence"]))
     supported = supported_laws(ca.weights, ca.ranking)
     if len(supported) == 1:
         ca.best, ca.chosen = supported[0], ca.law_models[supported[0]]

@@ -1,7 +1,10 @@
 """Set-ups and tests that do not follow the shared law, and the per-record causes tallied beside them.
 
 A set-up is flagged when the best law with a multiplicative offset on that set-up beats the law
-without it decisively (leave-one-test-out dELPD > 4 and > t(0.975, tests - 1) SE). With exactly two set-ups an
+without it decisively (leave-one-test-out dELPD > 4 and > t(0.975, tests - 1) SE). With two set-ups and a
+named law with a pressure term, a set-up is also flagged when, among every law with and without its offset,
+those with it carry the stacking weight (``friction_uq.campaign.analysis``: one set-up's bars put all its
+tests at other pressures, and a pressure term can stand for its offset). With exactly two set-ups an
 offset on one is the same model as an offset on the other: the campaign then says that the two
 disagree, by how much, and lets the per-record causes (when a diagnosis named them) say which: the
 set-up where a cause was named that the other set-up never shows.
@@ -60,30 +63,36 @@ def setup_flags(base: Elpd, with_offset: dict[str, tuple[Elpd, dict[str, float]]
     """One entry per set-up whose offset model beats the shared law decisively (``quantity``: what the law
     was fitted to, kappa or f)."""
     flags = []
-    pair = len(setups) == 2
     for s, (e, delta) in with_offset.items():
         d, se = paired_difference(e.pointwise, base.pointwise)
-        if not RULE.decisive(d, se, n=e.pointwise.size):
-            continue
-        other = [x for x in setups if x != s]
-        entry: dict[str, object] = {
-            "setup": s, "basis": quantity, "offset": delta, "d_elpd": d, "d_se": se,
-            "tests": int(tallies.get(s, {}).get("tests", 0)),
-        }
-        if pair:
-            entry["relative_to"] = other[0]
-            entry["note"] = (f"with two set-ups an offset on {s} is an offset on {other[0]}: they disagree by "
-                             f"{delta['q50'] * 100:+.0f} % on {quantity}; which one is off needs a third set-up or "
-                             "the per-record causes")
-            own = {x: set(tallies.get(x, {}).get("causes") or {}) for x in setups}
-            only = {x: sorted(own[x] - own[y]) for x, y in ((s, other[0]), (other[0], s))}
-            named = s if only[s] and not only[other[0]] else other[0] if only[other[0]] and not only[s] else None
-            if named is not None:
-                entry["named_by_causes"], entry["causes_only_here"] = named, only[named]
-                entry["note_causes"] = f"named only in set-up {named}: " + ", ".join(only[named])
-        entry["causes"] = {x: causes_sentence(x, tallies[x]) for x in ([s] + (other if pair else [])) if x in tallies}
-        flags.append(entry)
+        if RULE.decisive(d, se, n=e.pointwise.size):
+            flags.append(setup_entry(s, delta, d, se, setups, tallies, quantity=quantity))
     return flags
+
+
+def setup_entry(s: str, delta: dict[str, float], d: float, se: float, setups: Sequence[str],
+                tallies: dict[str, dict[str, object]], *, quantity: str) -> dict[str, object]:
+    """The flag of set-up ``s``: its offset ``delta`` (a summary), the evidence (dELPD ``d`` +- ``se``), and with
+    two set-ups which of them the per-record causes point at."""
+    other = [x for x in setups if x != s]
+    pair = len(setups) == 2
+    entry: dict[str, object] = {
+        "setup": s, "basis": quantity, "offset": delta, "d_elpd": d, "d_se": se,
+        "tests": int(tallies.get(s, {}).get("tests", 0)),
+    }
+    if pair:
+        entry["relative_to"] = other[0]
+        entry["note"] = (f"with two set-ups an offset on {s} is an offset on {other[0]}: they disagree by "
+                         f"{delta['q50'] * 100:+.0f} % on {quantity}; which one is off needs a third set-up or "
+                         "the per-record causes")
+        own = {x: set(tallies.get(x, {}).get("causes") or {}) for x in setups}
+        only = {x: sorted(own[x] - own[y]) for x, y in ((s, other[0]), (other[0], s))}
+        named = s if only[s] and not only[other[0]] else other[0] if only[other[0]] and not only[s] else None
+        if named is not None:
+            entry["named_by_causes"], entry["causes_only_here"] = named, only[named]
+            entry["note_causes"] = f"named only in set-up {named}: " + ", ".join(only[named])
+    entry["causes"] = {x: causes_sentence(x, tallies[x]) for x in ([s] + (other if pair else [])) if x in tallies}
+    return entry
 
 
 def outlier_tests(chosen: Elpd, labels: Sequence[str]) -> list[dict[str, object]]:

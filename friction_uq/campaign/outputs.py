@@ -16,7 +16,9 @@ of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and
 ``posterior`` of the best (else heaviest) law's parameters in f units; ``models``: the same for every
 model; ``meanings``: each parameter in words with its unit; ``next_tests``: when the laws are not separated,
 each candidate test (set-up, V, p) with the expected information it brings on which law holds, most
-informative first (:mod:`.next_test`); ``nu`` the campaign's nu),
+informative first (:mod:`.next_test`); ``pressure_or_setup``: with two set-ups and a law with a pressure term
+named, the best law with a free offset on the second set-up against the best without (dELPD, SE, the weight
+the laws with the offset carry among all eight; empty otherwise); ``nu`` the campaign's nu),
 ``wall_seconds`` (``records``: the records' tasks, ``analysis``: the campaign's own analysis; added by
 ``run_campaign``), ``flagged`` (set-ups and tests; a set-up's entry says the ``basis`` its offset was measured on:
 the law's, or, for a diagnosed campaign, also ``kappa`` of the stationary analysis with
@@ -140,6 +142,7 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
                          "meanings": {k: parameter_words(k) for m in models.values() for k in m},
                          "next_tests": [{"setup": c.setup, "V": c.V, "p": c.p, "information_nats": c.information}
                                         for c in ca.next_tests],
+                         "pressure_or_setup": {k: v for k, v in ca.pressure_or_setup.items() if k != "sentence"},
                          "nu": {"mean": ca.nu[0], "sd": ca.nu[1]},
                          "fitted_to": None if ca.law_data is None else ca.law_data.meaning},
         "flagged": ca.flagged,

@@ -1,0 +1,63 @@
+"""Two set-ups at different pressures: a pressure term and an offset of one set-up are told apart only by the
+pressures within each set-up (friction_uq.campaign.analysis, ``_Laws.offset_alternative``). A velocity-weakening
+wall whose second set-up reads 20 % high (a plug friction the stationary analysis cannot see) is not a pressure
+law; a pressure law measured without an offset is not a set-up flag."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from friction_uq.campaign.analysis import RecordPosterior, analyse_tests, supported_laws
+from friction_uq.priors import PRIORS_DIR
+
+PRIOR = str(PRIORS_DIR / "I1.toml")
+NU = 0.4
+
+
+def _tests(f_of, offset_b: float, *, p_with_v: bool, seed: int = 7) -> list[RecordPosterior]:
+    """Ten tests, five per set-up at 5.5-12.5 m/s, B's bars at 1.7 times A's pressure; each test's kappa carries
+    its noise (0.7 %) and eq. 17's model-form term (2.5 %). ``p_with_v``: the wall pressure grows with the
+    striker speed (as on one bar set: pressure and speed go together within a set-up); else it is varied apart
+    from the speed (sample lengths, say): 0.75-1.25 times the set-up's level, in an order unlike the speeds'."""
+    rng = np.random.default_rng(seed)
+    tests = []
+    spread = np.array([1.0, 0.75, 1.25, 0.875, 1.125])
+    for setup, p_per_v, scale in (("A", 9e6, 1.0), ("B", 15e6, 1.0 + offset_b)):
+        for k, V in enumerate(np.linspace(5.5, 12.5, 5)):
+            p = p_per_v * V if p_with_v else p_per_v * 9.0 * spread[k]
+            kappa_true = f_of(V, p) * NU / (1 - NU) * scale
+            sd = kappa_true * float(np.hypot(0.007, 0.025))
+            kappa = rng.normal(kappa_true + rng.normal(0.0, sd), sd, 1000)
+            nu = rng.normal(NU + rng.normal(0.0, 0.013), 0.013, 1000)
+            tests.append(RecordPosterior(f"{setup}-0{k + 1}", setup, kappa * (1 - nu) / nu, kappa, nu,
+                                         rng.normal(p, 0.05 * p, 1000),
+                                         {"mean": V, "sd": 1e-3, "q05": V, "q50": V, "q95": V}, PRIOR))
+    return tests
+
+
+def test_a_set_up_reading_high_is_flagged_where_pressure_varies_within_each_set_up():
+    ca = analyse_tests(_tests(lambda V, p: 0.035 + 0.040 * np.exp(-V / 8.0), 0.20, p_with_v=False), {}, seed=2)
+    assert [f["setup"] for f in ca.flagged if "setup" in f] == ["B"]
+    assert "velocity" in supported_laws(ca.weights, ca.ranking)
+    if ca.pressure_or_setup:  # flagged by the weights, not by the offset's ELPD under the simplest law
+        assert ca.pressure_or_setup["weight_with_offset"] >= 0.9
+    flag = next(f for f in ca.flagged if "setup" in f)
+    assert 0.10 < flag["offset"]["q50"] < 0.30  # B's departure, measured
+
+
+def test_where_pressure_goes_with_speed_in_each_set_up_the_two_readings_are_both_said():
+    """Within each set-up p grows with V: a pressure term on a velocity law mimics B's 20 % (on these ten tests
+    velocity + offset B is 0.7 +- 1.7 behind pressure+velocity, with 0.4 of the weight): the campaign does not
+    flag B nor hide the alternative."""
+    ca = analyse_tests(_tests(lambda V, p: 0.035 + 0.040 * np.exp(-V / 8.0), 0.20, p_with_v=True), {}, seed=2)
+    alt = ca.pressure_or_setup
+    assert "offset B" in alt["best_with_offset"] and 0.1 < alt["weight_with_offset"] < 0.9
+    assert not [f for f in ca.flagged if "setup" in f]
+    said = [s for s in ca.sentences if "told apart only by the pressures" in s]
+    assert said and "velocity + offset B" in said[0]
+
+
+def test_a_pressure_law_without_an_offset_flags_no_set_up():
+    ca = analyse_tests(_tests(lambda V, p: 0.05 * (1.0 + 0.5 * (p - 1.1e8) / 1.1e8), 0.0, p_with_v=False), {}, seed=2)
+    assert not [f for f in ca.flagged if "setup" in f]
+    assert "pressure" in supported_laws(ca.weights, ca.ranking)
