@@ -149,12 +149,12 @@ def test_a_forked_map_gives_in_order_the_values_of_a_map_in_line():
 
 
 def test_the_campaign_law_comparison_is_the_same_on_one_or_two_processes(monkeypatch):
-    from friction_uq.campaign import analysis
+    from friction_uq.campaign import analysis, law_comparison
 
     tests = _campaign_tests()
     runs = []
     for workers in (1, 2):
-        monkeypatch.setattr(analysis, "LAW_WORKERS", workers)
+        monkeypatch.setattr(law_comparison, "LAW_WORKERS", workers)
         ca = analysis.analyse_tests(tests, {}, seed=3)
         runs.append(({r["model"]: r["elpd"] for r in ca.ranking}, ca.weights))
     assert runs[0] == runs[1]

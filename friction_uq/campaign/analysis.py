@@ -11,35 +11,29 @@ campaign's nu), and flags set-ups and tests (:mod:`.flags`).
 
 from __future__ import annotations
 
-import os
 import time
-
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .._parallel import forked_map
 from ..priors import load_priors
 from .flags import outlier_tests, setup_entry, setup_flags, tally_causes
 from .job import RecordResult
-from ..stats import RULE, WeightRule, paired_difference, stacking_weights
-from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, law_mean, loo, rank
+from .law_comparison import (WEIGHT_RULE, LawComparison, draw_summary, offset_sentence, simplest_supported,
+                             supported_laws, verdict)
+from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model, law_mean, loo
 from .next_test import Candidate, advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
 from .pooling import Pooled, implied_kappa_log_prior, strata
 
-__all__ = ["CampaignAnalysis", "RecordPosterior", "analyse", "analyse_tests", "read_test_posterior"]
+__all__ = ["WEIGHT_RULE", "CampaignAnalysis", "RecordPosterior", "analyse", "analyse_tests", "read_test_posterior",
+           "supported_laws", "verdict"]
 
 MIN_TESTS_FOR_LAWS = 5
-#: The verdict's rule on the laws' stacking weights (friction_uq.stats.weights).
-WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
 #: draws per test the laws' likelihood reads (a kernel density of them)
 LAW_DRAWS = 160
-#: processes the law models of one comparison are fitted on (forked where the process may fork; the
-#: results do not depend on it)
-LAW_WORKERS = min(2, os.cpu_count() or 1)
 
 
 @dataclass
@@ -66,7 +60,7 @@ class CampaignAnalysis:
     #: the stationary analysis's pooled f when ``pooled["f"]`` is f under the diagnosed models (else empty)
     pooled_stationary: dict[str, Pooled] = field(default_factory=dict)
     #: two set-ups, none flagged by the ELPD, a law with a pressure term named: every law with and without the
-    #: second set-up's offset, compared (:meth:`_Laws.offset_alternative`), and the sentence; else empty
+    #: second set-up's offset, compared (:meth:`~.law_comparison.LawComparison.offset_alternative`), and the sentence; else empty
     pressure_or_setup: dict[str, object] = field(default_factory=dict)
 
     def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:
@@ -119,67 +113,6 @@ def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None
                    basis="f" if diagnosed else "kappa", draws=tuple(y), draws_log_prior=log_prior)
 
 
-def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
-    """The laws the comparison cannot set apart: those that carry the stacking weight (:data:`WEIGHT_RULE`) and
-    every law whose ELPD is not decisively behind the best's (:data:`friction_uq.stats.RULE`: dELPD > 4 and beyond
-    t(0.975, n - 1) SE over the n tests), less a law that holds another of them as a special case
-    (:data:`~.laws.SPECIAL_CASES`, constant excepted) without predicting the tests more than 4 better than it:
-    its extra term is not asked for by the data. Stacking puts its weight on one of several laws that predict the
-    tests alike, and which one follows the sampler's bits (on the bundled campaign, three laws within 1.3 ELPD
-    of each other took weights 0.83, 0.65 and 0.96 in turn over seeds 1-3); the set of laws not ruled out does
-    not. Simplest first (fewest parameters, then name), so that the same set reads the same."""
-    rows = {str(r.get("law", r["model"])): r for r in ranking}
-    close = [law for law, r in rows.items() if law in weights and not RULE.decisive(
-        float(r["d_elpd"]), float(r["d_se"]), n=int(r["n_tests"]) if r.get("n_tests") else None)]
-    kept = set(WEIGHT_RULE.supported(weights)) | set(close)
-    behind = {law: float(r["d_elpd"]) for law, r in rows.items()}
-    richer = {law for law in kept for simple in SPECIAL_CASES.get(law, ())
-              if simple != "constant" and simple in kept and law in behind and simple in behind
-              and behind[simple] - behind[law] <= RULE.min_delpd}
-    return sorted(kept - richer, key=lambda law: (len(LAW_PARAMS.get(law, ())), law))
-
-
-def simplest_supported(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> str:
-    """The law with the fewest parameters among the supported ones (:func:`supported_laws`; the heaviest among
-    equals): set-ups are flagged under it, since a richer law can absorb a set-up's offset into the term it adds
-    (a pressure term fits a set-up whose bars put it at other pressures)."""
-    return min(supported_laws(weights, ranking), key=lambda law: (len(LAW_PARAMS[law]), -weights[law]))
-
-
-def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
-    """What the comparison supports (:func:`supported_laws`), in sentences: the law, or the laws the data do not
-    separate (with their stacking weights and how far behind the best each is); and that f is not constant
-    whenever the constant law carries little weight and is decisively behind."""
-    supported = supported_laws(weights, ranking)
-    by_name = {str(r.get("law", r["model"])): r for r in ranking}
-
-    def w(name: str) -> str:
-        r = by_name[name]
-        gap = "" if float(r["d_elpd"]) == 0.0 else f", {float(r['d_elpd']):.1f} +- {float(r['d_se']):.1f} behind"
-        return f"{name} (weight {weights[name]:.2f}{gap})"
-
-    if len(supported) == 1 and weights[supported[0]] >= WEIGHT_RULE.mass - 1e-9:
-        out = [f"friction law: {w(supported[0])}, the law that carries the weight"]
-    elif len(supported) == 1:
-        richer = [law for law, cases in SPECIAL_CASES.items() if supported[0] in cases and law in weights]
-        out = [f"friction law: {w(supported[0])}: the laws that contain it ({', '.join(richer)}) predict the tests "
-               "no better, the others are ruled out"]
-    else:
-        out = ["friction law: the data do not separate " + ", ".join(w(n) for n in supported)]
-    if "constant" not in supported and weights.get("constant", 1.0) < WEIGHT_RULE.little:
-        out.append(f"f is not constant: the constant law carries {weights['constant']:.2f} of the weight")
-    elif "constant" in supported and len(supported) > 1:
-        out.append(f"no dependence of f on V or p is resolved: a constant f carries {weights['constant']:.2f} of "
-                   "the weight, and the laws beside it predict the tests as well")
-    return out
-
-
-def _summ(x: np.ndarray) -> dict[str, float]:
-    q = np.quantile(x, [0.05, 0.5, 0.95])
-    return {"mean": float(np.mean(x)), "sd": float(np.std(x)), "q05": float(q[0]), "q50": float(q[1]),
-            "q95": float(q[2])}
-
-
 def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np.ndarray]:
     """The law's parameters in f units: kappa-law draws times (1-nu)/nu with the campaign's nu (a law
     fitted to f directly: times its scale only)."""
@@ -220,7 +153,7 @@ def stationary_flags(tests: Sequence[RecordPosterior], law: str, offsets: Sequen
     with_offset = {}
     for k, s in enumerate(offsets):
         fit = Fit(Model(law, s, cal), data, kbar=kbar, p_ref=p_ref, seed=seed + 78 + k)
-        with_offset[s] = (loo(fit, seed=seed + 78 + k), _summ(fit.draws[:, -2]))
+        with_offset[s] = (loo(fit, seed=seed + 78 + k), draw_summary(fit.draws[:, -2]))
     flags = setup_flags(base, with_offset, setups, tallies, quantity="kappa")
     for f in flags:
         s = str(f["setup"])
@@ -232,103 +165,6 @@ def stationary_flags(tests: Sequence[RecordPosterior], law: str, offsets: Sequen
                                + ("the causes named account for the stationary departure" if s not in already
                                   else "the causes named do not account for it"))
     return flags
-
-
-def _fit_and_loo(job: tuple[Model, LawData, float, float, int]) -> tuple[Fit, Elpd]:
-    """One law model fitted and its leave-one-test-out ELPD (a job of :func:`~friction_uq._parallel.forked_map`)."""
-    model, data, kbar, p_ref, seed = job
-    fit = Fit(model, data, kbar=kbar, p_ref=p_ref, seed=seed)
-    return fit, loo(fit, seed=seed)
-
-
-class _Laws:
-    """The law fits of one campaign analysis: the comparison (fits, LOO, ranking, weights) and the flags."""
-
-    def __init__(self, ca: CampaignAnalysis, data: LawData, kbar: float, p_ref: float, seed: int,
-                 say: Callable[[str], None], t0: float) -> None:
-        self.ca, self.data, self.kbar, self.p_ref, self.seed, self.say, self.t0 = ca, data, kbar, p_ref, seed, say, t0
-        self.k = 0
-
-    def fit_all(self, models: Sequence[Model]) -> list[tuple[Fit, Elpd]]:
-        """Each model fitted with its leave-one-test-out ELPD, on up to :data:`LAW_WORKERS` forked processes; the
-        k-th model of the analysis takes seed ``seed + 1000 k`` whichever process fits it."""
-        first = self.k + 1
-        self.k += len(models)
-        self.say(f"friction law model{'s' if len(models) > 1 else ''} {first}{f'-{self.k}' if len(models) > 1 else ''} "
-                 f"({', '.join(m.name for m in models)}): fit and leave-one-test-out; "
-                 f"{time.perf_counter() - self.t0:.0f} s so far")
-        jobs = [(m, self.data, self.kbar, self.p_ref, self.seed + 1000 * (first - 1 + i)) for i, m in enumerate(models)]
-        out = forked_map(_fit_and_loo, jobs, workers=LAW_WORKERS)
-        for m, (fit, _) in zip(models, out):
-            self.ca.fits[m.name] = fit
-        return out
-
-    def compare(self, cal: tuple[str, ...], freed: tuple[str, ...]) -> dict[str, Elpd]:
-        """Every law with calibration offsets (and the ``freed`` set-ups' levels left out): ranking and weights."""
-        models = [Model(law, None, cal, freed) for law in LAWS]
-        elpds = {m.name: e for m, (_, e) in zip(models, self.fit_all(models))}
-        self.ca.ranking = rank(list(elpds.values()))
-        self.ca.weights = {Model(k.split(" + ")[0]).law: w
-                           for k, w in stacking_weights({n: e.pointwise for n, e in elpds.items()}).items()}
-        self.ca.law_models = {m.split(" + ")[0]: m for m in elpds}
-        for r in self.ca.ranking:
-            r["law"] = str(r["model"]).split(" + ")[0]
-            r["weight"] = self.ca.weights[r["law"]]
-        self.base = elpds
-        return elpds
-
-    def flag(self, law: str, offsets: Sequence[str], cal: tuple[str, ...], setups: Sequence[str],
-             tallies: dict[str, dict[str, object]]) -> tuple[dict[str, tuple[Elpd, dict[str, float]]], list[str]]:
-        """Set-ups off the shared law beyond their calibration, the most decisive first, each tested with the
-        ones found before left out (one set-up pulling the law makes the others look off). Returns the
-        first round's offsets (every candidate set-up) and the set-ups flagged."""
-        base = self.base[Model(law, None, cal).name]
-        freed: list[str] = []
-        first: dict[str, tuple[Elpd, dict[str, float]]] = {}
-        while True:
-            models = [Model(law, s, cal, tuple(freed)) for s in offsets if s not in freed]
-            trial = {str(m.offset_setup): (e, _summ(fit.draws[:, -2])) for m, (fit, e) in zip(models, self.fit_all(models))}
-            first = first or trial
-            flags = setup_flags(base, trial, setups, tallies, quantity=self.data.basis) if trial else []
-            if not flags:
-                return first, freed
-            top = max(flags, key=lambda f: float(f["d_elpd"]))
-            self.ca.flagged.append(top)
-            freed.append(str(top["setup"]))
-            base = trial[str(top["setup"])][0]
-            if len(setups) == 2:  # with two set-ups one offset is all that can be told
-                return first, freed
-
-    def offset_alternative(self, setup: str, cal: tuple[str, ...],
-                           first: dict[str, tuple[Elpd, dict[str, float]]]) -> dict[str, object]:
-        """With two set-ups: every law with a free offset on ``setup`` (the flag's own was fitted already, in
-        ``first``) beside every law without, their stacking weights together, and the best with the offset
-        against the best without. A law with a pressure term can stand for a difference between the set-ups (a
-        plug friction or a gauge's calibration in one), since one set-up's bars put all its tests at other
-        pressures: the two readings are told apart only by the pressures within each set-up."""
-        done = {first[setup][0].model: first[setup]} if setup in first else {}
-        todo = [m for m in (Model(law, setup, cal) for law in LAWS) if m.name not in done]
-        done |= {m.name: (e, _summ(fit.draws[:, -2])) for m, (fit, e) in zip(todo, self.fit_all(todo))}
-        weights = stacking_weights({n: e.pointwise for n, e in (self.base | {k: v[0] for k, v in done.items()}).items()})
-        best = max(done, key=lambda k: done[k][0].elpd)
-        top = max(self.base.values(), key=lambda e: e.elpd)
-        d, se = paired_difference(done[best][0].pointwise, top.pointwise)
-        return {"setup": setup, "best_with_offset": best, "offset": done[best][1], "best_without": top.model,
-                "d_elpd": d, "d_se": se, "weight_with_offset": float(sum(weights[k] for k in done))}
-
-
-def _offset_sentence(alt: dict[str, object], flagged: bool) -> str:
-    delta = alt["offset"]
-    lead = (f"{alt['best_with_offset']} (set-up {alt['setup']} {delta['q50'] * 100:+.0f} % [{delta['q05'] * 100:+.0f}, "
-            f"{delta['q95'] * 100:+.0f}] off the shared law) predicts the tests {alt['d_elpd']:+.1f} +- {alt['d_se']:.1f} "
-            f"against {alt['best_without']}, and the laws with that offset carry {alt['weight_with_offset']:.2f} of "
-            "the weight of all eight")
-    head = "with two set-ups a pressure term and a difference between the set-ups are told apart only by the pressures "
-    if flagged:
-        return (head + f"within each: {lead}, so set-up {alt['setup']} is flagged and the laws compared with its level "
-                "left out; a third set-up, or `--diagnose` (a plug friction or a gauge's gain fitted per test), "
-                "tells the two readings apart")
-    return head + f"within each: {lead}; a third set-up, or `--diagnose`, tells them apart"
 
 
 def analyse(results: Sequence[RecordResult], records_dir: str | Path, *, seed: int = 20161,
@@ -364,7 +200,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     setups = sorted(set(data.setups))
     offsets = [setups[-1]] if len(setups) == 2 else (setups if len(setups) > 2 else [])
     cal = tuple(setups[1:])  # every set-up but the first: a calibration offset (laws.CALIBRATION_SD)
-    laws = _Laws(ca, data, kbar, p_ref, seed, say, t0)
+    laws = LawComparison(ca, data, kbar, p_ref, seed, say, t0)
     elpds = laws.compare(cal, ())
     law_for_flags = simplest_supported(ca.weights, ca.ranking)
     first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies)
@@ -374,7 +210,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
             ca.flagged.append(setup_entry(offsets[0], alt["offset"], alt["d_elpd"], alt["d_se"], setups, tallies,
                                           quantity=data.basis) | {"weight_with_offset": alt["weight_with_offset"]})
             freed = [offsets[0]]
-        ca.pressure_or_setup = alt | {"sentence": _offset_sentence(alt, bool(freed))}
+        ca.pressure_or_setup = alt | {"sentence": offset_sentence(alt, bool(freed))}
     if freed:  # the laws again, the flagged set-ups' levels left out (a free offset each): never fitted by them
         elpds = laws.compare(cal, tuple(freed))
         law_for_flags = simplest_supported(ca.weights, ca.ranking)
@@ -408,7 +244,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     ca.nu = campaign_nu(trusted, pm, psd)
     name = ca.chosen or ca.law_models[max(ca.weights, key=ca.weights.get)]
     ca.law_draws = f_law_draws(ca.fits[name], ca.nu, seed=seed)
-    ca.law_posterior = {k: _summ(v) for k, v in ca.law_draws.items()}
+    ca.law_posterior = {k: draw_summary(v) for k, v in ca.law_draws.items()}
     chosen_elpd = elpds[name]
     ca.flagged += outlier_tests(chosen_elpd, data.labels)
     return ca
