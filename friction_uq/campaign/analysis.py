@@ -13,20 +13,20 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..priors import load_priors
 from .flags import outlier_tests, setup_entry, setup_flags, tally_causes
+from .conclusions import CampaignAnalysis
 from .job import RecordResult
 from .law_comparison import (WEIGHT_RULE, LawComparison, draw_summary, offset_sentence, simplest_supported,
                              supported_laws, verdict)
-from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model, law_mean, loo
-from .next_test import Candidate, advice, rank_next_tests
+from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model, loo
+from .next_test import advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
-from .pooling import Pooled, implied_kappa_log_prior, strata
+from .pooling import implied_kappa_log_prior, strata
 
 __all__ = ["WEIGHT_RULE", "CampaignAnalysis", "RecordPosterior", "analyse", "analyse_tests", "read_test_posterior",
            "supported_laws", "verdict"]
@@ -34,43 +34,6 @@ __all__ = ["WEIGHT_RULE", "CampaignAnalysis", "RecordPosterior", "analyse", "ana
 MIN_TESTS_FOR_LAWS = 5
 #: draws per test the laws' likelihood reads (a kernel density of them)
 LAW_DRAWS = 160
-
-
-@dataclass
-class CampaignAnalysis:
-    tests: list[RecordPosterior]
-    pooled: dict[str, Pooled]
-    tallies: dict[str, dict[str, object]]
-    law_data: LawData | None = None
-    ranking: list[dict[str, object]] = field(default_factory=list)
-    best: str | None = None
-    chosen: str | None = None
-    law_posterior: dict[str, dict[str, float]] = field(default_factory=dict)
-    law_draws: dict[str, np.ndarray] = field(default_factory=dict)
-    fits: dict[str, Fit] = field(default_factory=dict)
-    nu: tuple[float, float] = (float("nan"), float("nan"))
-    flagged: list[dict[str, object]] = field(default_factory=list)
-    sentences: list[str] = field(default_factory=list)
-    #: each law's stacking weight (friction_uq.stats.stacking_weights)
-    weights: dict[str, float] = field(default_factory=dict)
-    #: candidate next tests, the most informative first (.next_test), when the laws are not separated
-    next_tests: list[Candidate] = field(default_factory=list)
-    #: law -> the name of its model in ``fits`` that the weights are of (the law, or with set-ups left out)
-    law_models: dict[str, str] = field(default_factory=dict)
-    #: the stationary analysis's pooled f when ``pooled["f"]`` is f under the diagnosed models (else empty)
-    pooled_stationary: dict[str, Pooled] = field(default_factory=dict)
-    #: two set-ups, none flagged by the ELPD, a law with a pressure term named: every law with and without the
-    #: second set-up's offset, compared (:meth:`~.law_comparison.LawComparison.offset_alternative`), and the sentence; else empty
-    pressure_or_setup: dict[str, object] = field(default_factory=dict)
-
-    def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:
-        """Draws of f along (V, p) for one set-up under a fitted model, at the campaign's nu: (draws, len(V))."""
-        fit = self.fits[model]
-        x = fit.draws[:: max(1, len(fit.draws) // n)]
-        th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
-        y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref)
-        y = y * fit.model.setup_scale(th, [setup] * len(np.atleast_1d(V)))
-        return y * fit.kbar * fit.data.to_f(self.nu[0])
 
 
 def campaign_nu(tests: Sequence[RecordPosterior], prior_mean: float, prior_sd: float) -> tuple[float, float]:

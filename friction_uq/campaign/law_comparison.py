@@ -10,17 +10,14 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._parallel import forked_map
 from ..stats import RULE, WeightRule, paired_difference, stacking_weights
+from .conclusions import CampaignAnalysis
 from .flags import setup_flags
 from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, loo, rank
-
-if TYPE_CHECKING:
-    from .analysis import CampaignAnalysis
 
 #: The verdict's rule on the laws' stacking weights (friction_uq.stats.weights).
 WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
