@@ -166,16 +166,19 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     laws = LawComparison(ca, data, kbar, p_ref, seed, say, t0)
     elpds = laws.compare(cal, ())
     law_for_flags = simplest_supported(ca.weights, ca.ranking)
-    first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies)
-    if not freed and len(setups) == 2 and any("c" in LAW_PARAMS[law] for law in supported_laws(ca.weights, ca.ranking)):
-        alt = laws.offset_alternative(offsets[0], cal, first)
+    two = len(setups) == 2
+    pressure_named = any("c" in LAW_PARAMS[law] for law in supported_laws(ca.weights, ca.ranking))
+    first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies, every_law=two and pressure_named)
+    if not freed and two and pressure_named:
+        alt = laws.offset_alternative(offsets[0], cal)
         if alt["weight_with_offset"] >= WEIGHT_RULE.mass:  # the offset, not the pressure term, carries the weight
             ca.flagged.append(setup_entry(offsets[0], alt["offset"], alt["d_elpd"], alt["d_se"], setups, tallies,
                                           quantity=data.basis) | {"weight_with_offset": alt["weight_with_offset"]})
             freed = [offsets[0]]
         ca.pressure_or_setup = alt | {"sentence": offset_sentence(alt, bool(freed))}
     if freed:  # the laws again, the flagged set-ups' levels left out (a free offset each): never fitted by them
-        elpds = laws.compare(cal, tuple(freed))
+        done = laws.offset_models(freed[0], cal) if two else None  # with two set-ups: the offset models themselves
+        elpds = laws.compare(cal, tuple(freed), {k: v[0] for k, v in done.items()} if done else None)
         law_for_flags = simplest_supported(ca.weights, ca.ranking)
         ca.sentences.append(f"the friction law is compared with the level of set-up {', '.join(freed)} left out: it "
                             "departs from the shared law beyond its calibration (3 %), a finding for diagnose to "

@@ -105,6 +105,8 @@ class LawComparison:
                  say: Callable[[str], None], t0: float) -> None:
         self.ca, self.data, self.kbar, self.p_ref, self.seed, self.say, self.t0 = ca, data, kbar, p_ref, seed, say, t0
         self.k = 0
+        #: model name -> (ELPD, summary of its offset's draws) of every model with a free offset fitted so far
+        self.offset_fits: dict[str, tuple[Elpd, dict[str, float]]] = {}
 
     def fit_all(self, models: Sequence[Model]) -> list[tuple[Fit, Elpd]]:
         """Each model fitted with its leave-one-test-out ELPD, on up to :data:`LAW_WORKERS` forked processes; the
@@ -120,10 +122,14 @@ class LawComparison:
             self.ca.fits[m.name] = fit
         return out
 
-    def compare(self, cal: tuple[str, ...], freed: tuple[str, ...]) -> dict[str, Elpd]:
-        """Every law with calibration offsets (and the ``freed`` set-ups' levels left out): ranking and weights."""
-        models = [Model(law, None, cal, freed) for law in LAWS]
-        elpds = {m.name: e for m, (_, e) in zip(models, self.fit_all(models))}
+    def compare(self, cal: tuple[str, ...], freed: tuple[str, ...],
+                elpds: dict[str, Elpd] | None = None) -> dict[str, Elpd]:
+        """Every law with calibration offsets (and the ``freed`` set-ups' levels left out): ranking and weights.
+        ``elpds``: the four models fitted already (a free offset on one set-up is the same model whether it was
+        fitted to flag the set-up or to leave its level out)."""
+        if elpds is None:
+            models = [Model(law, None, cal, freed) for law in LAWS]
+            elpds = {m.name: e for m, (_, e) in zip(models, self.fit_all(models))}
         self.ca.ranking = rank(list(elpds.values()))
         self.ca.weights = {Model(k.split(" + ")[0]).law: w
                            for k, w in stacking_weights({n: e.pointwise for n, e in elpds.items()}).items()}
@@ -135,16 +141,22 @@ class LawComparison:
         return elpds
 
     def flag(self, law: str, offsets: Sequence[str], cal: tuple[str, ...], setups: Sequence[str],
-             tallies: dict[str, dict[str, object]]) -> tuple[dict[str, tuple[Elpd, dict[str, float]]], list[str]]:
+             tallies: dict[str, dict[str, object]], *, every_law: bool = False,
+             ) -> tuple[dict[str, tuple[Elpd, dict[str, float]]], list[str]]:
         """Set-ups off the shared law beyond their calibration, the most decisive first, each tested with the
         ones found before left out (one set-up pulling the law makes the others look off). Returns the
-        first round's offsets (every candidate set-up) and the set-ups flagged."""
+        first round's offsets (every candidate set-up) and the set-ups flagged. ``every_law``: the first round
+        also fits the other laws with each offset (:meth:`offset_alternative` reads them), in the same batch."""
         base = self.base[Model(law, None, cal).name]
         freed: list[str] = []
         first: dict[str, tuple[Elpd, dict[str, float]]] = {}
         while True:
-            models = [Model(law, s, cal, tuple(freed)) for s in offsets if s not in freed]
-            trial = {str(m.offset_setup): (e, draw_summary(fit.draws[:, -2])) for m, (fit, e) in zip(models, self.fit_all(models))}
+            laws = LAWS if every_law and not first else (law,)
+            models = [Model(x, s, cal, tuple(freed)) for s in offsets if s not in freed for x in laws]
+            fitted = {m: (e, draw_summary(fit.draws[:, -2])) for m, (fit, e) in zip(models, self.fit_all(models))}
+            if not freed:
+                self.offset_fits |= {m.name: v for m, v in fitted.items()}
+            trial = {str(m.offset_setup): v for m, v in fitted.items() if m.law == law}
             first = first or trial
             flags = setup_flags(base, trial, setups, tallies, quantity=self.data.basis) if trial else []
             if not flags:
@@ -156,16 +168,22 @@ class LawComparison:
             if len(setups) == 2:  # with two set-ups one offset is all that can be told
                 return first, freed
 
-    def offset_alternative(self, setup: str, cal: tuple[str, ...],
-                           first: dict[str, tuple[Elpd, dict[str, float]]]) -> dict[str, object]:
-        """With two set-ups: every law with a free offset on ``setup`` (the flag's own was fitted already, in
-        ``first``) beside every law without, their stacking weights together, and the best with the offset
-        against the best without. A law with a pressure term can stand for a difference between the set-ups (a
-        plug friction or a gauge's calibration in one), since one set-up's bars put all its tests at other
-        pressures: the two readings are told apart only by the pressures within each set-up."""
-        done = {first[setup][0].model: first[setup]} if setup in first else {}
-        todo = [m for m in (Model(law, setup, cal) for law in LAWS) if m.name not in done]
-        done |= {m.name: (e, draw_summary(fit.draws[:, -2])) for m, (fit, e) in zip(todo, self.fit_all(todo))}
+    def offset_models(self, setup: str, cal: tuple[str, ...]) -> dict[str, tuple[Elpd, dict[str, float]]]:
+        """Every law with a free offset on ``setup`` (those not fitted yet are fitted now): name -> (ELPD, summary
+        of the offset's draws)."""
+        todo = [m for m in (Model(law, setup, cal) for law in LAWS) if m.name not in self.offset_fits]
+        if todo:
+            self.offset_fits |= {m.name: (e, draw_summary(fit.draws[:, -2]))
+                                 for m, (fit, e) in zip(todo, self.fit_all(todo))}
+        return {m.name: self.offset_fits[m.name] for m in (Model(law, setup, cal) for law in LAWS)}
+
+    def offset_alternative(self, setup: str, cal: tuple[str, ...]) -> dict[str, object]:
+        """With two set-ups: every law with a free offset on ``setup`` beside every law without, their stacking
+        weights together, and the best with the offset against the best without. A law with a pressure term
+        can stand for a difference between the set-ups (a plug friction or a gauge's calibration in one), since
+        one set-up's bars put all its tests at other pressures: the two readings are told apart only by the
+        pressures within each set-up."""
+        done = self.offset_models(setup, cal)
         weights = stacking_weights({n: e.pointwise for n, e in (self.base | {k: v[0] for k, v in done.items()}).items()})
         best = max(done, key=lambda k: done[k][0].elpd)
         top = max(self.base.values(), key=lambda e: e.elpd)
