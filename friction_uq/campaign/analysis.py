@@ -180,11 +180,13 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
         done = laws.offset_models(freed[0], cal) if two else None  # with two set-ups: the offset models themselves
         elpds = laws.compare(cal, tuple(freed), {k: v[0] for k, v in done.items()} if done else None)
         law_for_flags = simplest_supported(ca.weights, ca.ranking)
+        if ca.pressure_or_setup:  # why the set-up was flagged, before what follows from it
+            ca.sentences.append(str(ca.pressure_or_setup["sentence"]))
         ca.sentences.append(f"the friction law is compared with the level of set-up {', '.join(freed)} left out: it "
                             "departs from the shared law beyond its calibration (3 %), a finding for diagnose to "
                             "explain, not a part of any law")
     ca.sentences += verdict(ca.weights, ca.ranking)
-    if ca.pressure_or_setup:
+    if ca.pressure_or_setup and not freed:  # the alternative the named law leaves open
         ca.sentences.append(str(ca.pressure_or_setup["sentence"]))
     supported = supported_laws(ca.weights, ca.ranking)
     if len(supported) == 1:

@@ -94,7 +94,9 @@ def statements(ca: CampaignAnalysis) -> list[str]:
             what = "'s stationary analysis" if basis != ca.law_data.basis else ""
             out.append(f"flagged: set-up {f['setup']}{what} does not follow the shared law{rel}: {basis} offset "
                        f"{off['q50'] * 100:+.0f} % [{off['q05'] * 100:+.0f}, {off['q95'] * 100:+.0f}], dELPD "
-                       f"{f['d_elpd']:.1f} (SE {f['d_se']:.1f})")
+                       f"{f['d_elpd']:.1f} (SE {f['d_se']:.1f})"
+                       + (f", the laws with this offset carrying {f['weight_with_offset']:.2f} of the weight"
+                          if "weight_with_offset" in f else ""))
             out.extend(str(f[key]) for key in ("note", "note_diagnosed", "note_causes") if key in f)
             out.extend(str(c) for c in f["causes"].values())
         else:
