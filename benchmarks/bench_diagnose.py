@@ -155,8 +155,11 @@ def main() -> None:
         else:
             print(f"{h:<18} {c['n']:>3} {c['exact'] / n:>6.2f} {c['named_or_inseparable'] / n:>11.2f} "
                   f"{c['covered'] / n:>9.2f} {'-':>6} {c['refused']:>7}  {tally}")
-    eff = [h for h in HIDDEN]
+    eff = [h for h in HIDDEN if h in stats]  # with --only, the groups analysed
     tot = sum(stats[h]["n"] - stats[h]["refused"] for h in eff)
+    if tot == 0:
+        print(f"no effect record analysed; time per record median {np.median(secs):.1f} s" if secs else "no record analysed")
+        return
     print(f"all effect records: exact {sum(stats[h]['exact'] for h in eff) / tot:.2f}, named or inseparable "
           f"{sum(stats[h]['named_or_inseparable'] for h in eff) / tot:.2f}, f covered "
           f"{sum(stats[h]['covered'] for h in eff) / tot:.2f}; time per record median {np.median(secs):.1f} s")
