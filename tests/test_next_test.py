@@ -30,3 +30,15 @@ def test_the_advice_names_the_best_candidate():
     text = advice(cands, {"velocity": 0.5, "pressure": 0.45, "constant": 0.05})
     assert text.startswith("the most informative next test: set-up B at a sliding speed of 12.0 m/s")
     assert "0.41 nats" in text and advice([], {}) is None
+
+
+def test_the_laws_the_verdict_names_are_asked_about_equally_whatever_stacking_says():
+    """Stacking may give 0.99 to one of two laws whose ELPDs are not decisively apart; the verdict names both, and
+    the advice must be about both (equal weights), not about nothing."""
+    from friction_uq.campaign.next_test import _in_play
+
+    weights = {"velocity": 0.99, "pressure": 0.001, "pressure+velocity": 0.009, "constant": 0.0}
+    assert _in_play(weights, None) == ["velocity"]
+    assert _in_play(weights, ["pressure", "velocity"]) == ["pressure", "velocity"]
+    cands = [Candidate("B", 12.0, 1.4e8, 0.3)]
+    assert "which of pressure, velocity holds" in advice(cands, weights, ["pressure", "velocity"])

@@ -193,8 +193,8 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
         ca.best, ca.chosen = supported[0], ca.law_models[supported[0]]
     else:
         say("the expected information of one more test at each set-up and speed")
-        ca.next_tests = rank_next_tests({law: ca.fits[m] for law, m in ca.law_models.items()}, ca.weights)
-        tip = advice(ca.next_tests, ca.weights)
+        ca.next_tests = rank_next_tests({law: ca.fits[m] for law, m in ca.law_models.items()}, ca.weights, supported)
+        tip = advice(ca.next_tests, ca.weights, supported)
         if tip:
             ca.sentences.append(tip)
     prior0 = load_priors(tests[0].prior_file)["nu"]

@@ -7,7 +7,8 @@ outcome y (Lindley 1956; for telling models apart, Box and Hill 1967):
 
     I(K; y) = H(sum_k w_k p_k(y)) - sum_k w_k H(p_k(y)),
 
-with w_k the laws' stacking weights (renormalised over the laws still in play) and p_k the law's
+with w_k equal over the laws the verdict names (the data do not separate them: the question is which of
+them holds; without such a list, the stacking weights of the laws still in play, renormalised) and p_k the law's
 posterior predictive of the new test's value: the law's draws at (V, p) for that set-up (with its
 calibration offset), widened by the law's test-to-test scatter and by a test's own uncertainty (the
 median of the campaign's), each taken as normal. H of the mixture is integrated on a grid (the
@@ -19,6 +20,7 @@ do not overlap settles the question.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,12 +64,20 @@ def information(means: np.ndarray, variances: np.ndarray, weights: np.ndarray, *
     return max(0.0, h_mix - h_each)
 
 
-def rank_next_tests(fits: dict[str, Fit], weights: dict[str, float]) -> list[Candidate]:
-    """Every candidate test, the most informative first; empty when fewer than two laws are in play."""
-    play = [k for k, w in weights.items() if w >= IN_PLAY and k in fits]
+def _in_play(weights: dict[str, float], named: Sequence[str] | None) -> list[str]:
+    """The laws the question is about: those the verdict names, else those with :data:`IN_PLAY` of the weight."""
+    return list(named) if named and len(named) > 1 else [k for k, w in weights.items() if w >= IN_PLAY]
+
+
+def rank_next_tests(fits: dict[str, Fit], weights: dict[str, float],
+                    named: Sequence[str] | None = None) -> list[Candidate]:
+    """Every candidate test, the most informative first; empty when fewer than two laws are in play. ``named``:
+    the laws the verdict does not separate (equally weighted; module docstring). Stacking can put nearly all
+    its weight on one of laws whose ELPDs are not decisively apart, which would leave nothing to ask."""
+    play = [k for k in _in_play(weights, named) if k in fits]
     if len(play) < 2:
         return []
-    w = np.array([weights[k] for k in play])
+    w = np.ones(len(play)) if named and len(named) > 1 else np.array([weights[k] for k in play])
     data = fits[play[0]].data
     test_sd = float(np.median(data.kappa_sd)) / fits[play[0]].kbar
     out = []
@@ -82,12 +92,12 @@ def rank_next_tests(fits: dict[str, Fit], weights: dict[str, float]) -> list[Can
     return sorted(out, key=lambda c: -c.information)
 
 
-def advice(cands: list[Candidate], weights: dict[str, float]) -> str | None:
+def advice(cands: list[Candidate], weights: dict[str, float], named: Sequence[str] | None = None) -> str | None:
     """One sentence for the summary, or None when the laws are separated already."""
     if not cands:
         return None
     best = cands[0]
-    play = [k for k, w in weights.items() if w >= IN_PLAY]
+    play = _in_play(weights, named)
     return (f"the most informative next test: set-up {best.setup} at a sliding speed of {best.V:.1f} m/s "
             f"(wall pressure about {best.p * 1e-6:.0f} MPa): it is expected to bring {best.information:.2f} nats "
             f"on which of {', '.join(play)} holds (the least informative candidate: {cands[-1].information:.2f})")
