@@ -122,19 +122,27 @@ def _law_page(ca: CampaignAnalysis):
     return fig
 
 
-def _comparison_page(ca: CampaignAnalysis):
-    """The laws' stacking weights as bars, each with its dELPD +- SE behind the best; the next-test advice."""
+def _comparison_page(ca: CampaignAnalysis, named: list[str]):
+    """The laws' stacking weights as bars, each with its dELPD +- SE behind the best, the laws the verdict names
+    (``named``: campaign.json's ``friction_law.supported``) in colour; the next-test advice."""
     fig, axes = figure("Friction laws: which the data support (stacking weights) and which test would tell them apart",
                        nrows=1, ncols=2)
     ax = axes[0]
     r = sorted(ca.ranking, key=lambda m: -float(m["weight"]))
     y = np.arange(len(r))[::-1]
-    ax.barh(y, [float(m["weight"]) for m in r], color=["C0" if float(m["weight"]) >= 0.1 else "0.7" for m in r])
-    ax.set_yticks(y, [f"{m.get('law', m['model'])}\n(dELPD {float(m['d_elpd']):.1f} +- {float(m['d_se']):.1f})"
-                      for m in r])
+    law = [str(m.get("law", m["model"])) for m in r]
+    ax.barh(y, [float(m["weight"]) for m in r], color=["C0" if x in named else "0.7" for x in law])
+    for yy, x, m in zip(y, law, r):
+        if x in named:
+            w = float(m["weight"])
+            inside = w > 0.85  # the word on the bar, in white, where the bar reaches the axis' end
+            ax.text(w - 0.01 if inside else w + 0.01, yy, "named", va="center", ha="right" if inside else "left",
+                    fontsize=8, color="white" if inside else "C0")
+    ax.set_yticks(y, [f"{x}\n(dELPD {float(m['d_elpd']):.1f} +- {float(m['d_se']):.1f})" for x, m in zip(law, r)])
     ax.set_xlim(0, 1)
     ax.set_xlabel("stacking weight (0-1): the share of the campaign's predictions each law carries")
-    ax.set_title("blue: 0.1 or more of the weight; grey: the data speak against it", loc="left", fontsize=9)
+    ax.set_title("blue: named by the verdict (carries the weight, or its ELPD is not decisively behind);\n"
+                 "grey: ruled out, or a richer law the tests do not ask for", loc="left", fontsize=9)
     ax = axes[1]
     if ca.next_tests:
         for k, setup in enumerate(sorted({c.setup for c in ca.next_tests})):
@@ -193,7 +201,8 @@ def write_campaign_report(ca: CampaignAnalysis, doc: dict[str, Any], path: str |
         if ca.tests:
             pages.append(_forest(ca))
         if ca.law_data is not None and ca.ranking:
-            pages += [_law_page(ca), _comparison_page(ca), _flag_page(ca)]
+            pages += [_law_page(ca), _comparison_page(ca, list(doc["friction_law"].get("supported") or [])),
+                      _flag_page(ca)]
         buf = io.BytesIO()  # in memory, then written at once (a disk that fills mid-file is one OSError)
         with PdfPages(buf) as pdf:
             for fig in pages:
