@@ -66,3 +66,9 @@ def log_kernel_mixture(mean: np.ndarray, var: np.ndarray, y: np.ndarray, logw: n
                     acc += np.exp(logw[i, j] - 0.5 * (y[i, j] - m) ** 2 / v - top)
             out[w, i] = top + np.log(acc) - 0.5 * np.log(2.0 * np.pi * v)
     return out
+
+
+def warm_up_kernels() -> None:
+    """Load the compiled :func:`log_kernel_mixture` in this process (from numba's cache, or compiled): called
+    before forking workers, so that each child does not load it again (0.5-1 s each)."""
+    log_kernel_mixture(np.zeros((1, 1)), np.ones((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)))

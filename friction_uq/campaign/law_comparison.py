@@ -17,7 +17,7 @@ from .._parallel import forked_map
 from ..stats import RULE, WeightRule, paired_difference, stacking_weights
 from .conclusions import CampaignAnalysis
 from .flags import setup_flags
-from .kernels import log_kernel_mixture
+from .kernels import warm_up_kernels
 from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, loo, rank
 
 #: The verdict's rule on the laws' stacking weights (friction_uq.stats.weights).
@@ -118,8 +118,7 @@ class LawComparison:
                  f"({', '.join(m.name for m in models)}): fit and leave-one-test-out; "
                  f"{time.perf_counter() - self.t0:.0f} s so far")
         jobs = [(m, self.data, self.kbar, self.p_ref, self.seed + 1000 * (first - 1 + i)) for i, m in enumerate(models)]
-        # the compiled kernel loaded here once, before the fork, not in every child (0.5-1 s each)
-        log_kernel_mixture(np.zeros((1, 1)), np.ones((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)))
+        warm_up_kernels()  # loaded here once, before the fork, not in every child (0.5-1 s each)
         out = forked_map(_fit_and_loo, jobs, workers=LAW_WORKERS)
         for m, (fit, _) in zip(models, out):
             self.ca.fits[m.name] = fit

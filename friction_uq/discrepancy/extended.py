@@ -17,7 +17,6 @@ sliding speed, pressure and slip (``f_effective`` of the mechanism), summarised 
 from __future__ import annotations
 
 import math
-import multiprocessing
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
@@ -25,7 +24,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from .._parallel import can_fork, end_with_parent
+from .._parallel import can_fork, forked_map
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
@@ -225,16 +224,13 @@ class Diagnoser:
         """:meth:`fit` for each (variants, start, label) job, on ``workers`` processes (forked: they share
         this object). A daemon process or one running other threads (a campaign's Dask worker: forking
         a threaded process can deadlock) fits them in turn. Same results as one by one."""
-        workers = min(workers, len(jobs))
-        if workers <= 1 or not can_fork():
+        def fit_job(job: tuple[tuple[Variant, ...], Mapping[str, float], str]) -> tuple:
+            mf = self.fit(*job)  # what of the fit can be pickled back from a forked worker
+            return mf.fit, mf.hoop_gain, mf.elpd, mf.f_effective, mf.predicted
+
+        if min(workers, len(jobs)) <= 1 or not can_fork():
             return [self.fit(*job) for job in jobs]
-        global _ACTIVE
-        _ACTIVE = (self, jobs)
-        try:
-            with multiprocessing.get_context("fork").Pool(workers, initializer=end_with_parent) as pool:
-                parts = pool.map(_fit_job, range(len(jobs)), chunksize=1)
-        finally:
-            _ACTIVE = None
+        parts = forked_map(fit_job, jobs, workers=workers)
         out = []
         for (variants, _, label), (fit, gain, elpd, f_eff, predicted) in zip(jobs, parts):
             lik = WholeRecordLikelihood(self.prep, self._model(variants))  # closures do not cross processes
@@ -258,16 +254,6 @@ class Diagnoser:
         for v in variants:
             f = v.mechanism.f_effective({**values, "f": f}, self.context)
         return float(f)
-
-
-_ACTIVE: tuple[Diagnoser, list] | None = None
-
-
-def _fit_job(i: int) -> tuple[WholeRecordFit, float, Elpd, np.ndarray, dict[str, np.ndarray]]:
-    """One job of :meth:`Diagnoser.fit_many` in a forked worker: what of the fit can be pickled."""
-    dg, jobs = _ACTIVE
-    mf = dg.fit(*jobs[i])
-    return mf.fit, mf.hoop_gain, mf.elpd, mf.f_effective, mf.predicted
 
 
 def candidates(exclude: tuple[str, ...] = ()) -> list[Variant]:
