@@ -2,6 +2,7 @@
 
     python benchmarks/bench_campaign.py bundled [--workers 1 2] [--pdf] [--keep DIR]
     python benchmarks/bench_campaign.py simulated [--n 100] [--workers 2]
+    python benchmarks/bench_campaign.py analysis DIR [DIR ...] [--repeat 3]
 
 ``bundled`` runs the 10 records of data/A and data/B in a fresh folder for each worker count
 (nothing up to date) and prints wall time, the CPU time the workers spent on the records (user +
@@ -10,19 +11,27 @@ of a worker process, and the wall time of the campaign's own analysis (pooling, 
 records. ``simulated`` draws N test configurations (the bundled A-01 and B-01 set-ups
 with striker speeds uniform in 6-14 m/s and fresh noise seeds), simulates them (not timed) and
 runs them as one campaign without PDF reports; it prints the time per record and the campaign's
-conclusions. The machine may be shared: quote CPU time beside wall time.
+conclusions. ``analysis`` times the campaign's own analysis alone (pooling, law fits on the package's
+forked processes, flags, next-test advice; no record is run again) on the stored records of campaign
+output folders (``campaign --out DIR``, with or without ``--diagnose``), ``--repeat`` times each, and
+prints each time and their median (target, issue 20: <= 15 s for 10 tests on 2 cores). The machine may
+be shared: quote CPU time beside wall time.
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import shutil
 import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
+for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # as the friction-uq command: before numpy loads
+    os.environ.setdefault(_var, "1")
+
+import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -85,9 +94,29 @@ def simulated(args: argparse.Namespace) -> None:
     shutil.rmtree(tmp, ignore_errors=True)
 
 
+def analysis(args: argparse.Namespace) -> None:
+    from friction_uq.campaign.analysis import analyse
+    from friction_uq.campaign.job import read_result
+
+    print(f"{'campaign':<40} {'tests':>5} {'diagnosed':>9} {'analysis s (each run)':>24} {'median s':>9}")
+    for folder in args.dirs:
+        results = [read_result(p) for p in sorted(Path(folder, "records").glob("*.result.json"))]
+        ok = [r for r in results if r.ok]
+        diagnosed = sum(bool(r.settings.get("diagnose")) for r in ok)
+        walls = []
+        for _ in range(args.repeat):
+            t0 = time.perf_counter()
+            analyse(results, Path(folder, "records"), seed=20161)  # the campaign command's default seed
+            walls.append(time.perf_counter() - t0)
+        each = " ".join(f"{w:.1f}" for w in walls)
+        print(f"{str(folder):<40} {len(ok):>5} {diagnosed:>9} {each:>24} {float(np.median(walls)):>9.1f}")
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("case", choices=("bundled", "simulated"))
+    p.add_argument("case", choices=("bundled", "simulated", "analysis"))
+    p.add_argument("dirs", nargs="*", help="analysis: campaign output folders")
+    p.add_argument("--repeat", type=int, default=3, help="analysis: runs of the analysis per folder (default 3)")
     p.add_argument("--workers", type=int, nargs="+", default=None)
     p.add_argument("--n", type=int, default=100, help="simulated records (default 100)")
     p.add_argument("--seed", type=int, default=2026)
@@ -95,7 +124,9 @@ def main() -> None:
     p.add_argument("--keep", help="bundled: keep the campaign outputs in KEEP/workers<N> (fresh folders)")
     args = p.parse_args()
     args.workers = args.workers or ([1, 2] if args.case == "bundled" else [2])
-    (bundled if args.case == "bundled" else simulated)(args)
+    if args.case == "analysis" and not args.dirs:
+        p.error("analysis needs campaign output folders")
+    {"bundled": bundled, "simulated": simulated, "analysis": analysis}[args.case](args)
 
 
 if __name__ == "__main__":

@@ -21,9 +21,9 @@ from ..priors import load_priors
 from .flags import outlier_tests, setup_entry, setup_flags, tally_causes
 from .conclusions import CampaignAnalysis
 from .job import RecordResult
-from .law_comparison import (WEIGHT_RULE, LawComparison, draw_summary, offset_sentence, simplest_supported,
-                             supported_laws, verdict)
-from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model, loo
+from .law_comparison import (WEIGHT_RULE, LawComparison, draw_summary, fits_with_loo, offset_sentence,
+                             simplest_supported, supported_laws, verdict)
+from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model
 from .next_test import advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
 from .pooling import implied_kappa_log_prior, strata
@@ -112,11 +112,10 @@ def stationary_flags(tests: Sequence[RecordPosterior], law: str, offsets: Sequen
     data = _law_data(tests, diagnosed=False)
     kbar, p_ref = float(np.mean(data.kappa)), float(np.mean(data.p))
     cal = tuple(setups[1:])
-    base = loo(Fit(Model(law, None, cal), data, kbar=kbar, p_ref=p_ref, seed=seed + 77), seed=seed + 77)
-    with_offset = {}
-    for k, s in enumerate(offsets):
-        fit = Fit(Model(law, s, cal), data, kbar=kbar, p_ref=p_ref, seed=seed + 78 + k)
-        with_offset[s] = (loo(fit, seed=seed + 78 + k), draw_summary(fit.draws[:, -2]))
+    jobs = [(Model(law, None, cal), data, kbar, p_ref, seed + 77)]
+    jobs += [(Model(law, s, cal), data, kbar, p_ref, seed + 78 + k) for k, s in enumerate(offsets)]
+    (_, base), *rest = fits_with_loo(jobs)
+    with_offset = {s: (e, draw_summary(fit.draws[:, -2])) for s, (fit, e) in zip(offsets, rest)}
     flags = setup_flags(base, with_offset, setups, tallies, quantity="kappa")
     for f in flags:
         s = str(f["setup"])

@@ -18,7 +18,8 @@ from ..stats import RULE, WeightRule, paired_difference, stacking_weights
 from .conclusions import CampaignAnalysis
 from .flags import setup_flags
 from .kernels import warm_up_kernels
-from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, loo, rank
+from .laws import (LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, loo_elpd, psis_loo, rank,
+                   refit_elpd, to_refit)
 
 #: The verdict's rule on the laws' stacking weights (friction_uq.stats.weights).
 WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
@@ -92,11 +93,30 @@ def draw_summary(x: np.ndarray) -> dict[str, float]:
 
 
 
-def _fit_and_loo(job: tuple[Model, LawData, float, float, int]) -> tuple[Fit, Elpd]:
-    """One law model fitted and its leave-one-test-out ELPD (a job of :func:`~friction_uq._parallel.forked_map`)."""
+def _fit(job: tuple[Model, LawData, float, float, int]) -> Fit:
     model, data, kbar, p_ref, seed = job
-    fit = Fit(model, data, kbar=kbar, p_ref=p_ref, seed=seed)
-    return fit, loo(fit, seed=seed)
+    return Fit(model, data, kbar=kbar, p_ref=p_ref, seed=seed)
+
+
+def _refit(job: tuple[Fit, int, int]) -> float:
+    fit, i, seed = job
+    return refit_elpd(fit, i, seed=seed)
+
+
+def fits_with_loo(jobs: Sequence[tuple[Model, LawData, float, float, int]]) -> list[tuple[Fit, Elpd]]:
+    """Each (model, data, kbar, p_ref, seed) job fitted, with its leave-one-test-out ELPD, on up to
+    :data:`LAW_WORKERS` forked processes: the fits first, then every model's exact refits (tests with a high
+    Pareto k) as jobs of their own, so that a model with many refits does not keep one process busy while the
+    other waits. The same values as :func:`~.laws.loo` on each fit in turn (the same seeds)."""
+    warm_up_kernels()  # loaded here once, before the fork, not in every child (0.5-1 s each)
+    fits = forked_map(_fit, jobs, workers=LAW_WORKERS)
+    psis = [psis_loo(fit) for fit in fits]
+    todo = [(n, i) for n, (_, k) in enumerate(psis) for i in to_refit(k)]
+    values = forked_map(_refit, [(fits[n], i, jobs[n][4]) for n, i in todo], workers=LAW_WORKERS)
+    refits: list[dict[int, float]] = [{} for _ in fits]
+    for (n, i), v in zip(todo, values):
+        refits[n][i] = v
+    return [(fit, loo_elpd(fit, *psis[n], refits[n])) for n, fit in enumerate(fits)]
 
 
 class LawComparison:
@@ -118,8 +138,7 @@ class LawComparison:
                  f"({', '.join(m.name for m in models)}): fit and leave-one-test-out; "
                  f"{time.perf_counter() - self.t0:.0f} s so far")
         jobs = [(m, self.data, self.kbar, self.p_ref, self.seed + 1000 * (first - 1 + i)) for i, m in enumerate(models)]
-        warm_up_kernels()  # loaded here once, before the fork, not in every child (0.5-1 s each)
-        out = forked_map(_fit_and_loo, jobs, workers=LAW_WORKERS)
+        out = fits_with_loo(jobs)
         for m, (fit, _) in zip(models, out):
             self.ca.fits[m.name] = fit
         return out
