@@ -18,8 +18,8 @@ from ..stats import RULE, WeightRule, paired_difference, stacking_weights
 from .conclusions import CampaignAnalysis
 from .flags import setup_flags
 from .kernels import warm_up_kernels
-from .laws import (LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, loo_elpd, psis_loo, rank,
-                   refit_elpd, to_refit)
+from .law_loo import loo_elpd, psis_loo, refit_elpd, to_refit
+from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, rank
 
 #: The verdict's rule on the laws' stacking weights (friction_uq.stats.weights).
 WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
@@ -107,7 +107,7 @@ def fits_with_loo(jobs: Sequence[tuple[Model, LawData, float, float, int]]) -> l
     """Each (model, data, kbar, p_ref, seed) job fitted, with its leave-one-test-out ELPD, on up to
     :data:`LAW_WORKERS` forked processes: the fits first, then every model's exact refits (tests with a high
     Pareto k) as jobs of their own, so that a model with many refits does not keep one process busy while the
-    other waits. The same values as :func:`~.laws.loo` on each fit in turn (the same seeds)."""
+    other waits. The same values as :func:`~.law_loo.loo` on each fit in turn (the same seeds)."""
     warm_up_kernels()  # loaded here once, before the fork, not in every child (0.5-1 s each)
     fits = forked_map(_fit, jobs, workers=LAW_WORKERS)
     psis = [psis_loo(fit) for fit in fits]

@@ -42,12 +42,10 @@ test whose Pareto k exceeds 0.7.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import logsumexp
 
 from ..stats import RULE, paired_difference
 from ..stats.streams import legacy_state
@@ -64,13 +62,10 @@ NESTS = {"constant": set(LAWS), "velocity": {"velocity", "pressure+velocity"},
 LAW_PARAMS = {"constant": ("a",), "velocity": ("d", "s", "log_vc"), "pressure": ("a", "c"),
               "pressure+velocity": ("d", "s", "log_vc", "c")}
 LOG_VC_RANGE = (np.log(0.3), np.log(300.0))
-PARETO_K_MAX = 0.7
 #: Prior sd of a set-up's calibration offset (module docstring).
 CALIBRATION_SD = 0.03
 #: Prior sd of a free set-up offset (flag models only).
 FREE_OFFSET_SD = 0.3
-#: an exact leave-one-out refit's chain: it starts from the full fit's walkers, so it burns in less
-REFIT = {"nwalkers": 32, "nsteps": 700, "burn": 200}
 
 
 @dataclass(frozen=True)
@@ -295,56 +290,6 @@ class Elpd:
     pointwise: np.ndarray
     pareto_k: np.ndarray
     refits: int
-
-
-def psis_loo(fit: Fit) -> tuple[np.ndarray, np.ndarray]:
-    """Leave-one-test-out by Pareto-smoothed importance sampling: each test's ELPD and Pareto k."""
-    import arviz as az
-
-    ll = fit.pointwise(fit.draws)
-    dt = az.from_dict({"posterior": {"r": fit.draws[None, :, -1]}, "log_likelihood": {"y": ll[None]},
-                       "observed_data": {"y": fit.data.kappa}}, dims={"y": ["test"]})
-    with warnings.catch_warnings():  # high Pareto k is handled by exact refits (refit_elpd)
-        warnings.filterwarnings("ignore", message="Estimated shape parameter of Pareto")
-        res = az.loo(dt, pointwise=True)
-    return np.asarray(res.elpd_i, float).copy(), np.asarray(res.pareto_k, float)
-
-
-def refit_elpd(fit: Fit, i: int, *, seed: int) -> float:
-    """Test ``i``'s leave-one-out ELPD from an exact refit without it (where its Pareto k > 0.7), with the seed
-    ``seed + 1 + i``."""
-    sub = fit.data.drop(i)
-    # started from the full fit's last walkers, which are near the leave-one-out posterior: a shorter burn-in
-    start = fit.draws[-REFIT["nwalkers"]:]
-    refit = Fit(fit.model, sub, kbar=fit.kbar, p_ref=fit.p_ref, seed=seed + 1 + i, start=start, **REFIT)
-    lli = refit.pointwise(refit.draws, _one(fit.data, i))[:, 0]
-    return float(logsumexp(lli) - np.log(lli.size))
-
-
-def to_refit(k: np.ndarray) -> list[int]:
-    """The tests whose PSIS estimate is not trusted (Pareto k > :data:`PARETO_K_MAX`): refitted exactly."""
-    return [int(i) for i in np.flatnonzero(k > PARETO_K_MAX)]
-
-
-def loo_elpd(fit: Fit, elpd_i: np.ndarray, k: np.ndarray, refits: dict[int, float]) -> Elpd:
-    """The model's ELPD (sum and SE over tests) from the PSIS values with the refitted tests' values in place."""
-    elpd_i = elpd_i.copy()
-    for i, v in refits.items():
-        elpd_i[i] = v
-    n = elpd_i.size
-    return Elpd(fit.model.name, float(elpd_i.sum()), float(np.sqrt(n * np.var(elpd_i, ddof=1))), elpd_i, k,
-                len(refits))
-
-
-def loo(fit: Fit, *, seed: int) -> Elpd:
-    """Leave-one-test-out ELPD: PSIS-LOO, exact refits where Pareto k > 0.7 (one after the other; a campaign
-    spreads the refits of several models over its processes: ``law_comparison.fits_with_loo``)."""
-    elpd_i, k = psis_loo(fit)
-    return loo_elpd(fit, elpd_i, k, {i: refit_elpd(fit, i, seed=seed) for i in to_refit(k)})
-
-
-def _one(d: LawData, i: int) -> LawData:
-    return d.select(np.arange(d.n) == i)
 
 
 def rank(elpds: Sequence[Elpd]) -> list[dict[str, float | str]]:
