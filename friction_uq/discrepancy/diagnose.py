@@ -150,6 +150,22 @@ def separability(verdict: Verdict) -> tuple[tuple[str, ...], tuple[str, ...], st
     return names, channels, SEPARATE_BY.get(frozenset(names[:2]), DEFAULT_SEPARATION)
 
 
+@dataclass
+class _Search:
+    """The rounds of one diagnosis as they go: the reference model, the causes in it, each round's ranking,
+    verdict and misfit decision, and what round 1 could not separate."""
+
+    base: ModelFit
+    reference: ModelFit
+    causes: list[Variant] = field(default_factory=list)
+    rounds: list[tuple[Ranked, ...]] = field(default_factory=list)
+    verdicts: list[Verdict] = field(default_factory=list)
+    misfits: list[MisfitDecision] = field(default_factory=list)
+    not_sep: tuple[str, ...] = ()
+    other_channels: tuple[str, ...] = ()
+    separate_by: object = None
+
+
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
              hoop: bool, seed: int, n_draws: int = 1000, progress: Callable[[str], None] | None = None,
              base_scales: Mapping[str, tuple[float, float]] | None = None, max_causes: int = MAX_CAUSES,
@@ -168,24 +184,45 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
                    nominal=start)
     say(f"baseline (up to {max_causes} rounds of about ten extended models follow)")
     base = dg.fit((), start, "baseline")
-    reference = base
-    causes: list[Variant] = []
-    rounds: list[tuple[Ranked, ...]] = []
-    verdicts: list[Verdict] = []
-    misfits: list[MisfitDecision] = []
-    not_sep: tuple[str, ...] = ()
-    other_channels: tuple[str, ...] = ()
-    separate_by = None
+    st = _search(dg, prep, _Search(base, base), max_causes=max_causes, workers=workers, seed=seed, say=say, t0=t0)
+    final, causes, rounds, verdicts = st.reference, st.causes, st.rounds, st.verdicts
+    if st.not_sep and {m for m in st.not_sep[1:]} <= {v.mechanism.name for v in causes}:
+        st.not_sep, st.separate_by = (), None  # the rivals of round 1 were second causes, named in later rounds
+    say("posterior predictive of the final model")
+    if causes and len(next(iter(final.predicted.values()))) == 1:  # the mode only: a cause of the last round
+        final = replace(final, predicted=dg.predictive(final))
+    a = compare_whole_record(prep, st.base.predicted)
+    b = compare_whole_record(prep, final.predicted)
+    k = ess = float("nan")
+    method = None
+    mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else mixture(st.base, rounds[0], verdicts[0], seed)
+    if causes:
+        say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
+        final, ex = dg.exact_posterior(final)
+        k, ess, method = ex.pareto_k, ex.ess, ex.method
+        mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed)
+    return Diagnosis(baseline=st.base, rounds=tuple(rounds), misfits=tuple(st.misfits), causes=tuple(causes),
+                     not_separable=st.not_sep, channels_not_separable=st.other_channels, separate_by=st.separate_by,
+                     final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
+                     baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
+                     posterior_method=method, context=dg.context, seed=seed, verdicts=tuple(verdicts),
+                     mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src)
+
+
+def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, workers: int, seed: int,
+            say: Callable[[str], None], t0: float) -> _Search:
+    """The rounds: each fits every mechanism not yet in the reference model on top of it, ranks them, and the
+    naming rule judges; a named cause (or the best of candidates) joins the model and the next round begins."""
     fit_seconds, fitted = 0.0, 0  # process-seconds per extended model, for the progress lines' estimates
     for k in range(max_causes):
         say("misfit of the reference model")
-        reference = replace(reference, predicted=dg.predictive(reference))
+        st.reference = replace(st.reference, predicted=dg.predictive(st.reference))
         if k == 0:
-            base = reference
-        misfits.append(decide(compare_whole_record(prep, reference.predicted)))
-        used = tuple(v.mechanism.name for v in causes)
-        jobs = [(tuple(causes) + (cand,), dict(reference.fit.mode), "+".join([v.label for v in causes] + [cand.label]))
-                for cand in candidates(exclude=used)]
+            st.base = st.reference
+        st.misfits.append(decide(compare_whole_record(prep, st.reference.predicted)))
+        used = tuple(v.mechanism.name for v in st.causes)
+        jobs = [(tuple(st.causes) + (cand,), dict(st.reference.fit.mode),
+                 "+".join([v.label for v in st.causes] + [cand.label])) for cand in candidates(exclude=used)]
         per_model = fit_seconds / fitted if fitted else None
         eta = f", about {per_model * len(jobs) / max(1, min(workers, len(jobs))):.0f} s" if per_model else ""
         say(f"round {k + 1}: {len(jobs)} extended models ({', '.join(j[2] for j in jobs)}) on {workers} "
@@ -194,42 +231,21 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         fits = dg.fit_many(jobs, workers=workers)
         fit_seconds += (time.perf_counter() - t_round) * max(1, min(workers, len(jobs)))
         fitted += len(jobs)
-        ranked = rank(reference, fits, misfit=misfits[-1].detected)
-        rounds.append(ranked)
-        verdict = NAMING.judge(reference, ranked, misfit=misfits[-1].detected, seed=seed + k, first=k == 0)
-        verdicts.append(verdict)
+        ranked = rank(st.reference, fits, misfit=st.misfits[-1].detected)
+        st.rounds.append(ranked)
+        verdict = NAMING.judge(st.reference, ranked, misfit=st.misfits[-1].detected, seed=seed + k, first=k == 0)
+        st.verdicts.append(verdict)
         say(f"round {k + 1}: {verdict.kind}" + (f" ({verdict.named})" if verdict.named else ""))
         if verdict.named is not None and k == 0:
-            not_sep, other_channels, separate_by = separability(verdict)
+            st.not_sep, st.other_channels, st.separate_by = separability(verdict)
         if verdict.kind not in ("named", "candidates"):
             break
         # candidates: the best goes into the model all the same; a rival that is a second cause passes again in a
         # later round, one that is an alternative does not (then f is the mixture of the two, below)
         best = next(r for r in ranked if r.fit.label == verdict.named)
-        causes.append(best.fit.variants[-1])
-        reference = best.fit
-    final = reference
-    if not_sep and {m for m in not_sep[1:]} <= {v.mechanism.name for v in causes}:
-        not_sep, separate_by = (), None  # the rivals of round 1 were second causes, named in later rounds
-    say("posterior predictive of the final model")
-    if causes and len(next(iter(final.predicted.values()))) == 1:  # the mode only: a cause of the last round
-        final = replace(final, predicted=dg.predictive(final))
-    a = compare_whole_record(prep, base.predicted)
-    b = compare_whole_record(prep, final.predicted)
-    k = ess = float("nan")
-    method = None
-    mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else mixture(base, rounds[0], verdicts[0], seed)
-    if causes:
-        say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
-        final, ex = dg.exact_posterior(final)
-        k, ess, method = ex.pareto_k, ex.ess, ex.method
-        mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed)
-    return Diagnosis(baseline=base, rounds=tuple(rounds), misfits=tuple(misfits), causes=tuple(causes),
-                     not_separable=not_sep, channels_not_separable=other_channels, separate_by=separate_by,
-                     final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
-                     baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
-                     posterior_method=method, context=dg.context, seed=seed, verdicts=tuple(verdicts),
-                     mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src)
+        st.causes.append(best.fit.variants[-1])
+        st.reference = best.fit
+    return st
 
 
 def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
