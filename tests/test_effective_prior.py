@@ -132,3 +132,26 @@ def test_the_mixture_group_holds_each_draws_prior_from_the_model_it_came_from(tm
         np.testing.assert_allclose(lp[:30], F_PRIOR.logpdf(f[:30]))  # the reference leaves f as it is
         assert list(m["model"].values[0][[0, -1]]) == ["reference", "velocity_friction"]
         assert np.all(np.isfinite(lp)) and not np.allclose(lp[30:], F_PRIOR.logpdf(f[30:]))
+
+
+def test_a_mixture_member_that_drew_no_draw_is_written_without_one(tmp_path):
+    """A candidate whose stacking weight is too small to draw any of the mixture's draws (bundled A-02 under
+    diagnose ended in a ValueError on the empty set of its draws): the mixture is written with the others'."""
+    rng = np.random.default_rng(2)
+    base = _model("baseline", (), rng.normal(0.05, 0.002, 200))
+    vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
+    slip = _model("slip_friction", ("slip_friction",), rng.normal(0.055, 0.002, 200))
+    f = np.concatenate([base.f_effective[:40], vel.f_effective[:60]])
+    source = np.repeat([0, 1], [40, 60])  # slip_friction (index 2) drew nothing
+    dg = SimpleNamespace(baseline=base, final=base, causes=(), rounds=((SimpleNamespace(fit=vel),
+                                                                        SimpleNamespace(fit=slip)),),
+                         posterior_method=None, context=CTX, seed=4, mixture_f=f, mixture_source=source,
+                         mixture_weights={"reference": 0.4, "velocity_friction": 0.5999, "slip_friction": 1e-4},
+                         verdict=SimpleNamespace(kind="candidates"))
+    lp, _ = log_prior_f_effective(slip.variants, CTX, F_PRIOR, np.array([]), rng=np.random.default_rng(0))
+    assert lp.shape == (0,)
+    with _written(dg, tmp_path) as back:
+        m = back["discrepancy_mixture/posterior"]
+        assert m["f_effective"].shape == (1, 100)
+        assert set(m["model"].values[0]) == {"reference", "velocity_friction"}
+        assert np.all(np.isfinite(m["log_prior_f_effective"].values))

@@ -64,6 +64,8 @@ def log_prior_f_effective(variants: Sequence[Any], context: Context, f_prior: An
     that prior is in words (module docstring). ``f_prior``: the prior file's f prior
     (:class:`~friction_uq.priors.ParameterPrior`: its logpdf, cdf and ppf are used)."""
     y = np.asarray(y, float)
+    if y.size == 0:  # a mixture's member with a weight too small to draw any of its draws
+        return np.empty(y.shape), EXACT_NOTE if not variants else PUSHED_NOTE
     lo, hi = (float(x) for x in f_prior.ppf([1e-9, 1.0 - 1e-9]))
     grid = np.linspace(lo, hi, GRID)
     theta = _theta(variants, rng)
