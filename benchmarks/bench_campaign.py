@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import os
 import shutil
 import tempfile
@@ -103,10 +104,12 @@ def analysis(args: argparse.Namespace) -> None:
         results = [read_result(p) for p in sorted(Path(folder, "records").glob("*.result.json"))]
         ok = [r for r in results if r.ok]
         diagnosed = sum(bool(r.settings.get("diagnose")) for r in ok)
+        doc = Path(folder, "campaign.json")
+        seed = json.loads(doc.read_text()).get("seed", 20161) if doc.exists() else 20161  # the campaign's own
         walls = []
         for _ in range(args.repeat):
             t0 = time.perf_counter()
-            analyse(results, Path(folder, "records"), seed=20161)  # the campaign command's default seed
+            analyse(results, Path(folder, "records"), seed=seed)
             walls.append(time.perf_counter() - t0)
         each = " ".join(f"{w:.1f}" for w in walls)
         print(f"{str(folder):<40} {len(ok):>5} {diagnosed:>9} {each:>24} {float(np.median(walls)):>9.1f}")

@@ -93,9 +93,10 @@ def draw_summary(x: np.ndarray) -> dict[str, float]:
 
 
 
-def _fit(job: tuple[Model, LawData, float, float, int]) -> Fit:
+def _fit(job: tuple[Model, LawData, float, float, int]) -> tuple[Fit, tuple[np.ndarray, np.ndarray]]:
     model, data, kbar, p_ref, seed = job
-    return Fit(model, data, kbar=kbar, p_ref=p_ref, seed=seed)
+    fit = Fit(model, data, kbar=kbar, p_ref=p_ref, seed=seed)
+    return fit, psis_loo(fit)
 
 
 def _refit(job: tuple[Fit, int, int]) -> float:
@@ -107,10 +108,9 @@ def fits_with_loo(jobs: Sequence[tuple[Model, LawData, float, float, int]]) -> l
     """Each (model, data, kbar, p_ref, seed) job fitted, with its leave-one-test-out ELPD, on up to
     :data:`LAW_WORKERS` forked processes: the fits first, then every model's exact refits (tests with a high
     Pareto k) as jobs of their own, so that a model with many refits does not keep one process busy while the
-    other waits. The same values as :func:`~.law_loo.loo` on each fit in turn (the same seeds)."""
+    other waits; each refit has the seed ``seed + 1 + i`` of its model's seed and test, whichever process runs it."""
     warm_up_kernels()  # loaded here once, before the fork, not in every child (0.5-1 s each)
-    fits = forked_map(_fit, jobs, workers=LAW_WORKERS)
-    psis = [psis_loo(fit) for fit in fits]
+    fits, psis = zip(*forked_map(_fit, jobs, workers=LAW_WORKERS)) if jobs else ((), ())
     todo = [(n, i) for n, (_, k) in enumerate(psis) for i in to_refit(k)]
     values = forked_map(_refit, [(fits[n], i, jobs[n][4]) for n, i in todo], workers=LAW_WORKERS)
     refits: list[dict[int, float]] = [{} for _ in fits]

@@ -1,7 +1,7 @@
 """Leave-one-test-out ELPD of a friction-law fit (:class:`~.laws.Fit`): Pareto-smoothed importance sampling
 (PSIS-LOO, Vehtari et al. 2017, through ArviZ), with an exact refit without the test wherever its Pareto k
 exceeds :data:`PARETO_K_MAX`. The parts are separate so that a campaign can spread the refits of several
-models over its processes (``law_comparison.fits_with_loo``); :func:`loo` runs them in turn."""
+models over its processes (``law_comparison.fits_with_loo``)."""
 
 from __future__ import annotations
 
@@ -54,13 +54,6 @@ def loo_elpd(fit: Fit, elpd_i: np.ndarray, k: np.ndarray, refits: dict[int, floa
     n = elpd_i.size
     return Elpd(fit.model.name, float(elpd_i.sum()), float(np.sqrt(n * np.var(elpd_i, ddof=1))), elpd_i, k,
                 len(refits))
-
-
-def loo(fit: Fit, *, seed: int) -> Elpd:
-    """Leave-one-test-out ELPD: PSIS-LOO, exact refits where Pareto k > 0.7 (one after the other; a campaign
-    spreads the refits of several models over its processes: ``law_comparison.fits_with_loo``)."""
-    elpd_i, k = psis_loo(fit)
-    return loo_elpd(fit, elpd_i, k, {i: refit_elpd(fit, i, seed=seed) for i in to_refit(k)})
 
 
 def _one(d: LawData, i: int) -> LawData:

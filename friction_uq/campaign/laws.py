@@ -36,8 +36,7 @@ Without draws the test's likelihood is the normal N(y; law, sqrt(sd_y^2 + law_va
 Priors: a, d, s uniform on (0, 5); v_c log-uniform on (0.3, 300) m/s; c ~ N(0, 1); cal_s ~ N(0, 0.03);
 delta ~ N(0, 0.3).
 
-Sampled with emcee; leave-one-test-out ELPD by PSIS-LOO (ArviZ), with an exact refit for every
-test whose Pareto k exceeds 0.7.
+Sampled with emcee (:mod:`.law_coordinates`); leave-one-test-out ELPD in :mod:`.law_loo`.
 """
 
 from __future__ import annotations

@@ -163,7 +163,7 @@ class _Search:
     misfits: list[MisfitDecision] = field(default_factory=list)
     not_sep: tuple[str, ...] = ()
     other_channels: tuple[str, ...] = ()
-    separate_by: object = None
+    separate_by: str | None = None
 
 
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,

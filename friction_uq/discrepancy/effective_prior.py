@@ -64,8 +64,6 @@ def log_prior_f_effective(variants: Sequence[Any], context: Context, f_prior: An
     that prior is in words (module docstring). ``f_prior``: the prior file's f prior
     (:class:`~friction_uq.priors.ParameterPrior`: its logpdf, cdf and ppf are used)."""
     y = np.asarray(y, float)
-    if y.size == 0:  # a mixture's member with a weight too small to draw any of its draws
-        return np.empty(y.shape), EXACT_NOTE if not variants else PUSHED_NOTE
     lo, hi = (float(x) for x in f_prior.ppf([1e-9, 1.0 - 1e-9]))
     grid = np.linspace(lo, hi, GRID)
     theta = _theta(variants, rng)
@@ -73,6 +71,8 @@ def log_prior_f_effective(variants: Sequence[Any], context: Context, f_prior: An
     G = np.broadcast_to(G, (max(1, len(next(iter(theta.values()), []))), GRID))
     if np.array_equal(G, np.broadcast_to(grid, G.shape)):
         return np.asarray(f_prior.logpdf(y), float), EXACT_NOTE
+    if y.size == 0:  # no draw to evaluate it at (a mixture's member whose weight drew none)
+        return np.empty(y.shape), PUSHED_NOTE
     width = np.diff(G, axis=1)
     if np.any(width < -1e-12 * np.abs(G[:, 1:]).max()):
         names = "+".join(v.label for v in variants)
