@@ -110,6 +110,8 @@ def fits_with_loo(jobs: Sequence[tuple[Model, LawData, float, float, int]]) -> l
     Pareto k) as jobs of their own, so that a model with many refits does not keep one process busy while the
     other waits; each refit has the seed ``seed + 1 + i`` of its model's seed and test, whichever process runs it."""
     warm_up_kernels()  # loaded here once, before the fork, not in every child (0.5-1 s each)
+    import arviz  # noqa: F401 - the same: the children's PSIS uses it, and a child that imports it pays ~1 s
+
     fits, psis = zip(*forked_map(_fit, jobs, workers=LAW_WORKERS)) if jobs else ((), ())
     todo = [(n, i) for n, (_, k) in enumerate(psis) for i in to_refit(k)]
     values = forked_map(_refit, [(fits[n], i, jobs[n][4]) for n, i in todo], workers=LAW_WORKERS)
