@@ -29,7 +29,7 @@ Required (issue 20): the true law the heaviest in >= 80 % of the 2x3 and >= 95 %
 "constant" named on a non-constant law in <= 5 %.
 
     python benchmarks/bench_campaign_study.py [--designs 2x3 3x4] [--laws velocity pressure constant slip]
-        [--simulators 1d axisymmetric] [--seeds 5] [--workers 2] [--save FILE]
+        [--simulators 1d axisymmetric] [--seeds 5] [--first-seed 1] [--workers 2] [--save FILE]
 
 About 30 s (2x3) and 60 s (3x4) a campaign on 2 cores with the 1-D simulation, plus 4-5 s a record to
 simulate with the axisymmetric one.
@@ -167,7 +167,8 @@ def main() -> None:
     p.add_argument("--designs", nargs="+", default=list(DESIGNS), choices=list(DESIGNS))
     p.add_argument("--laws", nargs="+", default=list(LAWS), choices=list(LAWS))
     p.add_argument("--simulators", nargs="+", default=["1d", "axisymmetric"], choices=["1d", "axisymmetric"])
-    p.add_argument("--seeds", type=int, default=5, help="campaigns per design, simulator and law (seeds 1..N)")
+    p.add_argument("--seeds", type=int, default=5, help="campaigns per design, simulator and law (default 5)")
+    p.add_argument("--first-seed", type=int, default=1, help="seeds FIRST .. FIRST + SEEDS - 1 (default 1)")
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--save", help="write every campaign's verdict to this JSON file as it comes")
     args = p.parse_args()
@@ -177,7 +178,7 @@ def main() -> None:
         for sim in args.simulators:
             for design in args.designs:
                 for law in args.laws:
-                    for seed in range(1, args.seeds + 1):
+                    for seed in range(args.first_seed, args.first_seed + args.seeds):
                         r = one_campaign(design, law, sim, seed, workers=args.workers, tmp=Path(tmp))
                         rows.append(r)
                         print(f"{design} {sim} {law} seed {seed}: weights "
