@@ -273,8 +273,6 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
     notes = []
     for i, label in enumerate(labels):
         at = dg.mixture_source == i
-        if not at.any():  # its weight drew none of the mixture's draws: nothing of it to divide out
-            continue
         rng = stream(dg.seed, "effective prior", f"mixture {label}")
         log_prior[at], note = log_prior_f_effective(fits[label].variants, dg.context, f_prior, dg.mixture_f[at],
                                                     rng=rng)
