@@ -11,7 +11,12 @@ Groups (f, nu, striker speed, rise time and noise drawn as in ``bench_misfit.py`
   trigger's skew);
 * one group per hidden mechanism of ``bench_diagnose.HIDDEN`` (1-D, at its documented strength), and
   ``axisymmetric_<mechanism>`` for those the axisymmetric simulation also has (plug friction, clearance, the
-  friction laws).
+  friction laws);
+* one group per measurement-chain fault (:data:`CHAIN_FAULTS`), made on the recorded strains of the 1-D
+  simulation with shapes the catalogue's models do not share: ``channel_timing`` (one output gauge read
+  3-5 us late or early), ``bandwidth`` (one output gauge through a second-order Butterworth low-pass at
+  50-80 kHz, not the model's first-order one) and ``zero_drift`` (one gauge's zero creeping 10-25
+  microstrain over the record along an exponential, not the model's straight line).
 
 For each record: ``diagnose``'s first round (the baseline against every extended model), written as one
 ``.npz`` per record: each model's pointwise block ELPD and calibration terms, its draws of f_effective, the
@@ -32,6 +37,7 @@ import time
 from types import MappingProxyType
 
 import numpy as np
+from scipy import signal
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_diagnose import HIDDEN, analyse, true_f  # noqa: E402
@@ -72,37 +78,76 @@ def _perturbation(c, r: np.random.Generator) -> tuple[object, str | None, str]:
     return c, ch, f"{ch} timing {float(r.uniform(-0.5, 0.5)):+.2f} us"
 
 
+OUTPUT_GAUGES = ("internal_output_bar", "external_output_bar", "tube_hoop")
+
+
+def _timing(r: np.random.Generator):
+    ch = str(r.choice(OUTPUT_GAUGES))
+    dt = float(r.uniform(3e-6, 5e-6) * r.choice([-1, 1]))
+    return _shifted(ch, dt), f"{ch} timing {dt * 1e6:+.2f} us"
+
+
+def _bandwidth(r: np.random.Generator):
+    ch = str(r.choice(OUTPUT_GAUGES))
+    fc = float(r.uniform(50e3, 80e3))
+
+    def edit(t, noisy):
+        noisy[ch] = signal.sosfilt(signal.butter(2, fc, fs=1.0 / (t[1] - t[0]), output="sos"), noisy[ch])
+    return edit, f"{ch} through a 2nd-order low-pass at {fc / 1e3:.0f} kHz"
+
+
+def _drift(r: np.random.Generator):
+    ch = str(r.choice(("input_bar", *OUTPUT_GAUGES)))
+    amp = float(r.uniform(10e-6, 25e-6) * r.choice([-1, 1]))
+
+    def edit(t, noisy):
+        u = (t - t[0]) / (t[-1] - t[0])
+        noisy[ch] = noisy[ch] + amp * (1.0 - np.exp(-2.0 * u)) / (1.0 - np.exp(-2.0))
+    return edit, f"{ch} zero creeps {amp * 1e6:+.0f} ue"
+
+
+#: Measurement-chain faults made on the recorded strains: group (the mechanism's name) -> maker of (edit, note)
+CHAIN_FAULTS = {"channel_timing": _timing, "bandwidth": _bandwidth, "zero_drift": _drift}
+
+
+def _shifted(ch: str, dt: float):
+    def edit(t, noisy):  # the channel read dt later (or earlier) than its neighbours
+        noisy[ch] = np.interp(t - dt, t, noisy[ch])
+    return edit
+
+
 def groups() -> list[str]:
     return (["clean_axisymmetric", "clean_perturbed"] + list(HIDDEN)
-            + [f"axisymmetric_{m}" for m in AXISYMMETRIC_MECHANISMS])
+            + [f"axisymmetric_{m}" for m in AXISYMMETRIC_MECHANISMS] + list(CHAIN_FAULTS))
 
 
 def make(group: str, k: int, r: np.random.Generator):
-    """The configuration of record ``k`` of ``group``, the channel to shift (and by how much, s) and a note."""
+    """The configuration of record ``k`` of ``group``, an edit of its recorded strains (``edit(time, noisy)``,
+    or None) and a note."""
     cfg = clean_config(r, "A" if k % 2 == 0 else "B")
-    shift, note = None, ""
+    edit, note = None, ""
     if group == "clean_axisymmetric":
         cfg, note = _axisymmetric(cfg), "axisymmetric"
     elif group == "clean_perturbed":
         cfg, ch, note = _perturbation(cfg, r)
         if ch is not None:
-            shift = (ch, float(note.split("timing ")[1].split(" us")[0]) * 1e-6)
+            edit = _shifted(ch, float(note.split("timing ")[1].split(" us")[0]) * 1e-6)
+    elif group in CHAIN_FAULTS:
+        edit, note = CHAIN_FAULTS[group](r)
     else:
         mech = group.removeprefix("axisymmetric_")
         cfg = HIDDEN[mech](cfg, r)
         note = mech
         if group.startswith("axisymmetric_"):
             cfg, note = _axisymmetric(cfg), f"axisymmetric {mech}"
-    return cfg, shift, note
+    return cfg, edit, note
 
 
-def write(cfg, path: str, seed: int, shift) -> object:
+def write(cfg, path: str, seed: int, edit) -> object:
     sim = simulate(cfg, seed=seed)
     noisy = dict(sim.noisy)
-    if shift is not None:  # the channel read dt later (or earlier) than its neighbours
-        ch, dt = shift
-        t = sim.time
-        noisy[ch] = np.interp(t - dt, t, noisy[ch])
+    if edit is not None:
+        edit(sim.time, noisy)
     write_strains(cfg, path, sim, noisy, campaign="V")
     return sim
 
@@ -145,7 +190,7 @@ def main() -> None:
     tmp = tempfile.mkdtemp()
     jobs = [(g, k) for g in groups() for k in range(a.clean if g.startswith("clean") else a.per)]
     for g, k in jobs:
-        cfg, shift, note = make(g, k, rng)
+        cfg, edit, note = make(g, k, rng)
         sim_seed = int(rng.integers(2**31))
         name = f"{g}-{k}"
         if (only is not None and g not in only) or os.path.exists(os.path.join(a.out, f"{name}.npz")):
@@ -153,7 +198,7 @@ def main() -> None:
         path = os.path.join(tmp, f"{name}.h5")
         t = time.perf_counter()
         try:
-            write(cfg, path, sim_seed, shift)
+            write(cfg, path, sim_seed, edit)
             prep, dg = analyse(path, priors, seed=k, max_causes=1)
         except FrictionUQError as exc:
             print(f"{name}: refused: {exc}", flush=True)

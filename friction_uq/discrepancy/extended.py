@@ -28,6 +28,7 @@ from .._parallel import can_fork, forked_map
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
+from ..models.measurement_chain import Reading
 from ..stats.ar1 import ar1_block_loo
 from ..stats.exact import ExactDraws, exact_draws
 from ..stats.laplace import robust_covariance
@@ -104,11 +105,12 @@ class Diagnoser:
 
     def _model(self, variants: tuple[Variant, ...]) -> SimulatorModel:
         extra = [self.modulus] + [p for v in variants for p in v.mechanism.parameters]
-        def apply(values: Mapping[str, float], settings: dict[str, Any], gains: dict[str, float]) -> None:
+        def apply(values: Mapping[str, float], settings: dict[str, Any], readings: dict[str, Reading]) -> None:
             app = settings["apparatus"]
-            settings["apparatus"] = replace(app, sample=replace(app.sample, young_modulus=float(values["sample_modulus"])))
+            sample = replace(app.sample, young_modulus=float(values["sample_modulus"]))
+            settings["apparatus"] = replace(app, sample=sample)
             for v in variants:
-                v.mechanism.apply(values, settings, gains, v.channel)
+                v.mechanism.apply(values, settings, readings, v.channel)
 
         return SimulatorModel(self.prep.record.apparatus, self.loading, hoop=self.hoop, extra=tuple(extra),
                               apply=apply, dispersive_loading=self.dispersive_loading)

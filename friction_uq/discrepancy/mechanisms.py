@@ -4,7 +4,8 @@ extension of the baseline simulator with named parameters.
 Every entry declares its parameters (:class:`~friction_uq.models.Parameter`: name, unit, physical
 support, meaning), their priors (scipy distributions over physical ranges, documented here), a
 starting value for the fit, what it is physically and its signature in the record, and how it acts
-on the simulator (``apply``: it edits the simulator settings and the gauge gains). The baseline's
+on the simulator (``apply``: it edits the simulator settings and the gauges' measurement chains,
+:mod:`friction_uq.models.measurement_chain`). The baseline's
 own parameters (f, nu and the sample's modulus factor) stay free in every fit. Adding a mechanism
 is one :func:`register` call below and its tests.
 
@@ -26,6 +27,19 @@ Priors (why these ranges):
 * ``dispersion``: no parameter (the bars' geometry gives it).
 * ``end_friction``: f_e ~ half-normal(0.25): PTFE on steel is 0.02-0.1, bare faces (a sheet torn or
   missing: explosive on steel) 0.3-0.5.
+
+The measurement chain beside the gain (each fitted once, on every gauge it may act on at once: a
+parameter per gauge, the gauges that read right keep theirs near the neutral value):
+
+* ``zero_drift``: a rate per gauge ~ normal(0, 10 microstrain per ms): a bridge warming or an
+  amplifier's zero creeping moves a few microstrain over a record of 1-2 ms; the constant part of a
+  zero is the likelihood's own offset.
+* ``channel_timing``: the output bars' and the hoop gauge's delays against the input bar ~ normal(0,
+  2 us): a gauge 1 cm from where the header puts it on a 5000 m/s bar reads 2 us late, two digitisers
+  triggered apart by a few samples as much (a delay common to every channel changes nothing).
+* ``bandwidth``: an equivalent first-order time constant per output gauge ~ half-normal(1 us): a bridge
+  amplifier of 100 kHz (older SHPB chains) has 1.6 us, one of 1 MHz 0.16 us. The input bar is left
+  out: its reading drives the simulation, and a low-pass commutes with the bars' linear response.
 """
 
 from __future__ import annotations
@@ -39,10 +53,12 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
+from ..models.measurement_chain import Reading
 from ..models.parameters import Parameter
 
-Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, float], str | None], None]
-"""apply(values, settings, gains, channel): edit the simulator settings and gauge gains in place."""
+Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, Reading], str | None], None]
+"""apply(values, settings, readings, channel): edit the simulator settings and the gauges' measurement chains
+(channel -> :class:`~friction_uq.models.measurement_chain.Reading`) in place."""
 
 
 @dataclass(frozen=True)
@@ -71,6 +87,7 @@ class Mechanism:
     f_effective: Callable[[Mapping[str, Any], Context], Any] = field(default=lambda v, c: v["f"])
     channels: tuple[str, ...] = ()  # gauge_gain: the gauges it may act on (one fit each)
     group: str | None = None  # mechanisms of one group replace the same thing (the friction law): one at a time
+    per_gauge: tuple[str, ...] = ()  # a measurement-chain fault fitted on every gauge at once: parameter i is gauge i's
 
     def prior_z(self) -> dict[str, tuple[float, float]]:
         """Gaussian stand-ins of the priors in each parameter's unbounded coordinate (centre, sd), from the
@@ -79,6 +96,20 @@ class Mechanism:
 
     def log_prior(self, values: Mapping[str, float]) -> float:
         return float(sum(self.priors[p.name].logpdf(values[p.name]) for p in self.parameters))
+
+    def departing_gauge(self, values: Mapping[str, float]) -> tuple[str, Parameter] | None:
+        """For a fault fitted on every gauge at once (``per_gauge``): the gauge whose parameter lies furthest
+        from its prior's centre, in the prior's sds, and that parameter (None for any other mechanism)."""
+        if not self.per_gauge:
+            return None
+        z = self.prior_z()
+
+        def away(p: Parameter) -> float:
+            centre, sd = z[p.name]
+            return abs(float(p.to_unbounded(values[p.name])) - centre) / sd
+
+        i = max(range(len(self.per_gauge)), key=lambda k: away(self.parameters[k]))
+        return self.per_gauge[i], self.parameters[i]
 
 
 MECHANISMS: dict[str, Mechanism] = {}
@@ -145,7 +176,7 @@ register(Mechanism(
 ))
 
 
-def _clearance(v: Mapping[str, float], s: dict[str, Any], g: dict[str, float], ch: str | None) -> None:
+def _clearance(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
     s["gap"] = float(v["gap"])
     s["tube_compliance"] = True
 
@@ -162,7 +193,7 @@ register(Mechanism(
 ))
 
 
-def _plug(v: Mapping[str, float], s: dict[str, Any], g: dict[str, float], ch: str | None) -> None:
+def _plug(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
     s["plug_friction_force"] = float(v["plug_force"])
     s["plug_friction_coefficient"] = float(v["plug_coefficient"])
 
@@ -180,10 +211,10 @@ register(Mechanism(
 ))
 
 
-def _gain(v: Mapping[str, float], s: dict[str, Any], g: dict[str, float], ch: str | None) -> None:
+def _gain(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
     if ch is None:
         raise ValueError("gauge_gain acts on one gauge: give its channel")
-    g[ch] = float(v["gain"])
+    g[ch].gain = float(v["gain"])
 
 
 register(Mechanism(
@@ -218,4 +249,58 @@ register(Mechanism(
     priors={"f_e": stats.halfnorm(scale=0.25)},
     start={"f_e": 0.01},
     apply=lambda v, s, g, ch: s.__setitem__("end_friction", float(v["f_e"])),
+))
+
+
+#: The gauges read against the input bar's (its reading drives the simulation), and the outputs' own
+OUTPUT_GAUGES = ("internal_output_bar", "external_output_bar", "tube_hoop")
+ALL_GAUGES = ("input_bar", *OUTPUT_GAUGES)
+
+
+def _per_gauge(field: str, name: str, gauges: tuple[str, ...]) -> Apply:
+    def apply(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
+        for gauge in gauges:
+            setattr(g[gauge], field, float(v[f"{name}_{gauge}"]))
+    return apply
+
+
+register(Mechanism(
+    name="zero_drift",
+    meaning="a gauge's zero drifting through the record: the channel reads the strain plus rate x time",
+    signature="a residual growing steadily with time on one channel, before the waves as after them",
+    parameters=tuple(Parameter(f"drift_{c}", "1/s", -math.inf, math.inf, f"zero drift of {c} (strain per second)",
+                               scale=1e-3)
+                     for c in ALL_GAUGES),
+    priors={f"drift_{c}": stats.norm(0.0, 0.01) for c in ALL_GAUGES},
+    start={f"drift_{c}": 0.0 for c in ALL_GAUGES},
+    apply=_per_gauge("drift", "drift", ALL_GAUGES),
+    per_gauge=ALL_GAUGES,
+))
+
+register(Mechanism(
+    name="channel_timing",
+    meaning="a channel read late or early against the input bar's: a gauge not where the header puts it, or "
+            "digitisers triggered apart",
+    signature="residuals shaped like the derivative of the wave at every front of one channel, opposite in sign "
+              "at its rise and its fall",
+    parameters=tuple(Parameter(f"delay_{c}", "s", -math.inf, math.inf, f"delay of {c} against the input bar",
+                               scale=1e-6)
+                     for c in OUTPUT_GAUGES),
+    priors={f"delay_{c}": stats.norm(0.0, 2e-6) for c in OUTPUT_GAUGES},
+    start={f"delay_{c}": 0.0 for c in OUTPUT_GAUGES},
+    apply=_per_gauge("delay", "delay", OUTPUT_GAUGES),
+    per_gauge=OUTPUT_GAUGES,
+))
+
+register(Mechanism(
+    name="bandwidth",
+    meaning="an amplifier too slow for the waves: a gauge's reading through a low-pass (equivalent first-order "
+            "time constant)",
+    signature="fronts of one channel late and rounded, the plateau right: residuals at every front, none between",
+    parameters=tuple(Parameter(f"time_constant_{c}", "s", 0.0, math.inf, f"low-pass time constant of {c}")
+                     for c in OUTPUT_GAUGES),
+    priors={f"time_constant_{c}": stats.halfnorm(scale=1e-6) for c in OUTPUT_GAUGES},
+    start={f"time_constant_{c}": 0.1e-6 for c in OUTPUT_GAUGES},
+    apply=_per_gauge("time_constant", "time_constant", OUTPUT_GAUGES),
+    per_gauge=OUTPUT_GAUGES,
 ))

@@ -77,7 +77,13 @@ PLAIN_NAMES = {
     "gauge_gain": "a bar gauge's calibration",
     "dispersion": "wave dispersion in the bars",
     "end_friction": "friction on the sample's end faces",
+    "zero_drift": "a gauge's zero drifting through the record",
+    "channel_timing": "a channel read late or early (a gauge's position, a trigger's skew)",
+    "bandwidth": "an amplifier too slow for the waves",
 }
+
+#: How a measurement-chain parameter is said: unit -> (factor, unit in words)
+CHAIN_UNITS = {"s": (1e6, "us"), "1/s": (1e3, "microstrain per ms")}
 
 
 def _describe(dg: Diagnosis) -> str:
@@ -101,8 +107,14 @@ def f_steps(dg: Diagnosis) -> list[tuple[Variant, float, float]]:
     return out
 
 
-def _cause_words(v: Variant) -> str:
+def _cause_words(v: Variant, dg: Diagnosis | None = None) -> str:
     where = f" on the {CHANNEL_LABELS.get(v.channel, v.channel)} gauge" if v.channel else ""
+    fit = None if dg is None else next((r.fit for rk in dg.rounds for r in rk if r.fit.variants[-1] == v), None)
+    if fit is not None and v.mechanism.per_gauge:  # a chain fault fitted on every gauge: say which, and how much
+        medians = {k: float(np.median(d)) for k, d in fit.fit.draws.items()}
+        gauge, p = v.mechanism.departing_gauge(medians)
+        factor, unit = CHAIN_UNITS.get(p.unit, (1.0, p.unit))
+        where = f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({medians[p.name] * factor:+.2g} {unit})"
     return f"{PLAIN_NAMES.get(v.mechanism.name, v.mechanism.name)}{where} ({v.mechanism.name})"
 
 
@@ -123,7 +135,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
                 f"nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
                 f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     steps = sorted(f_steps(dg), key=lambda s: -abs(s[2] - s[1]))
-    named = "; ".join(f"{_cause_words(v)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
+    named = "; ".join(f"{_cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
     if dg.channels_not_separable:
         alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
         named += f" (the same on {alt} gauge explains the record about as well)"
@@ -164,7 +176,7 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
 
 def _words_of(dg: Diagnosis, label: str) -> str:
     fit = next((r.fit for r in dg.ranking if r.fit.label == label), None)
-    return label if fit is None else _cause_words(fit.variants[-1])
+    return label if fit is None else _cause_words(fit.variants[-1], dg)
 
 
 def _where(dg: Diagnosis) -> str:

@@ -34,6 +34,10 @@ class Parameter:
         "logodds": log(value / (1 - value)) (support inside [0, 1]). A model picks the coordinates in
         which its posterior is simplest (the closed form: log f + log(nu/(1-nu)) = log kappa, eq. 17,
         a straight ridge); values mapped back beyond the support are the prior's to reject.
+    scale : float
+        For a parameter on the whole real line, the size it varies by (a channel's delay: 1e-6 s): its
+        unbounded coordinate is value / scale, so that mode searches and finite differences, which work
+        in that coordinate, step by numbers of order one whatever the unit.
     """
 
     name: str
@@ -42,6 +46,7 @@ class Parameter:
     high: float
     meaning: str
     transform: str = "auto"
+    scale: float = 1.0
 
     def __post_init__(self) -> None:
         if not self.low < self.high:
@@ -52,6 +57,8 @@ class Parameter:
             raise ValueError(f"parameter {self.name}: a log transform needs a finite lower bound")
         if self.transform == "logodds" and not (0.0 <= self.low and self.high <= 1.0):
             raise ValueError(f"parameter {self.name}: a log-odds transform needs a support inside [0, 1]")
+        if not self.scale > 0.0 or (self.scale != 1.0 and not (math.isinf(self.low) and math.isinf(self.high))):
+            raise ValueError(f"parameter {self.name}: a scale (> 0) is for a parameter on the whole real line")
 
     def contains(self, value: np.ndarray | float) -> np.ndarray:
         """True where ``value`` lies strictly inside the support."""
@@ -64,7 +71,7 @@ class Parameter:
         if self.transform == "logodds":
             return np.log(v) - np.log1p(-v)
         if math.isinf(self.high) and math.isinf(self.low):
-            return v
+            return v / self.scale
         if math.isinf(self.high) or self.transform == "log":
             return np.log(v - self.low)
         if math.isinf(self.low):
@@ -78,7 +85,7 @@ class Parameter:
         if self.transform == "logodds":
             return 1.0 / (1.0 + np.exp(-z))
         if math.isinf(self.high) and math.isinf(self.low):
-            return z
+            return z * self.scale
         if math.isinf(self.high) or self.transform == "log":
             return self.low + np.exp(z)
         if math.isinf(self.low):
@@ -91,7 +98,7 @@ class Parameter:
         if self.transform == "logodds":
             return -np.logaddexp(0.0, -z) - np.logaddexp(0.0, z)
         if math.isinf(self.high) and math.isinf(self.low):
-            return np.zeros_like(z)
+            return np.full_like(z, math.log(self.scale))
         if self.transform == "log":
             return z
         if math.isinf(self.high) or math.isinf(self.low):

@@ -9,8 +9,9 @@ and the tube hoop gauge, compression positive, on the record's time grid.
 Parameters are addressed by name. The baseline (the paper's model: Coulomb friction, elastic
 sample, rigid tube, frictionless plug, exact gauges, non-dispersive bars) has ``f``, ``nu`` and
 ``hoop_gain``. An extension adds parameters through ``extra`` and ``apply``: a function that
-turns the parameter values into simulator settings (a friction law, a gap, a plug friction, a
-gauge gain ...) — see :mod:`friction_uq.discrepancy.mechanisms`.
+turns the parameter values into simulator settings (a friction law, a gap, a plug friction) and
+into each gauge's measurement chain (:mod:`.measurement_chain`: a gain, a drift, a delay, a bandwidth)
+— see :mod:`friction_uq.discrepancy.mechanisms`.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from ..record import Apparatus
 from ..simulate.config import DEFAULT_PLUG, ChannelSpec, SimulationConfig
 from ..simulate.loading import Loading
 from ..simulate.model import run_model
+from .measurement_chain import Reading, delayed
 from .parameters import F, HOOP_GAIN, Parameter, ParameterSet
 
 #: nu as the simulator takes it: below 0.49, where the confined modulus (and with it the column's
@@ -40,8 +42,8 @@ GAUGES = ("input_bar", "internal_output_bar", "external_output_bar", "tube_hoop"
 #: prediction jump too; 3 covers nu up to about 0.48 at the nominal modulus.
 MIN_SUBSTEPS = 3
 
-#: Settings -> (config, gains) hook of an extension.
-Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, float]], None]
+#: Settings -> (config, readings) hook of an extension.
+Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, Reading]], None]
 
 
 @dataclass(frozen=True)
@@ -78,9 +80,10 @@ class SimulatorModel:
     extra : sequence of Parameter
         Parameters of an extension, after f, nu, hoop_gain.
     apply : callable
-        ``apply(values, settings, gains)`` edits the simulator settings (a dict of
-        :class:`~friction_uq.simulate.config.SimulationConfig` fields) and the per-channel gauge
-        gains for the values of the extension's parameters.
+        ``apply(values, settings, readings)`` edits the simulator settings (a dict of
+        :class:`~friction_uq.simulate.config.SimulationConfig` fields) and each gauge's measurement
+        chain (channel -> :class:`~.measurement_chain.Reading`) for the values of the extension's
+        parameters.
     """
 
     name = "simulator"
@@ -102,27 +105,25 @@ class SimulatorModel:
             min_substeps=MIN_SUBSTEPS,
         )
 
-    def config(self, values: Mapping[str, float]) -> tuple[SimulationConfig, dict[str, float]]:
-        """Simulator configuration and gauge gains for one set of parameter values."""
+    def config(self, values: Mapping[str, float]) -> tuple[SimulationConfig, dict[str, Reading]]:
+        """Simulator configuration and each gauge's measurement chain for one set of parameter values."""
         settings: dict[str, Any] = dict(self._base)
         settings["poisson_ratio"] = float(values["nu"])
         settings["friction_law"] = "coulomb"
         settings["friction_params"] = MappingProxyType({"f": float(values["f"])})
-        gains = {name: 1.0 for name in GAUGES}
-        gains["tube_hoop"] = float(values.get("hoop_gain", 1.0))
+        readings = {name: Reading() for name in GAUGES}
+        readings["tube_hoop"].gain = float(values.get("hoop_gain", 1.0))
         if self._apply is not None:
-            self._apply(values, settings, gains)
-        return SimulationConfig(**settings), gains
+            self._apply(values, settings, readings)
+        return SimulationConfig(**settings), readings
 
     def predict(self, values: Mapping[str, float]) -> Prediction:
         """Gauge strains over the whole record for one set of parameter values."""
-        cfg, gains = self.config(values)
+        cfg, readings = self.config(values)
         loading = self.dispersive_loading if cfg.dispersion and self.dispersive_loading is not None else self.loading
-        g_in = gains["input_bar"]
-        if g_in != 1.0:  # the measured incident wave is g_in times the true one
-            loading = Loading(loading.time, loading.at_gauge / g_in, loading.at_cell / g_in, loading.source)
-        out = run_model(cfg, loading=loading)
-        strains = {k: gains[k] * v for k, v in out.strains.items()}
+        out = run_model(cfg, loading=true_incident(loading, readings["input_bar"]))
+        t = loading.time
+        strains = {k: v if readings[k].exact else readings[k].applied(t, v) for k, v in out.strains.items()}
         return Prediction(strains, out.force_internal, out.force_external, out.force_input, out.sliding_velocity)
 
     def predict_draws(self, draws: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -134,3 +135,18 @@ class SimulatorModel:
             for ch, s in pred.strains.items():
                 rows.setdefault(ch, []).append(s)
         return {ch: np.array(v) for ch, v in rows.items()}
+
+
+def true_incident(loading: Loading, reading: Reading) -> Loading:
+    """The incident wave the input bar carried, from the wave its gauge read through ``reading``: the
+    measured wave is ``gain`` times the true one, ``delay`` late. The chain's drift over the incident
+    pulse (a few microstrain at most) and its bandwidth (which the cell's response then shares: a
+    low-pass commutes with the bars' linear response) are left in the wave."""
+    if reading.gain == 1.0 and reading.delay == 0.0:
+        return loading
+    t = loading.time
+
+    def back(x: np.ndarray) -> np.ndarray:
+        return delayed(t, x, -reading.delay) / reading.gain
+
+    return Loading(t, back(loading.at_gauge), back(loading.at_cell), loading.source)

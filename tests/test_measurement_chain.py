@@ -1,0 +1,200 @@
+"""A gauge's measurement chain (gain, drift, timing, bandwidth): the pure functions against closed forms and
+properties, the simulator's readings, and the catalogue's chain faults recovered from a record whose fault
+was made by other code than the model's (an interpolated shift, a Butterworth filter)."""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from types import MappingProxyType
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from scipy import signal
+
+from friction_uq.models.measurement_chain import Reading, delayed, low_passed, zero_drift
+from friction_uq.models.parameters import Parameter
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "benchmarks"))
+
+DT = 2e-7
+T = np.arange(2000) * DT
+
+
+def _pulse(t: np.ndarray, t0: float = 1e-4, rise: float = 10e-6, width: float = 150e-6) -> np.ndarray:
+    """A trapezoid: rise, plateau, fall (strain)."""
+    return 5e-4 * np.clip(np.minimum((t - t0) / rise, (t0 + width - t) / rise), 0.0, 1.0)
+
+
+finite = st.floats(-1e-3, 1e-3, allow_nan=False)
+
+
+@given(st.lists(finite, min_size=3, max_size=60))
+def test_neutral_chain_reads_the_strain_itself(x):
+    x = np.array(x)
+    t = np.arange(len(x)) * DT
+    np.testing.assert_array_equal(Reading().applied(t, x), x)
+    np.testing.assert_array_equal(delayed(t, x, 0.0), x)
+    np.testing.assert_array_equal(low_passed(t, x, 0.0), x)
+
+
+@given(st.integers(0, 50), st.lists(finite, min_size=60, max_size=120))
+def test_a_delay_of_whole_samples_shifts_the_samples(k, x):
+    x = np.array(x)
+    t = np.arange(len(x)) * DT
+    y = delayed(t, x, k * DT)
+    np.testing.assert_allclose(y[k:], x[:len(x) - k], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(y[:k], x[0])  # before the record: its first value held
+
+
+@given(st.floats(1e-8, 1e-5), st.floats(-1e-3, 1e-3))
+def test_the_low_pass_keeps_a_constant_and_answers_a_step_as_1_minus_exp(tau, level):
+    const = np.full(200, level)
+    np.testing.assert_allclose(low_passed(T[:200], const, tau), const, rtol=1e-12, atol=1e-18)
+    step = np.r_[np.zeros(10), np.ones(190)]
+    y = low_passed(T[:200], step, tau)
+    n = np.arange(190)  # the exact discretisation of y' = (x - y) / tau for x held over each sample
+    np.testing.assert_allclose(y[10:], 1.0 - np.exp(-(n + 1) * DT / tau), rtol=1e-10, atol=1e-14)
+
+
+def test_the_low_pass_and_its_minus_3_db_frequency():
+    """A sine at 1 / (2 pi tau) comes out at 1/sqrt(2) of its amplitude (first order), once settled."""
+    tau = 1e-6
+    t = np.arange(200_000) * 2e-8
+    x = np.sin(t / tau)
+    y = low_passed(t, x, tau)[100_000:]
+    assert np.max(np.abs(y)) == pytest.approx(1.0 / math.sqrt(2.0), rel=2e-3)
+
+
+def test_a_drift_is_a_straight_line_from_the_first_sample():
+    d = zero_drift(T + 3e-4, 0.01)
+    assert d[0] == 0.0 and d[-1] == pytest.approx(0.01 * (T[-1] - T[0]))
+    assert np.allclose(np.diff(d, 2), 0.0, atol=1e-18)
+
+
+def test_the_chain_in_hardware_order():
+    x = _pulse(T)
+    r = Reading(gain=1.1, drift=0.02, delay=1.3e-6, time_constant=0.4e-6)
+    want = 1.1 * delayed(T, low_passed(T, x, 0.4e-6), 1.3e-6) + 0.02 * (T - T[0])
+    np.testing.assert_allclose(r.applied(T, x), want, rtol=1e-12)
+    assert not r.exact and Reading().exact
+
+
+def test_a_parameter_on_the_real_line_steps_in_its_own_scale():
+    p = Parameter("delay", "s", -math.inf, math.inf, "a delay", scale=1e-6)
+    assert p.to_unbounded(2e-6) == pytest.approx(2.0)
+    assert p.from_unbounded(-0.5) == pytest.approx(-0.5e-6)
+    assert p.log_jacobian(0.3) == pytest.approx(math.log(1e-6))
+    with pytest.raises(ValueError, match="whole real line"):
+        Parameter("gap", "m", 0.0, 1.0, "a gap", scale=1e-6)
+
+
+def test_the_simulator_reads_the_input_bar_through_its_chain(chain_records):
+    """A delay on the input bar's reading: the measured incident wave stays where it was read (it drives the
+    simulation from where it truly was), the other gauges move against it."""
+    from friction_uq.analysis import prepare
+    from friction_uq.models import SimulatorModel, measured_loading
+    from friction_uq.record import read_record
+
+    rec = read_record(chain_records["clean"])
+    loading = measured_loading(rec, prepare(rec).forces)
+    delay = 2e-6
+
+    def late(values, settings, readings):
+        readings["input_bar"].delay = delay
+
+    base = SimulatorModel(rec.apparatus, loading).predict({"f": 0.05, "nu": 0.4})
+    moved = SimulatorModel(rec.apparatus, loading, apply=late).predict({"f": 0.05, "nu": 0.4})
+    t = loading.time
+    peak = np.max(np.abs(base.strains["input_bar"]))
+    assert np.max(np.abs(moved.strains["input_bar"] - base.strains["input_bar"])) < 0.02 * peak
+    early = delayed(t, base.strains["external_output_bar"], -delay)
+    assert np.max(np.abs(moved.strains["external_output_bar"] - early)) < 0.02 * np.max(early)
+    assert np.max(np.abs(base.strains["external_output_bar"] - early)) > 0.1 * np.max(early)  # it did move
+
+
+@pytest.fixture(scope="module")
+def chain_records(tmp_path_factory):
+    """One clean simulated record and the same record with its external output gauge read 4 us late and,
+    separately, through a 2nd-order Butterworth low-pass at 60 kHz."""
+    from bench_trust import write_strains
+    from simulated import noisy_config
+
+    from friction_uq.simulate import simulate
+
+    cfg = noisy_config(striker_velocity=10.0, friction_params=MappingProxyType({"f": 0.05}))
+    sim = simulate(cfg, seed=7)
+    t, ch = sim.time, "external_output_bar"
+    made = {"clean": dict(sim.noisy), "late": dict(sim.noisy), "slow": dict(sim.noisy)}
+    made["late"][ch] = np.interp(t - 4e-6, t, sim.noisy[ch])
+    made["slow"][ch] = signal.sosfilt(signal.butter(2, 60e3, fs=1.0 / (t[1] - t[0]), output="sos"), sim.noisy[ch])
+    folder = tmp_path_factory.mktemp("chain")
+    out = {}
+    for name, noisy in made.items():
+        path = str(folder / f"{name}.h5")
+        write_strains(cfg, path, sim, noisy, campaign="X")
+        out[name] = path
+    return out
+
+
+def _fits(path, names):
+    from friction_uq.analysis import prepare
+    from friction_uq.discrepancy.elpd import elpd_difference
+    from friction_uq.discrepancy.extended import Diagnoser, Variant
+    from friction_uq.discrepancy.mechanisms import MECHANISMS
+    from friction_uq.priors import default_prior_path, load_priors
+    from friction_uq.record import read_record
+
+    priors = load_priors(default_prior_path("I1"))
+
+    def log_prior(v):
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    dg = Diagnoser(prepare(read_record(path)), log_prior, hoop=True, seed=5, n_draws=60)
+    start = {"f": 0.05, "nu": 0.4}
+    base = dg.fit((), start, "reference")
+    out = {}
+    for name in names:
+        mf = dg.fit((Variant(MECHANISMS[name]),), start, name)
+        out[name] = (mf, *elpd_difference(mf.elpd, base.elpd))
+    return out
+
+
+def test_a_late_channel_is_measured_where_the_fault_was_made_by_other_code(chain_records):
+    fits = _fits(chain_records["late"], ("channel_timing",))
+    mf, delpd, se = fits["channel_timing"]
+    d = mf.fit.draws["delay_external_output_bar"]
+    lo, hi = np.quantile(d, [0.005, 0.995])
+    assert lo <= 4e-6 <= hi and lo > 0.0, (lo, hi)  # the truth inside, no delay outside
+    for other in ("delay_internal_output_bar", "delay_tube_hoop"):  # the gauges that read right stay near 0
+        assert abs(np.median(mf.fit.draws[other])) < 0.5e-6
+    assert delpd > 4.0, (delpd, se)  # evidence at the fronts only: whether it names the cause is the verdict's
+    assert np.quantile(mf.fit.draws["f"], 0.05) <= 0.05 <= np.quantile(mf.fit.draws["f"], 0.95)
+
+
+def test_a_slow_amplifier_is_seen_on_its_channel_and_a_clean_record_gains_nothing(chain_records):
+    mf, delpd, se = _fits(chain_records["slow"], ("bandwidth",))["bandwidth"]
+    tc = {c: float(np.median(mf.fit.draws[f"time_constant_{c}"]))
+          for c in ("internal_output_bar", "external_output_bar", "tube_hoop")}
+    # a 2nd-order Butterworth at 60 kHz delays a front like a first-order chain of about 1/(2 pi 60 kHz) ... 2x that
+    assert 1e-6 < tc["external_output_bar"] < 6e-6 and max(tc["internal_output_bar"], tc["tube_hoop"]) < 0.5e-6, tc
+    assert delpd > 4.0, (delpd, se)
+    for name, (_, d, s) in _fits(chain_records["clean"], ("bandwidth", "channel_timing", "zero_drift")).items():
+        assert d < 4.0, (name, d, s)  # nothing to gain on a clean record
+
+
+def test_a_chain_fault_fitted_on_every_gauge_says_which_gauge():
+    from friction_uq.discrepancy.mechanisms import MECHANISMS
+
+    m = MECHANISMS["channel_timing"]
+    gauge, p = m.departing_gauge({"delay_internal_output_bar": 0.1e-6, "delay_external_output_bar": -3e-6,
+                                  "delay_tube_hoop": 0.5e-6})
+    assert gauge == "external_output_bar" and p.name == "delay_external_output_bar"
+    gauge, _ = MECHANISMS["bandwidth"].departing_gauge({"time_constant_internal_output_bar": 0.2e-6,
+                                                        "time_constant_external_output_bar": 0.3e-6,
+                                                        "time_constant_tube_hoop": 2.5e-6})
+    assert gauge == "tube_hoop"
+    assert MECHANISMS["clearance"].departing_gauge({"gap": 1e-6}) is None
