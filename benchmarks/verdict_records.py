@@ -16,7 +16,9 @@ Groups (f, nu, striker speed, rise time and noise drawn as in ``bench_misfit.py`
   simulation with shapes the catalogue's models do not share: ``channel_timing`` (one output gauge read
   3-5 us late or early), ``bandwidth`` (one output gauge through a second-order Butterworth low-pass at
   50-80 kHz, not the model's first-order one) and ``zero_drift`` (one gauge's zero creeping 10-25
-  microstrain over the record along an exponential, not the model's straight line).
+  microstrain over the record along an exponential, not the model's straight line), ``bar_modulus`` (one
+  output bar's modulus 5-8 % off the header the record carries, its wave speed with it: the test simulated
+  with the true bar, the record written with the header's).
 
 For each record: ``diagnose``'s first round (the baseline against every extended model), written as one
 ``.npz`` per record: each model's pointwise block ELPD and calibration terms, its draws of f_effective, the
@@ -81,33 +83,43 @@ def _perturbation(c, r: np.random.Generator) -> tuple[object, str | None, str]:
 OUTPUT_GAUGES = ("internal_output_bar", "external_output_bar", "tube_hoop")
 
 
-def _timing(r: np.random.Generator):
+def _timing(c, r: np.random.Generator):
     ch = str(r.choice(OUTPUT_GAUGES))
     dt = float(r.uniform(3e-6, 5e-6) * r.choice([-1, 1]))
-    return _shifted(ch, dt), f"{ch} timing {dt * 1e6:+.2f} us"
+    return c, _shifted(ch, dt), f"{ch} timing {dt * 1e6:+.2f} us"
 
 
-def _bandwidth(r: np.random.Generator):
+def _bandwidth(c, r: np.random.Generator):
     ch = str(r.choice(OUTPUT_GAUGES))
     fc = float(r.uniform(50e3, 80e3))
 
     def edit(t, noisy):
         noisy[ch] = signal.sosfilt(signal.butter(2, fc, fs=1.0 / (t[1] - t[0]), output="sos"), noisy[ch])
-    return edit, f"{ch} through a 2nd-order low-pass at {fc / 1e3:.0f} kHz"
+    return c, edit, f"{ch} through a 2nd-order low-pass at {fc / 1e3:.0f} kHz"
 
 
-def _drift(r: np.random.Generator):
+def _drift(c, r: np.random.Generator):
     ch = str(r.choice(("input_bar", *OUTPUT_GAUGES)))
     amp = float(r.uniform(10e-6, 25e-6) * r.choice([-1, 1]))
 
     def edit(t, noisy):
         u = (t - t[0]) / (t[-1] - t[0])
         noisy[ch] = noisy[ch] + amp * (1.0 - np.exp(-2.0 * u)) / (1.0 - np.exp(-2.0))
-    return edit, f"{ch} zero creeps {amp * 1e6:+.0f} ue"
+    return c, edit, f"{ch} zero creeps {amp * 1e6:+.0f} ue"
 
 
-#: Measurement-chain faults made on the recorded strains: group (the mechanism's name) -> maker of (edit, note)
-CHAIN_FAULTS = {"channel_timing": _timing, "bandwidth": _bandwidth, "zero_drift": _drift}
+def _bar_modulus(c, r: np.random.Generator):
+    name = str(r.choice(["internal_output_bar", "external_output_bar"]))
+    k = float(r.uniform(1.05, 1.08) ** r.choice([-1, 1]))
+    bar = getattr(c.apparatus, name)
+    true = dataclasses.replace(bar, young_modulus=bar.young_modulus * k, wave_speed=bar.wave_speed * k ** 0.5)
+    return (dataclasses.replace(c, apparatus=dataclasses.replace(c.apparatus, **{name: true})), None,
+            f"{name} modulus x{k:.3f} of its header's")
+
+
+#: Measurement-chain faults: group (the mechanism's name) -> maker of (the configuration simulated, an edit of the
+#: recorded strains or None, a note); the record carries the clean configuration's header
+CHAIN_FAULTS = {"channel_timing": _timing, "bandwidth": _bandwidth, "zero_drift": _drift, "bar_modulus": _bar_modulus}
 
 
 def _shifted(ch: str, dt: float):
@@ -123,9 +135,9 @@ def groups() -> list[str]:
 
 def make(group: str, k: int, r: np.random.Generator):
     """The configuration of record ``k`` of ``group``, an edit of its recorded strains (``edit(time, noisy)``,
-    or None) and a note."""
+    or None), a note and the apparatus its header carries (None: the configuration's)."""
     cfg = clean_config(r, "A" if k % 2 == 0 else "B")
-    edit, note = None, ""
+    edit, note, header = None, "", None
     if group == "clean_axisymmetric":
         cfg, note = _axisymmetric(cfg), "axisymmetric"
     elif group == "clean_perturbed":
@@ -133,21 +145,24 @@ def make(group: str, k: int, r: np.random.Generator):
         if ch is not None:
             edit = _shifted(ch, float(note.split("timing ")[1].split(" us")[0]) * 1e-6)
     elif group in CHAIN_FAULTS:
-        edit, note = CHAIN_FAULTS[group](r)
+        header = cfg.apparatus
+        cfg, edit, note = CHAIN_FAULTS[group](cfg, r)
     else:
         mech = group.removeprefix("axisymmetric_")
         cfg = HIDDEN[mech](cfg, r)
         note = mech
         if group.startswith("axisymmetric_"):
             cfg, note = _axisymmetric(cfg), f"axisymmetric {mech}"
-    return cfg, edit, note
+    return cfg, edit, note, header
 
 
-def write(cfg, path: str, seed: int, edit) -> object:
+def write(cfg, path: str, seed: int, edit, header=None) -> object:
     sim = simulate(cfg, seed=seed)
     noisy = dict(sim.noisy)
     if edit is not None:
         edit(sim.time, noisy)
+    if header is not None:
+        cfg = dataclasses.replace(cfg, apparatus=header)
     write_strains(cfg, path, sim, noisy, campaign="V")
     return sim
 
@@ -190,7 +205,7 @@ def main() -> None:
     tmp = tempfile.mkdtemp()
     jobs = [(g, k) for g in groups() for k in range(a.clean if g.startswith("clean") else a.per)]
     for g, k in jobs:
-        cfg, edit, note = make(g, k, rng)
+        cfg, edit, note, header = make(g, k, rng)
         sim_seed = int(rng.integers(2**31))
         name = f"{g}-{k}"
         if (only is not None and g not in only) or os.path.exists(os.path.join(a.out, f"{name}.npz")):
@@ -198,7 +213,7 @@ def main() -> None:
         path = os.path.join(tmp, f"{name}.h5")
         t = time.perf_counter()
         try:
-            write(cfg, path, sim_seed, edit)
+            write(cfg, path, sim_seed, edit, header)
             prep, dg = analyse(path, priors, seed=k, max_causes=1)
         except FrictionUQError as exc:
             print(f"{name}: refused: {exc}", flush=True)

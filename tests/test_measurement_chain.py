@@ -5,6 +5,7 @@ was made by other code than the model's (an interpolated shift, a Butterworth fi
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 import os
 import sys
 from types import MappingProxyType
@@ -137,6 +138,13 @@ def chain_records(tmp_path_factory):
         path = str(folder / f"{name}.h5")
         write_strains(cfg, path, sim, noisy, campaign="X")
         out[name] = path
+    # the external output bar 6 % stiffer than the header the record carries (its wave speed 3 % faster)
+    bar = cfg.apparatus.external_output_bar
+    stiff = replace(cfg, apparatus=replace(cfg.apparatus, external_output_bar=replace(
+        bar, young_modulus=1.06 * bar.young_modulus, wave_speed=math.sqrt(1.06) * bar.wave_speed)))
+    sim = simulate(stiff, seed=7)
+    out["stiff"] = str(folder / "stiff.h5")
+    write_strains(cfg, out["stiff"], sim, dict(sim.noisy), campaign="X")
     return out
 
 
@@ -182,7 +190,8 @@ def test_a_slow_amplifier_is_seen_on_its_channel_and_a_clean_record_gains_nothin
     # a 2nd-order Butterworth at 60 kHz delays a front like a first-order chain of about 1/(2 pi 60 kHz) ... 2x that
     assert 1e-6 < tc["external_output_bar"] < 6e-6 and max(tc["internal_output_bar"], tc["tube_hoop"]) < 0.5e-6, tc
     assert delpd > 4.0, (delpd, se)
-    for name, (_, d, s) in _fits(chain_records["clean"], ("bandwidth", "channel_timing", "zero_drift")).items():
+    clean = _fits(chain_records["clean"], ("bandwidth", "channel_timing", "zero_drift", "bar_modulus"))
+    for name, (_, d, s) in clean.items():
         assert d < 4.0, (name, d, s)  # nothing to gain on a clean record
 
 
@@ -198,3 +207,13 @@ def test_a_chain_fault_fitted_on_every_gauge_says_which_gauge():
                                                         "time_constant_tube_hoop": 2.5e-6})
     assert gauge == "tube_hoop"
     assert MECHANISMS["clearance"].departing_gauge({"gap": 1e-6}) is None
+
+
+def test_an_output_bar_stiffer_than_its_header_is_measured(chain_records):
+    mf, delpd, se = _fits(chain_records["stiff"], ("bar_modulus",))["bar_modulus"]
+    k = mf.fit.draws["modulus_factor_external_output_bar"]
+    lo, hi = np.quantile(k, [0.005, 0.995])
+    assert lo <= 1.06 <= hi and lo > 1.0, (lo, hi)
+    assert abs(np.median(mf.fit.draws["modulus_factor_internal_output_bar"]) - 1.0) < 0.01
+    assert delpd > 4.0, (delpd, se)
+    assert np.quantile(mf.fit.draws["f"], 0.05) <= 0.05 <= np.quantile(mf.fit.draws["f"], 0.95)

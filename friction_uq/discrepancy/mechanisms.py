@@ -40,13 +40,17 @@ parameter per gauge, the gauges that read right keep theirs near the neutral val
 * ``bandwidth``: an equivalent first-order time constant per output gauge ~ half-normal(1 us): a bridge
   amplifier of 100 kHz (older SHPB chains) has 1.6 us, one of 1 MHz 0.16 us. The input bar is left
   out: its reading drives the simulation, and a low-pass commutes with the bars' linear response.
+* ``bar_modulus``: each output bar's modulus over its header's ~ lognormal(0, 3 %), its density kept (the
+  wave speed moves by half as much): a supplier's modulus is good to 2-3 %, a wave speed timed on the
+  bar to 1 %. The bar's force per microstrain and the wave's travel to its gauge both change. The input
+  bar is left out: its measured wave drives the simulation, transported to the cell once.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any
 
@@ -303,4 +307,31 @@ register(Mechanism(
     start={f"time_constant_{c}": 0.1e-6 for c in OUTPUT_GAUGES},
     apply=_per_gauge("time_constant", "time_constant", OUTPUT_GAUGES),
     per_gauge=OUTPUT_GAUGES,
+))
+
+
+def _bar_modulus(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
+    app = s["apparatus"]
+    for name in OUTPUT_BARS:
+        k = float(v[f"modulus_factor_{name}"])
+        bar = getattr(app, name)
+        app = replace(app, **{name: replace(bar, young_modulus=bar.young_modulus * k,
+                                            wave_speed=bar.wave_speed * math.sqrt(k))})
+    s["apparatus"] = app
+
+
+OUTPUT_BARS = ("internal_output_bar", "external_output_bar")
+
+register(Mechanism(
+    name="bar_modulus",
+    meaning="an output bar's modulus (and with it its wave speed) not the header's: its force per microstrain "
+            "and the wave's travel time to its gauge both off",
+    signature="one output channel scaled by a constant factor and its fronts early or late by a fraction of a "
+              "microsecond per per cent",
+    parameters=tuple(Parameter(f"modulus_factor_{b}", "-", 0.0, math.inf, f"Young's modulus of the {b} over the "
+                               "header's") for b in OUTPUT_BARS),
+    priors={f"modulus_factor_{b}": _lognormal(1.0, 0.03) for b in OUTPUT_BARS},
+    start={f"modulus_factor_{b}": 1.0 for b in OUTPUT_BARS},
+    apply=_bar_modulus,
+    per_gauge=OUTPUT_BARS,
 ))

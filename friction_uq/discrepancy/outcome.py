@@ -80,10 +80,11 @@ PLAIN_NAMES = {
     "zero_drift": "a gauge's zero drifting through the record",
     "channel_timing": "a channel read late or early (a gauge's position, a trigger's skew)",
     "bandwidth": "an amplifier too slow for the waves",
+    "bar_modulus": "an output bar's modulus off its header",
 }
 
 #: How a measurement-chain parameter is said: unit -> (factor, unit in words)
-CHAIN_UNITS = {"s": (1e6, "us"), "1/s": (1e3, "microstrain per ms")}
+CHAIN_UNITS = {"s": (1e6, "us"), "1/s": (1e3, "microstrain per ms"), "-": (1.0, "times the header's")}
 
 
 def _describe(dg: Diagnosis) -> str:
@@ -114,7 +115,9 @@ def _cause_words(v: Variant, dg: Diagnosis | None = None) -> str:
         medians = {k: float(np.median(d)) for k, d in fit.fit.draws.items()}
         gauge, p = v.mechanism.departing_gauge(medians)
         factor, unit = CHAIN_UNITS.get(p.unit, (1.0, p.unit))
-        where = f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({medians[p.name] * factor:+.2g} {unit})"
+        x = medians[p.name] * factor
+        where = f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({x:.3g} {unit})" if p.unit == "-" else \
+            f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({x:+.2g} {unit})"
     return f"{PLAIN_NAMES.get(v.mechanism.name, v.mechanism.name)}{where} ({v.mechanism.name})"
 
 
