@@ -13,8 +13,9 @@ Groups (f, nu, striker speed, rise time and noise drawn as in ``bench_misfit.py`
   ``axisymmetric_<mechanism>`` for those the axisymmetric simulation also has (plug friction, clearance, the
   friction laws);
 * one group per measurement-chain fault (:data:`CHAIN_FAULTS`), made on the recorded strains of the 1-D
-  simulation with shapes the catalogue's models do not share: ``channel_timing`` (one output gauge read
-  3-5 us late or early), ``bandwidth`` (one output gauge through a second-order Butterworth low-pass at
+  simulation: ``channel_timing`` (one output gauge read 3-5 us late or early: a pure delay, made by the
+  same linear interpolation as the model's), and, with shapes the catalogue's models do not share,
+  ``bandwidth`` (one output gauge through a second-order Butterworth low-pass at
   50-80 kHz, not the model's first-order one) and ``zero_drift`` (one gauge's zero creeping 10-25
   microstrain over the record along an exponential, not the model's straight line), ``bar_modulus`` (one
   output bar's modulus 5-8 % off the header the record carries, its wave speed with it: the test simulated

@@ -1,6 +1,7 @@
 """A gauge's measurement chain (gain, drift, timing, bandwidth): the pure functions against closed forms and
-properties, the simulator's readings, and the catalogue's chain faults recovered from a record whose fault
-was made by other code than the model's (an interpolated shift, a Butterworth filter)."""
+properties, the simulator's readings, and the catalogue's chain faults recovered from simulated records (a
+channel shifted, a channel through a Butterworth filter the model's first-order low-pass does not share, an
+output bar stiffer than its header)."""
 
 from __future__ import annotations
 
@@ -52,13 +53,26 @@ def test_a_delay_of_whole_samples_shifts_the_samples(k, x):
 
 
 @given(st.floats(1e-8, 1e-5), st.floats(-1e-3, 1e-3))
-def test_the_low_pass_keeps_a_constant_and_answers_a_step_as_1_minus_exp(tau, level):
+def test_the_low_pass_keeps_a_constant_and_answers_a_ramped_step_exactly(tau, level):
     const = np.full(200, level)
     np.testing.assert_allclose(low_passed(T[:200], const, tau), const, rtol=1e-12, atol=1e-18)
+    # a step from 0 to 1 between samples 9 and 10, linear in between: y' = (x - y) / tau solved by hand
     step = np.r_[np.zeros(10), np.ones(190)]
     y = low_passed(T[:200], step, tau)
-    n = np.arange(190)  # the exact discretisation of y' = (x - y) / tau for x held over each sample
-    np.testing.assert_allclose(y[10:], 1.0 - np.exp(-(n + 1) * DT / tau), rtol=1e-10, atol=1e-14)
+    a, r = math.exp(-DT / tau), tau / DT
+    n = np.arange(190)
+    np.testing.assert_allclose(y[10:], 1.0 - r * (1.0 - a) * a ** n, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(y[:10], 0.0, atol=1e-18)
+
+
+def test_the_low_pass_and_the_delay_tend_to_the_strain_and_do_not_lead():
+    x = _pulse(T)
+    assert np.max(np.abs(low_passed(T, x, 1e-12) - x)) < 1e-6 * np.max(x)
+    assert np.max(np.abs(delayed(T, x, 1e-12) - x)) < 1e-6 * np.max(x)
+    # through a slow low-pass a long ramp lags by tau exactly (no half-sample lead): x - tau x'
+    ramp = T.copy()
+    tau = 1e-6
+    np.testing.assert_allclose(low_passed(T, ramp, tau)[200:], ramp[200:] - tau, rtol=0, atol=1e-12)
 
 
 def test_the_low_pass_and_its_minus_3_db_frequency():
@@ -76,12 +90,25 @@ def test_a_drift_is_a_straight_line_from_the_first_sample():
     assert np.allclose(np.diff(d, 2), 0.0, atol=1e-18)
 
 
-def test_the_chain_in_hardware_order():
+def test_the_chain_adds_its_drift_after_the_gain():
+    """Gain, low-pass and delay are linear and commute; the drift is the amplifier's zero, not scaled by the
+    bridge's gain."""
+    zero = np.zeros_like(T)
+    np.testing.assert_allclose(Reading(gain=2.0, drift=0.02).applied(T, zero), 0.02 * (T - T[0]), rtol=1e-12)
+    r = Reading(gain=1.1, delay=1.3e-6, time_constant=0.4e-6)
     x = _pulse(T)
-    r = Reading(gain=1.1, drift=0.02, delay=1.3e-6, time_constant=0.4e-6)
-    want = 1.1 * delayed(T, low_passed(T, x, 0.4e-6), 1.3e-6) + 0.02 * (T - T[0])
-    np.testing.assert_allclose(r.applied(T, x), want, rtol=1e-12)
+    np.testing.assert_allclose(r.applied(T, x), 1.1 * low_passed(T, delayed(T, x, 1.3e-6), 0.4e-6),
+                               rtol=1e-9, atol=1e-15)
     assert not r.exact and Reading().exact
+
+
+@given(st.floats(-50.0, 50.0), st.floats(1e-9, 1e3))
+def test_a_scaled_parameter_round_trips_with_its_jacobian(z, scale):
+    p = Parameter("x", "-", -math.inf, math.inf, "x", scale=scale)
+    assert float(p.to_unbounded(p.from_unbounded(z))) == pytest.approx(z, rel=1e-12, abs=1e-12)
+    h = 1e-6
+    slope = (float(p.from_unbounded(z + h)) - float(p.from_unbounded(z - h))) / (2 * h)
+    assert float(p.log_jacobian(z)) == pytest.approx(math.log(slope), rel=1e-6, abs=1e-6)
 
 
 def test_a_parameter_on_the_real_line_steps_in_its_own_scale():
@@ -202,10 +229,14 @@ def test_a_chain_fault_fitted_on_every_gauge_says_which_gauge():
     gauge, p = m.departing_gauge({"delay_internal_output_bar": 0.1e-6, "delay_external_output_bar": -3e-6,
                                   "delay_tube_hoop": 0.5e-6})
     assert gauge == "external_output_bar" and p.name == "delay_external_output_bar"
-    gauge, _ = MECHANISMS["bandwidth"].departing_gauge({"time_constant_internal_output_bar": 0.2e-6,
-                                                        "time_constant_external_output_bar": 0.3e-6,
-                                                        "time_constant_tube_hoop": 2.5e-6})
-    assert gauge == "tube_hoop"
+    for right in (1e-9, 0.1e-6, 0.3e-6):  # gauges that read right, at any time constant near 0
+        gauge, _ = MECHANISMS["bandwidth"].departing_gauge({"time_constant_internal_output_bar": right,
+                                                            "time_constant_external_output_bar": right,
+                                                            "time_constant_tube_hoop": 2.5e-6})
+        assert gauge == "tube_hoop", right
+    gauge, _ = MECHANISMS["bar_modulus"].departing_gauge({"modulus_factor_internal_output_bar": 0.999,
+                                                          "modulus_factor_external_output_bar": 0.95})
+    assert gauge == "external_output_bar"
     assert MECHANISMS["clearance"].departing_gauge({"gap": 1e-6}) is None
 
 

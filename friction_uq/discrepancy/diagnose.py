@@ -182,7 +182,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     say = progress or (lambda msg: None)
     dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales,
                    nominal=start)
-    say(f"baseline (up to {max_causes} rounds of about ten extended models follow)")
+    say(f"baseline (up to {max_causes} rounds of up to {len(candidates())} extended models follow)")
     base = dg.fit((), start, "baseline")
     st = _search(dg, prep, _Search(base, base), max_causes=max_causes, workers=workers, seed=seed, say=say, t0=t0)
     final, causes, rounds, verdicts = st.reference, st.causes, st.rounds, st.verdicts

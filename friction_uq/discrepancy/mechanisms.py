@@ -39,7 +39,8 @@ parameter per gauge, the gauges that read right keep theirs near the neutral val
   triggered apart by a few samples as much (a delay common to every channel changes nothing).
 * ``bandwidth``: an equivalent first-order time constant per output gauge ~ half-normal(1 us): a bridge
   amplifier of 100 kHz (older SHPB chains) has 1.6 us, one of 1 MHz 0.16 us. The input bar is left
-  out: its reading drives the simulation, and a low-pass commutes with the bars' linear response.
+  out: its reading, low-pass and all, drives the simulation, so the output gauges' time constants are
+  read against the input bar's (exactly so where the cell responds linearly to the wave's shape).
 * ``bar_modulus``: each output bar's modulus over its header's ~ lognormal(0, 3 %), its density kept (the
   wave speed moves by half as much): a supplier's modulus is good to 2-3 %, a wave speed timed on the
   bar to 1 %. The bar's force per microstrain and the wave's travel to its gauge both change. The input
@@ -92,6 +93,7 @@ class Mechanism:
     channels: tuple[str, ...] = ()  # gauge_gain: the gauges it may act on (one fit each)
     group: str | None = None  # mechanisms of one group replace the same thing (the friction law): one at a time
     per_gauge: tuple[str, ...] = ()  # a measurement-chain fault fitted on every gauge at once: parameter i is gauge i's
+    neutral: float = 0.0  # per_gauge: the parameter's value where its gauge reads right
 
     def prior_z(self) -> dict[str, tuple[float, float]]:
         """Gaussian stand-ins of the priors in each parameter's unbounded coordinate (centre, sd), from the
@@ -103,14 +105,13 @@ class Mechanism:
 
     def departing_gauge(self, values: Mapping[str, float]) -> tuple[str, Parameter] | None:
         """For a fault fitted on every gauge at once (``per_gauge``): the gauge whose parameter lies furthest
-        from its prior's centre, in the prior's sds, and that parameter (None for any other mechanism)."""
+        from the neutral value (``neutral``: the gauge reads right), in its prior's sds, and that parameter
+        (None for any other mechanism)."""
         if not self.per_gauge:
             return None
-        z = self.prior_z()
 
         def away(p: Parameter) -> float:
-            centre, sd = z[p.name]
-            return abs(float(p.to_unbounded(values[p.name])) - centre) / sd
+            return abs(float(values[p.name]) - self.neutral) / float(self.priors[p.name].std())
 
         i = max(range(len(self.per_gauge)), key=lambda k: away(self.parameters[k]))
         return self.per_gauge[i], self.parameters[i]
@@ -273,7 +274,7 @@ register(Mechanism(
     meaning="a gauge's zero drifting through the record: the channel reads the strain plus rate x time",
     signature="a residual growing steadily with time on one channel, before the waves as after them",
     parameters=tuple(Parameter(f"drift_{c}", "1/s", -math.inf, math.inf, f"zero drift of {c} (strain per second)",
-                               scale=1e-3)
+                               scale=1e-2)
                      for c in ALL_GAUGES),
     priors={f"drift_{c}": stats.norm(0.0, 0.01) for c in ALL_GAUGES},
     start={f"drift_{c}": 0.0 for c in ALL_GAUGES},
@@ -334,4 +335,5 @@ register(Mechanism(
     start={f"modulus_factor_{b}": 1.0 for b in OUTPUT_BARS},
     apply=_bar_modulus,
     per_gauge=OUTPUT_BARS,
+    neutral=1.0,
 ))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..models.parameters import effective_sample_size, summarize_draws
+from ..models.parameters import Parameter, effective_sample_size, summarize_draws
 from ..stats import khat_threshold
 from ..stats.streams import stream
 from .diagnose import Diagnosis, ModelFit, Ranked
@@ -108,16 +108,28 @@ def f_steps(dg: Diagnosis) -> list[tuple[Variant, float, float]]:
     return out
 
 
+def _chain_gauge(v: Variant, dg: Diagnosis | None) -> tuple[str, Parameter, float] | None:
+    """For a measurement-chain fault fitted on every gauge (``per_gauge``): the gauge it names, the parameter and
+    its posterior median, from the final model's draws when it holds the fault (else the round's fit)."""
+    if dg is None or not v.mechanism.per_gauge:
+        return None
+    fit = dg.final if v in dg.final.variants else next(
+        (r.fit for rk in dg.rounds for r in rk if r.fit.variants[-1] == v), None)
+    if fit is None:
+        return None
+    medians = {k: float(np.median(d)) for k, d in fit.fit.draws.items()}
+    gauge, p = v.mechanism.departing_gauge(medians)
+    return gauge, p, medians[p.name]
+
+
 def _cause_words(v: Variant, dg: Diagnosis | None = None) -> str:
     where = f" on the {CHANNEL_LABELS.get(v.channel, v.channel)} gauge" if v.channel else ""
-    fit = None if dg is None else next((r.fit for rk in dg.rounds for r in rk if r.fit.variants[-1] == v), None)
-    if fit is not None and v.mechanism.per_gauge:  # a chain fault fitted on every gauge: say which, and how much
-        medians = {k: float(np.median(d)) for k, d in fit.fit.draws.items()}
-        gauge, p = v.mechanism.departing_gauge(medians)
+    chain = _chain_gauge(v, dg)
+    if chain is not None:  # say which gauge, and how much
+        gauge, p, value = chain
         factor, unit = CHAIN_UNITS.get(p.unit, (1.0, p.unit))
-        x = medians[p.name] * factor
-        where = f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({x:.3g} {unit})" if p.unit == "-" else \
-            f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({x:+.2g} {unit})"
+        x = f"{value * factor:.3g}" if p.unit == "-" else f"{value * factor:+.2g}"
+        where = f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({x} {unit})"
     return f"{PLAIN_NAMES.get(v.mechanism.name, v.mechanism.name)}{where} ({v.mechanism.name})"
 
 
@@ -231,6 +243,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
                                                       "f": summarize_draws(dg.mixture_f)},
         "cause": cause.mechanism.name if cause else None,
         "cause_channel": cause.channel if cause else None,
+        # a measurement-chain fault fitted on every gauge: the gauge whose parameter departs most from reading right
+        "cause_gauge": (_chain_gauge(cause, dg) or (None,))[0] if cause else None,
         "cause_channel_not_separable": list(dg.channels_not_separable),
         "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.causes],
         "not_separable": list(dg.not_separable),

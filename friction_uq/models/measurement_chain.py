@@ -7,7 +7,8 @@ Each is a small pure function on the record's uniform time grid; :class:`Reading
 order of the hardware (gauge -> bridge -> amplifier -> digitiser). Strain in, strain out, compression
 positive; times in s. With every parameter at its neutral value (gain 1, drift 0, delay 0, time
 constant 0) the reading is the strain itself, and each function is continuous in its parameter
-through that value, so that a fit can start from the exact chain and move away from it smoothly.
+through that value (the delay piecewise linear between whole samples), so that a fit can start from
+the exact chain and move away from it.
 """
 
 from __future__ import annotations
@@ -29,16 +30,22 @@ def delayed(time: np.ndarray, strain: np.ndarray, delay: float) -> np.ndarray:
 
 def low_passed(time: np.ndarray, strain: np.ndarray, time_constant: float) -> np.ndarray:
     """The strain through a first-order low-pass of time constant ``time_constant`` (s; the -3 dB frequency
-    is 1 / (2 pi time_constant)): y' = (x - y) / time_constant, discretised exactly for a signal held over
-    each sample, started at rest on the first sample (a record starts before the waves). A time constant
-    of 0 passes the strain unchanged. An amplifier of higher order with the same -3 dB frequency delays a
-    front by about as much; the fitted time constant is that of the equivalent first-order chain."""
+    is 1 / (2 pi time_constant)): y' = (x - y) / time_constant, solved exactly for the strain interpolated
+    linearly between samples (as :func:`delayed` reads it, so that neither leads the other by half a sample),
+    started at rest on the first sample (a record starts before the waves). A time constant of 0 passes the
+    strain unchanged, and the output tends to it as the time constant does. An amplifier of higher order with
+    the same -3 dB frequency delays a front by about as much; the fitted time constant is that of the
+    equivalent first-order chain.
+
+    With a = exp(-dt / tau) and r = tau / dt: y[n] = a y[n-1] + (1 - r (1 - a)) x[n] + (r (1 - a) - a) x[n-1]
+    (the particular solution x - tau x' of a linear input, plus the decay of the rest)."""
     x = np.asarray(strain, float)
     if time_constant <= 0.0:
         return x
     dt = float(time[1] - time[0])
     a = float(np.exp(-dt / time_constant))
-    b, den = [1.0 - a], [1.0, -a]
+    c = (time_constant / dt) * (1.0 - a)
+    b, den = [1.0 - c, c - a], [1.0, -a]
     zi = signal.lfilter_zi(b, den) * x[0]
     return signal.lfilter(b, den, x, zi=zi)[0]
 

@@ -140,8 +140,9 @@ class SimulatorModel:
 def true_incident(loading: Loading, reading: Reading) -> Loading:
     """The incident wave the input bar carried, from the wave its gauge read through ``reading``: the
     measured wave is ``gain`` times the true one, ``delay`` late. The chain's drift over the incident
-    pulse (a few microstrain at most) and its bandwidth (which the cell's response then shares: a
-    low-pass commutes with the bars' linear response) are left in the wave."""
+    pulse (a few microstrain at most) and its bandwidth are left in the wave: the simulation is driven by
+    the wave as the input gauge's amplifier passed it, and the other gauges' bandwidths are read against
+    it (exactly so where the cell responds linearly to the wave's shape)."""
     if reading.gain == 1.0 and reading.delay == 0.0:
         return loading
     t = loading.time
