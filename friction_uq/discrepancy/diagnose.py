@@ -56,6 +56,16 @@ SEPARATE_BY = {
         "a test at another striker speed (the load and the slip grow together through one test)",
     frozenset({"clearance", "end_friction"}):
         "the hoop gauge's start (a clearance delays it) or a test with another sample length",
+    frozenset({"channel_timing", "bandwidth"}):
+        "the amplifier's response to a sharp step (a calibration pulse through the channel) and the digitisers' "
+        "trigger times",
+    frozenset({"gauge_gain", "bar_modulus"}):
+        "the bar's wave speed timed on the bar itself (a striker on the bar alone), and a shunt calibration of the "
+        "gauge",
+    frozenset({"channel_timing", "bar_modulus"}):
+        "the bar's wave speed timed on the bar itself and the gauge's distance measured again",
+    frozenset({"bandwidth", "dispersion"}):
+        "the amplifier's response to a sharp step (dispersion is the bar's, the same on every amplifier)",
 }
 DEFAULT_SEPARATION = "another test of the campaign (another striker speed or another internal output bar)"
 
