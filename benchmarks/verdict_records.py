@@ -19,7 +19,8 @@ Groups (f, nu, striker speed, rise time and noise drawn as in ``bench_misfit.py`
   50-80 kHz, not the model's first-order one) and ``zero_drift`` (one gauge's zero creeping 10-25
   microstrain over the record along an exponential, not the model's straight line), ``bar_modulus`` (one
   output bar's modulus 5-8 % off the header the record carries, its wave speed with it: the test simulated
-  with the true bar, the record written with the header's).
+  with the true bar, the record written with the header's); and the same four on records of the axisymmetric
+  simulation (``axisymmetric_<fault>``).
 
 For each record: ``diagnose``'s first round (the baseline against every extended model), written as one
 ``.npz`` per record: each model's pointwise block ELPD and calibration terms, its draws of f_effective, the
@@ -131,7 +132,8 @@ def _shifted(ch: str, dt: float):
 
 def groups() -> list[str]:
     return (["clean_axisymmetric", "clean_perturbed"] + list(HIDDEN)
-            + [f"axisymmetric_{m}" for m in AXISYMMETRIC_MECHANISMS] + list(CHAIN_FAULTS))
+            + [f"axisymmetric_{m}" for m in AXISYMMETRIC_MECHANISMS] + list(CHAIN_FAULTS)
+            + [f"axisymmetric_{m}" for m in CHAIN_FAULTS])
 
 
 def make(group: str, k: int, r: np.random.Generator):
@@ -145,9 +147,11 @@ def make(group: str, k: int, r: np.random.Generator):
         cfg, ch, note = _perturbation(cfg, r)
         if ch is not None:
             edit = _shifted(ch, float(note.split("timing ")[1].split(" us")[0]) * 1e-6)
-    elif group in CHAIN_FAULTS:
+    elif group.removeprefix("axisymmetric_") in CHAIN_FAULTS:
         header = cfg.apparatus
-        cfg, edit, note = CHAIN_FAULTS[group](cfg, r)
+        cfg, edit, note = CHAIN_FAULTS[group.removeprefix("axisymmetric_")](cfg, r)
+        if group.startswith("axisymmetric_"):
+            cfg, note = _axisymmetric(cfg), f"axisymmetric, {note}"
     else:
         mech = group.removeprefix("axisymmetric_")
         cfg = HIDDEN[mech](cfg, r)

@@ -43,6 +43,12 @@ def mixture_label(dg: Diagnosis) -> str:
     return "mixture of " + ", ".join(parts)
 
 
+def unresolved(dg: Diagnosis) -> bool:
+    """A first round of candidates whose rivals no later round named: the causes fitted are not named, and f is
+    the mixture of the candidates (``Diagnosis.mixture_f``)."""
+    return bool(dg.causes) and dg.mixture_f is not None
+
+
 def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
     """The headline f of a diagnosed record: the final model's label and its f when a cause was named; the
     stacking mixture's when the record named candidates or an unexplained misfit (:mod:`.verdict`); None when
@@ -162,9 +168,17 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         fx = summarize_draws(dg.mixture_f)
         quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
     first = dg.ranking[0]
-    return (f"Causes found, the one that moves f most first: {named}. f = {fx['q50']:.3f} [{fx['q05']:.3f}, "
+    # candidates the record does not tell apart (a rival never named in a later round): the one fitted first is
+    # no more the cause than its rivals, and f is their mixture
+    lead = ("Candidates, not a cause: this record does not tell apart " + ", ".join(dg.not_separable or
+            [v.mechanism.name for v in dg.causes]) + f"; fitted in turn: {named}." if unresolved(dg) else
+            f"Causes found, the one that moves f most first: {named}.")
+    if unresolved(dg):
+        sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
+    return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, "
             f"{fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from the stationary analysis "
-            f"without them. Why: {_describe(dg)}; the first cause's evidence is {first.delpd:.0f} +- {first.se:.0f} "
+            f"without them. Why: {_describe(dg)}; the {'strongest candidate' if unresolved(dg) else 'first cause'}'s "
+            f"evidence is {first.delpd:.0f} +- {first.se:.0f} "
             f"nats.{sep}{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
 
 
@@ -235,8 +249,10 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
     hoop = dg.final.hoop_gain
     v = dg.verdict
     return {
-        # the record's: named when causes were (a first round's candidates resolved later, or not: then `mixture`)
-        "verdict": "named" if dg.causes else (v.kind if v is not None else None),
+        # the record's: named when causes were (a first round's candidates resolved by later rounds); candidates
+        # whose rivals stay unresolved: "candidates" (the causes fitted in turn are in `causes`, f is `mixture`'s)
+        "verdict": (("candidates" if unresolved(dg) else "named") if dg.causes
+                    else (v.kind if v is not None else None)),
         "round_verdicts": [r.kind for r in dg.verdicts],
         "stacking_weights": dict(v.weights) if v is not None else {},
         "mixture": None if dg.mixture_f is None else {"weights": dict(dg.mixture_weights),
