@@ -98,5 +98,9 @@ def test_candidates_a_record_does_not_tell_apart_are_said_as_candidates_not_caus
     assert doc["verdict"] == "candidates" and doc["mixture"] is not None
     assert doc["sentence"].startswith("Candidates, not a cause: this record does not tell apart ")
     assert "Causes found" not in doc["sentence"]
+    from friction_uq.report.quote import quote_line
+
+    line = quote_line({"q05": 0.106, "q50": 0.114, "q95": 0.122}, dg)
+    assert "candidates diagnose could not tell apart" in line and "causes diagnose named" not in line, line
     truth = verdict_records.true_f(cfg, prep)
     assert doc["mixture"]["f"]["q05"] <= truth <= doc["mixture"]["f"]["q95"], (truth, doc["mixture"]["f"])

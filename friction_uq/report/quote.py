@@ -18,6 +18,8 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, 
     named = None if diagnosis is None else headline(diagnosis)
     if named is not None:
         label, fx = named
+        if diagnosis.mixture_f is not None:  # unexplained, or candidates the record does not tell apart
+            return f"the {label}, candidates diagnose could not tell apart", fx
         return f"the model with the causes diagnose named ({label})", fx
     return "the stationary analysis (eq. 17 and the hoop gauge)", f_stationary
 

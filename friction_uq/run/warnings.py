@@ -67,23 +67,18 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
         return "`friction-uq diagnose` names the cause and gives f under it."
     from ..discrepancy.outcome import headline
 
-    if not diagnosis.causes and diagnosis.mixture_f is not None:
+    if diagnosis.mixture_f is not None:  # unexplained, or candidates (fitted in turn or not) the record leaves open
         fm = headline(diagnosis)[1]
         q05, q50, q95 = fm["q05"], fm["q50"], fm["q95"]
-        what = "no single cause explains it" if diagnosis.verdict.kind == "unexplained" else \
-            "the record does not tell its candidate causes apart"
+        what = "no single cause explains it" if not diagnosis.causes and diagnosis.verdict.kind == "unexplained" \
+            else "the record does not tell its candidate causes apart" + (
+                f" ({', '.join(diagnosis.not_separable)})" if diagnosis.not_separable else "")
         return (f"`diagnose`: {what}; f from their stacking mixture is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the "
                 "JSON's f), wide enough for whichever is right: quote that, with this warning.")
     if not diagnosis.causes:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
     fx = diagnosis.final.f_summary()
     names = ", ".join(v.label for v in diagnosis.causes)
-    if diagnosis.mixture_f is not None:  # the first cause not told from an alternative: f from both
-        fm = headline(diagnosis)[1]
-        q05, q50, q95 = fm["q05"], fm["q50"], fm["q95"]
-        return (f"`diagnose` names {names}, the first not told apart from {', '.join(diagnosis.not_separable[1:])}: "
-                f"f from the mixture of the two is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the JSON's f), which is the f "
-                "to quote.")
     return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "
             "(the JSON's f), which is the f to quote.")
 
