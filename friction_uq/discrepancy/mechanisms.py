@@ -262,53 +262,43 @@ OUTPUT_GAUGES = ("internal_output_bar", "external_output_bar", "tube_hoop")
 ALL_GAUGES = ("input_bar", *OUTPUT_GAUGES)
 
 
-def _per_gauge(field: str, name: str, gauges: tuple[str, ...]) -> Apply:
+def _chain_fault(name: str, field: str, gauges: tuple[str, ...], *, unit: str, low: float, prior: Any, start: float,
+                 what: str, meaning: str, signature: str, scale: float = 1.0) -> Mechanism:
+    """A measurement-chain fault fitted on every gauge of ``gauges`` at once: one parameter ``<field>_<gauge>`` per
+    gauge (the :class:`~friction_uq.models.measurement_chain.Reading` field it sets; ``what``: its meaning, with
+    ``{gauge}`` for the gauge), the same prior and start for each."""
     def apply(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
         for gauge in gauges:
-            setattr(g[gauge], field, float(v[f"{name}_{gauge}"]))
-    return apply
+            setattr(g[gauge], field, float(v[f"{field}_{gauge}"]))
+
+    return Mechanism(
+        name=name, meaning=meaning, signature=signature,
+        parameters=tuple(Parameter(f"{field}_{c}", unit, low, math.inf, what.format(gauge=c), scale=scale)
+                         for c in gauges),
+        priors={f"{field}_{c}": prior for c in gauges}, start={f"{field}_{c}": start for c in gauges},
+        apply=apply, per_gauge=gauges)
 
 
-register(Mechanism(
-    name="zero_drift",
+register(_chain_fault(
+    "zero_drift", "drift", ALL_GAUGES, unit="1/s", low=-math.inf, prior=stats.norm(0.0, 0.01), start=0.0,
+    scale=1e-2, what="zero drift of {gauge} (strain per second)",
     meaning="a gauge's zero drifting through the record: the channel reads the strain plus rate x time",
-    signature="a residual growing steadily with time on one channel, before the waves as after them",
-    parameters=tuple(Parameter(f"drift_{c}", "1/s", -math.inf, math.inf, f"zero drift of {c} (strain per second)",
-                               scale=1e-2)
-                     for c in ALL_GAUGES),
-    priors={f"drift_{c}": stats.norm(0.0, 0.01) for c in ALL_GAUGES},
-    start={f"drift_{c}": 0.0 for c in ALL_GAUGES},
-    apply=_per_gauge("drift", "drift", ALL_GAUGES),
-    per_gauge=ALL_GAUGES,
-))
+    signature="a residual growing steadily with time on one channel, before the waves as after them"))
 
-register(Mechanism(
-    name="channel_timing",
+register(_chain_fault(
+    "channel_timing", "delay", OUTPUT_GAUGES, unit="s", low=-math.inf, prior=stats.norm(0.0, 2e-6), start=0.0,
+    scale=1e-6, what="delay of {gauge} against the input bar",
     meaning="a channel read late or early against the input bar's: a gauge not where the header puts it, or "
             "digitisers triggered apart",
     signature="residuals shaped like the derivative of the wave at every front of one channel, opposite in sign "
-              "at its rise and its fall",
-    parameters=tuple(Parameter(f"delay_{c}", "s", -math.inf, math.inf, f"delay of {c} against the input bar",
-                               scale=1e-6)
-                     for c in OUTPUT_GAUGES),
-    priors={f"delay_{c}": stats.norm(0.0, 2e-6) for c in OUTPUT_GAUGES},
-    start={f"delay_{c}": 0.0 for c in OUTPUT_GAUGES},
-    apply=_per_gauge("delay", "delay", OUTPUT_GAUGES),
-    per_gauge=OUTPUT_GAUGES,
-))
+              "at its rise and its fall"))
 
-register(Mechanism(
-    name="bandwidth",
+register(_chain_fault(
+    "bandwidth", "time_constant", OUTPUT_GAUGES, unit="s", low=0.0, prior=stats.halfnorm(scale=1e-6), start=0.1e-6,
+    what="low-pass time constant of {gauge}",
     meaning="an amplifier too slow for the waves: a gauge's reading through a low-pass (equivalent first-order "
             "time constant)",
-    signature="fronts of one channel late and rounded, the plateau right: residuals at every front, none between",
-    parameters=tuple(Parameter(f"time_constant_{c}", "s", 0.0, math.inf, f"low-pass time constant of {c}")
-                     for c in OUTPUT_GAUGES),
-    priors={f"time_constant_{c}": stats.halfnorm(scale=1e-6) for c in OUTPUT_GAUGES},
-    start={f"time_constant_{c}": 0.1e-6 for c in OUTPUT_GAUGES},
-    apply=_per_gauge("time_constant", "time_constant", OUTPUT_GAUGES),
-    per_gauge=OUTPUT_GAUGES,
-))
+    signature="fronts of one channel late and rounded, the plateau right: residuals at every front, none between"))
 
 
 def _bar_modulus(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:

@@ -160,26 +160,25 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     if dg.channels_not_separable:
         alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
         named += f" (the same on {alt} gauge explains the record about as well)"
-    sep = ""
-    if dg.not_separable:
-        sep = (f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would.")
-    quote = "with them (the f to quote)"
-    if dg.mixture_f is not None:  # a first cause the record does not tell from an alternative: f from both
-        fx = summarize_draws(dg.mixture_f)
-        quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
     first = dg.ranking[0]
-    # candidates the record does not tell apart (a rival never named in a later round): the one fitted first is
-    # no more the cause than its rivals, and f is their mixture
-    lead = ("Candidates, not a cause: this record does not tell apart " + ", ".join(dg.not_separable or
-            [v.mechanism.name for v in dg.causes]) + f"; fitted in turn: {named}." if unresolved(dg) else
-            f"Causes found, the one that moves f most first: {named}.")
-    if unresolved(dg):
+    if unresolved(dg):  # candidates no later round told apart: the one fitted first is no more the cause than its
+        # rivals, and f is their mixture
+        fx = summarize_draws(dg.mixture_f)
+        lead = ("Candidates, not a cause: this record does not tell apart "
+                f"{', '.join(dg.not_separable or [v.mechanism.name for v in dg.causes])}; fitted in turn: {named}.")
+        quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
+        evidence = "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
-    return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, "
-            f"{fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from the stationary analysis "
-            f"without them. Why: {_describe(dg)}; the {'strongest candidate' if unresolved(dg) else 'first cause'}'s "
-            f"evidence is {first.delpd:.0f} +- {first.se:.0f} "
-            f"nats.{sep}{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
+    else:
+        lead = f"Causes found, the one that moves f most first: {named}."
+        quote = "with them (the f to quote)"
+        evidence = "first cause"
+        sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
+            if dg.not_separable else ""
+    return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from "
+            f"the stationary analysis without them. Why: {_describe(dg)}; the {evidence}'s evidence is "
+            f"{first.delpd:.0f} +- {first.se:.0f} nats.{sep}"
+            f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
 
 
 def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
