@@ -158,3 +158,52 @@ def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int) 
     finally:
         _MAPPED = None
 
+
+
+_POOLED: Callable[[Any], Any] | None = None
+
+
+def _pooled(x: Any) -> Any:
+    return _POOLED(x)
+
+
+class ForkedPool:
+    """``fn`` on ``workers`` forked processes for many calls of :meth:`map` (a sampler's steps), forked once
+    on entering the ``with`` block; in turn, in this process, where :func:`can_fork` says no or one worker
+    is asked for. ``fn`` reaches the workers by the fork (it need not pickle: a closure over a likelihood);
+    each call's items and values are pickled. ``fn`` must be pure, so that the values do not depend on
+    ``workers``. One pool at a time per process."""
+
+    def __init__(self, fn: Callable[[Any], Any], *, workers: int) -> None:
+        self._fn = fn
+        self._workers = workers
+        self._pool: Any = None
+
+    @property
+    def forked(self) -> bool:
+        return self._pool is not None
+
+    def map(self, items: Sequence[Any]) -> list[Any]:
+        """``[fn(x) for x in items]``, in order, split over the workers."""
+        items = list(items)
+        if self._pool is None or len(items) <= 1:
+            return [self._fn(x) for x in items]
+        chunk = max(1, len(items) // (4 * self._workers))
+        return self._pool.map(_pooled, items, chunksize=chunk)
+
+    def __enter__(self) -> ForkedPool:
+        global _POOLED
+        if self._workers > 1 and can_fork():
+            if _POOLED is not None:
+                raise RuntimeError("one ForkedPool at a time per process")
+            _POOLED = self._fn
+            self._pool = multiprocessing.get_context("fork").Pool(self._workers, initializer=end_with_parent)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        global _POOLED
+        if self._pool is not None:
+            self._pool.terminate()
+            self._pool.join()
+            self._pool = None
+            _POOLED = None

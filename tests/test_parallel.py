@@ -174,3 +174,31 @@ def _campaign_tests():
                                    {"mean": V, "sd": 1e-3, "q05": V, "q50": V, "q95": V},
                                    str(PRIORS_DIR / "I1.toml")))
     return out
+
+
+def test_a_forked_pool_gives_the_values_in_order_and_in_line_where_it_may_not_fork(monkeypatch):
+    offset = MappingProxyType({"c": 2.5})  # does not pickle: the workers inherit the function by the fork
+    fn = lambda x: float(np.sum(x ** 2)) + offset["c"]  # noqa: E731 - a closure, as a likelihood's is
+    rows = np.random.default_rng(3).normal(size=(37, 3))
+    expected = [fn(r) for r in rows]
+    may_fork = can_fork()
+    with _parallel.ForkedPool(fn, workers=2) as pool:
+        assert pool.forked is may_fork
+        assert pool.map(rows) == expected
+        assert pool.map(rows[:5]) == expected[:5]  # many calls on one pool
+    assert _parallel._POOLED is None and can_fork() is may_fork  # its threads are gone: later work may fork
+    monkeypatch.setattr(_parallel, "can_fork", lambda: False)
+    with _parallel.ForkedPool(fn, workers=2) as pool:
+        assert not pool.forked and pool.map(rows) == expected
+
+
+def test_an_exception_in_a_pool_worker_reaches_the_caller_and_the_pool_is_released():
+    def fn(x):
+        if x == 3:
+            raise ValueError("a column too stiff to integrate")
+        return x
+
+    with pytest.raises(ValueError, match="too stiff"):
+        with _parallel.ForkedPool(fn, workers=2) as pool:
+            pool.map(range(8))
+    assert _parallel._POOLED is None

@@ -68,7 +68,7 @@ def test_same_seed_same_bits():
 
 
 def test_stacking_weights_go_to_the_model_that_predicts_better_and_are_shared_by_equals():
-    from friction_uq.stats import WeightRule, stacking_weights
+    from friction_uq.stats import stacking_weights
 
     rng = np.random.default_rng(0)
     a = rng.normal(-1.0, 0.3, 12)
@@ -93,3 +93,19 @@ def test_bootstrapped_stacking_shares_the_weight_of_a_near_tie_and_keeps_a_clear
     assert tie == stacking_weights({"a": base + d, "b": base}, seed=1)  # same seed, same weights
     far = stacking_weights({"a": base + 2.0, "b": base}, seed=1)  # 20 nats ahead on every point
     assert far["a"] > 0.99 and WeightRule().supported(far) == ["a"]
+
+
+@pytest.mark.parametrize("wrong", [False, True])
+def test_a_pool_sharing_the_evaluations_gives_the_same_bits(wrong):
+    """The importance stage and emcee's (a proposal far off: ``wrong``) with the density's values from a pool
+    of forked processes: the draws are the ones computed in turn."""
+    from friction_uq._parallel import ForkedPool
+
+    mode, cov = (MU + np.array([1.2, 1.8]), S / 100) if wrong else (MU, S)
+    kw = dict(rng=np.random.default_rng(11), n_out=500, emcee_steps=40, emcee_burn=10)
+    alone = exact_draws(NORMAL.logpdf, mode, cov, cov, **kw)
+    with ForkedPool(NORMAL.logpdf, workers=2) as pool:
+        kw["rng"] = np.random.default_rng(11)
+        shared = exact_draws(NORMAL.logpdf, mode, cov, cov, map_rows=pool.map, **kw)
+    assert shared.method == alone.method and (alone.method == "emcee") is wrong
+    assert np.array_equal(shared.z_adjusted, alone.z_adjusted)

@@ -183,8 +183,9 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring).
 
     ``base_scales``: Gaussian stand-ins (centre, sd in the unbounded coordinate) of the f and nu
-    priors for the mode search. ``workers``: processes fitting a round's extended models (None: the
-    machine's cores, at most :data:`MAX_WORKERS`); the result does not depend on it.
+    priors for the mode search. ``workers``: processes fitting a round's extended models and sharing the
+    exact posterior's evaluations (None: the machine's cores, at most :data:`MAX_WORKERS`); the result does
+    not depend on it.
     """
     t0 = time.perf_counter()
     if workers is None:
@@ -208,7 +209,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else mixture(st.base, rounds[0], verdicts[0], seed)
     if causes:
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
-        final, ex = dg.exact_posterior(final)
+        final, ex = dg.exact_posterior(final, workers=workers)
         k, ess, method = ex.pareto_k, ex.ess, ex.method
         mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed)
     return Diagnosis(baseline=st.base, rounds=tuple(rounds), misfits=tuple(st.misfits), causes=tuple(causes),

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from .._parallel import can_fork, forked_map
+from .._parallel import ForkedPool, can_fork, forked_map
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
@@ -171,7 +171,8 @@ class Diagnoser:
 
         return log_prior
 
-    def exact_posterior(self, mf: ModelFit, *, n: int = IMPORTANCE_DRAWS) -> tuple[ModelFit, ExactDraws]:
+    def exact_posterior(self, mf: ModelFit, *, n: int = IMPORTANCE_DRAWS,
+                        workers: int = 1) -> tuple[ModelFit, ExactDraws]:
         """The model with its exact posterior, robust to a model that still misses (:mod:`friction_uq.stats.exact`).
 
         The fit's normal approximation (robust covariance) is weighted by the exact posterior density (the
@@ -179,6 +180,7 @@ class Diagnoser:
         was from it; beyond the limit a second proposal or emcee samples it. The exact draws are then
         given the robust covariance by the open-faced sandwich adjustment, which keeps their shape. The
         returned model's draws and f_effective are these; its mode, ELPD and predictions are unchanged.
+        ``workers``: processes sharing the density's evaluations (forked once; the draws do not depend on it).
         """
         fit = mf.fit
         params = [mf.lik.model.parameters[name] for name in fit.names]
@@ -198,7 +200,9 @@ class Diagnoser:
                 return -np.inf
 
         rng = stream(self.seed, "exact posterior", mf.label)
-        ex = exact_draws(log_post, mode, cov, robust, rng=rng, n_importance=n, n_out=EXACT_DRAWS)
+        with ForkedPool(log_post, workers=workers) as pool:
+            ex = exact_draws(log_post, mode, cov, robust, rng=rng, n_importance=n, n_out=EXACT_DRAWS,
+                             map_rows=pool.map)
         draws = {p.name: np.asarray(p.from_unbounded(ex.z_adjusted[:, i]), float) for i, p in enumerate(params)}
         f_eff = np.array([self._f_effective(mf.variants, {k: float(v[s]) for k, v in draws.items()})
                           for s in range(EXACT_DRAWS)])

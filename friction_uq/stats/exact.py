@@ -53,9 +53,9 @@ def sandwich_map(mode: np.ndarray, cov_laplace: np.ndarray, cov_robust: np.ndarr
     return sym_cholesky(cov_robust) @ np.linalg.inv(sym_cholesky(cov_laplace))
 
 
-def _weighted(log_post: Callable[[np.ndarray], float], dist, n: int, rng: np.random.Generator):
+def _weighted(log_post_rows: Callable[[np.ndarray], np.ndarray], dist, n: int, rng: np.random.Generator):
     z = np.atleast_2d(dist.rvs(size=n, random_state=rng)).reshape(n, -1)
-    res = importance_weights(np.array([log_post(zi) for zi in z]), dist.logpdf(z))
+    res = importance_weights(np.asarray(log_post_rows(z), float), dist.logpdf(z))
     return z, res.log_weights, float(res.pareto_k), float(res.ess)
 
 
@@ -64,7 +64,7 @@ def _resample(z: np.ndarray, log_w: np.ndarray, n: int, rng: np.random.Generator
     return z[rng.choice(len(z), size=n, p=w / w.sum())]
 
 
-def _emcee(log_post: Callable[[np.ndarray], float], z: np.ndarray, log_w: np.ndarray, n: int,
+def _emcee(log_post_rows: Callable[[np.ndarray], np.ndarray], z: np.ndarray, log_w: np.ndarray, n: int,
            rng: np.random.Generator, *, steps: int, burn: int) -> np.ndarray:
     import emcee
 
@@ -73,7 +73,7 @@ def _emcee(log_post: Callable[[np.ndarray], float], z: np.ndarray, log_w: np.nda
     start = z[np.argsort(log_w)[::-1][:nwalkers]]
     start = start + 1e-4 * rng.standard_normal(start.shape)  # distinct walkers even where draws repeat
     rs = legacy_state(rng)  # emcee's own stream, seeded from ours
-    sampler = emcee.EnsembleSampler(nwalkers, ndim, log_post)
+    sampler = emcee.EnsembleSampler(nwalkers, ndim, log_post_rows, vectorize=True)
     sampler.run_mcmc(emcee.State(start, random_state=rs.get_state()), steps, progress=False)
     chain = sampler.get_chain(discard=burn, flat=True)
     return chain[rng.choice(len(chain), size=n, replace=len(chain) < n)]
@@ -81,14 +81,22 @@ def _emcee(log_post: Callable[[np.ndarray], float], z: np.ndarray, log_w: np.nda
 
 def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_laplace: np.ndarray,
                 cov_robust: np.ndarray, *, rng: np.random.Generator, n_importance: int = 200, n_out: int = 1000,
-                emcee_steps: int = 150, emcee_burn: int = 50) -> ExactDraws:
+                emcee_steps: int = 150, emcee_burn: int = 50,
+                map_rows: Callable[[np.ndarray], list[float]] | None = None
+                ) -> ExactDraws:
     """Exact posterior draws behind a Laplace approximation, and their sandwich-adjusted copy (module docstring).
 
     ``log_post(z)``: the exact log posterior density in the unbounded coordinates (Jacobians included), up to
-    a constant; -inf outside the support.
+    a constant; -inf outside the support. ``map_rows(z)``: ``log_post``'s values for the rows of ``z``, in
+    order (default: one after the other; a pool of processes may share them out: the draws are the same bits).
     """
     mode = np.asarray(mode, float)
-    z, lw, k1, ess = _weighted(log_post, stats.multivariate_normal(mode, cov_robust, allow_singular=True),
+    mapped = map_rows or (lambda rows: [log_post(r) for r in rows])
+
+    def log_post_rows(z: np.ndarray) -> np.ndarray:
+        return np.asarray(mapped(np.atleast_2d(z)), float)
+
+    z, lw, k1, ess = _weighted(log_post_rows, stats.multivariate_normal(mode, cov_robust, allow_singular=True),
                                n_importance, rng)
     calls, method, k_used = n_importance, "importance", k1
     k_max = khat_threshold(n_importance)
@@ -97,14 +105,14 @@ def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_l
         w /= w.sum()
         mean = w @ z
         cov = np.atleast_2d(np.cov(z, rowvar=False, aweights=w)) * 1.5 + 1e-12 * np.eye(len(mode))
-        z2, lw2, k2, ess2 = _weighted(log_post, stats.multivariate_t(mean, cov, df=5, allow_singular=True),
+        z2, lw2, k2, ess2 = _weighted(log_post_rows, stats.multivariate_t(mean, cov, df=5, allow_singular=True),
                                       n_importance, rng)
         calls += n_importance
         if k2 <= k_max:
             z, lw, k_used, ess, method = z2, lw2, k2, ess2, "importance (second proposal)"
         else:
             zz, ll = np.concatenate([z, z2]), np.concatenate([lw, lw2])
-            out = _emcee(log_post, zz, ll, n_out, rng, steps=emcee_steps, burn=emcee_burn)
+            out = _emcee(log_post_rows, zz, ll, n_out, rng, steps=emcee_steps, burn=emcee_burn)
             calls += max(16, 4 * len(mode)) * emcee_steps
             omega = sandwich_map(mode, cov_laplace, cov_robust)
             return ExactDraws(out, mode + (out - mode) @ omega.T, "emcee", k1, math.nan, float(len(out)), calls)
