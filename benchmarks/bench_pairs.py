@@ -1,0 +1,138 @@
+"""Two hidden effects at once: does ``diagnose`` name both, and does f's interval hold the truth?
+
+Records (f, nu, striker speed, rise time and noise drawn as in ``bench_misfit.py``, both bundled set-ups):
+eight pairs of effects on the 1-D simulation and eight on the axisymmetric one (:data:`PAIRS_1D`,
+:data:`PAIRS_AXISYMMETRIC`), each effect at the strength of its single-effect study group
+(``bench_diagnose.HIDDEN`` for the mechanisms of the cell, ``verdict_records.CHAIN_FAULTS`` for the faults
+of the measurement chain). Each record goes through ``diagnose`` with all its rounds (up to
+``MAX_CAUSES``), as ``friction-uq diagnose`` does.
+
+Per record it prints the pair, each round's verdict, the causes named, the quoted f (the headline's: the
+named model's, or the stacking mixture's; the baseline's when nothing needed explaining) against the truth
+(the wall's coefficient at the window's mean sliding speed, pressure and slip), and the time. The table:
+per simulator, how often both effects were named, one, a wrong cause named, a record ended as candidates or
+unexplained, and f covered by its 90 % interval.
+
+    python benchmarks/bench_pairs.py [--seed 29] [--only 1d,axisymmetric] [--first 0] [--count 8]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+from collections import Counter
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_diagnose import HIDDEN, analyse, true_f  # noqa: E402
+from bench_misfit import clean_config  # noqa: E402
+from verdict_records import CHAIN_FAULTS, _axisymmetric, write  # noqa: E402
+
+from friction_uq.discrepancy.diagnose import MAX_CAUSES  # noqa: E402
+from friction_uq.discrepancy.outcome import headline  # noqa: E402
+from friction_uq.errors import FrictionUQError  # noqa: E402
+from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+
+#: Pairs on the 1-D simulation: the issue's two (a clearance with a velocity law; plug friction with a gauge's
+#: gain), others of the cell with each other, and faults of the chain with effects of the cell.
+PAIRS_1D = (("clearance", "velocity_friction"), ("plug_friction", "gauge_gain"), ("end_friction", "gauge_gain"),
+            ("clearance", "pressure_friction"), ("plug_friction", "slip_friction"), ("dispersion", "clearance"),
+            ("velocity_friction", "channel_timing"), ("plug_friction", "bar_modulus"))
+#: Pairs on the axisymmetric simulation: only effects it has (plug friction, clearance, the friction laws) and
+#: faults of the chain (made on its recorded strains).
+PAIRS_AXISYMMETRIC = (("clearance", "velocity_friction"), ("plug_friction", "channel_timing"),
+                      ("clearance", "pressure_friction"), ("plug_friction", "slip_friction"),
+                      ("clearance", "bar_modulus"), ("velocity_friction", "channel_timing"),
+                      ("plug_friction", "clearance"), ("pressure_friction", "bar_modulus"))
+
+
+def make_pair(pair: tuple[str, str], axisymmetric: bool, k: int, r: np.random.Generator):
+    """The configuration simulated, the edit of its recorded strains (or None), the header's apparatus (or
+    None: the configuration's) and a note, for record ``k`` with the two effects of ``pair``."""
+    cfg = clean_config(r, "A" if k % 2 == 0 else "B")
+    clean_header = cfg.apparatus
+    edit, header, notes = None, None, []
+    for effect in pair:
+        if effect in CHAIN_FAULTS:
+            cfg, e, note = CHAIN_FAULTS[effect](cfg, r)
+            edit = e if e is not None else edit
+            header = clean_header if effect == "bar_modulus" else header
+            notes.append(note)
+        else:
+            cfg = HIDDEN[effect](cfg, r)
+            notes.append(effect)
+    if axisymmetric:
+        cfg = _axisymmetric(cfg)
+    return cfg, edit, header, " + ".join(notes)
+
+
+def named_causes(dg) -> list[str]:
+    """The mechanisms a round named outright (a round of candidates names none)."""
+    return [v.mechanism.name for v, verdict in zip(dg.causes, dg.verdicts) if verdict.kind == "named"]
+
+
+def score(pair: tuple[str, str], dg, cfg, prep) -> dict:
+    named = named_causes(dg)
+    head = headline(dg)
+    fx = head[1] if head is not None else dg.final.f_summary()
+    truth = true_f(cfg, prep)
+    return {"both": set(pair) <= set(named), "one": len(set(pair) & set(named)) == 1,
+            "wrong": bool(set(named) - set(pair)), "kind": dg.verdicts[0].kind if dg.verdicts else "none",
+            "covered": fx["q05"] <= truth <= fx["q95"], "named": named, "f": fx, "truth": truth,
+            "rounds": [v.kind for v in dg.verdicts]}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seed", type=int, default=29)
+    ap.add_argument("--only", default="1d,axisymmetric", help="simulators: 1d, axisymmetric or both")
+    ap.add_argument("--first", type=int, default=0, help="first pair of each list to analyse")
+    ap.add_argument("--count", type=int, default=8, help="pairs of each list to analyse")
+    a = ap.parse_args()
+    priors = load_priors(default_prior_path("I1"))
+    rng = np.random.default_rng(a.seed)
+    tmp = tempfile.mkdtemp()
+    tally: dict[str, Counter] = {}
+    secs = []
+    for sim, pairs in (("1d", PAIRS_1D), ("axisymmetric", PAIRS_AXISYMMETRIC)):
+        for k, pair in enumerate(pairs):
+            cfg, edit, header, note = make_pair(pair, sim == "axisymmetric", k, rng)
+            sim_seed = int(rng.integers(2**31))  # drawn for every record: the others do not move with --only
+            if sim not in a.only.split(",") or not a.first <= k < a.first + a.count:
+                continue
+            c = tally.setdefault(sim, Counter())
+            c["n"] += 1
+            path = os.path.join(tmp, f"{sim}-{k}.h5")
+            t = time.perf_counter()
+            try:
+                write(cfg, path, sim_seed, edit, header)
+                prep, dg = analyse(path, priors, seed=k, max_causes=MAX_CAUSES)
+            except FrictionUQError as exc:
+                c["refused"] += 1
+                print(f"{sim}-{k} ({note}): refused: {exc}", flush=True)
+                continue
+            secs.append(time.perf_counter() - t)
+            s = score(pair, dg, cfg, prep)
+            for key in ("both", "one", "wrong", "covered"):
+                c[key] += s[key]
+            c[f"first:{s['kind']}"] += 1
+            fx = s["f"]
+            print(f"{sim}-{k} ({note}): rounds {s['rounds']}, named {s['named']}; f {fx['q50']:.4f} "
+                  f"[{fx['q05']:.4f}, {fx['q95']:.4f}] truth {s['truth']:.4f}; {secs[-1]:.0f} s", flush=True)
+            os.remove(path)
+    print(f"\n{'simulator':<13} {'n':>3} {'both':>5} {'one':>4} {'wrong':>6} {'f covered':>9} {'refused':>7}  "
+          "first round's verdict")
+    for sim, c in tally.items():
+        kinds = ", ".join(f"{k.split(':', 1)[1]} {v}" for k, v in sorted(c.items()) if k.startswith("first:"))
+        print(f"{sim:<13} {c['n']:>3} {c['both']:>5} {c['one']:>4} {c['wrong']:>6} {c['covered']:>9} "
+              f"{c['refused']:>7}  {kinds}")
+    if secs:
+        print(f"time per record: median {np.median(secs):.0f} s, range {min(secs):.0f}-{max(secs):.0f} s")
+
+
+if __name__ == "__main__":
+    main()
