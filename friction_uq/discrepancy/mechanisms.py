@@ -28,30 +28,15 @@ Priors (why these ranges):
 * ``end_friction``: f_e ~ half-normal(0.25): PTFE on steel is 0.02-0.1, bare faces (a sheet torn or
   missing: explosive on steel) 0.3-0.5.
 
-The measurement chain beside the gain (each fitted once, on every gauge it may act on at once: a
-parameter per gauge, the gauges that read right keep theirs near the neutral value):
-
-* ``zero_drift``: a rate per gauge ~ normal(0, 10 microstrain per ms): a bridge warming or an
-  amplifier's zero creeping moves a few microstrain over a record of 1-2 ms; the constant part of a
-  zero is the likelihood's own offset.
-* ``channel_timing``: the output bars' and the hoop gauge's delays against the input bar ~ normal(0,
-  2 us): a gauge 1 cm from where the header puts it on a 5000 m/s bar reads 2 us late, two digitisers
-  triggered apart by a few samples as much (a delay common to every channel changes nothing).
-* ``bandwidth``: an equivalent first-order time constant per output gauge ~ half-normal(1 us): a bridge
-  amplifier of 100 kHz (older SHPB chains) has 1.6 us, one of 1 MHz 0.16 us. The input bar is left
-  out: its reading, low-pass and all, drives the simulation, so the output gauges' time constants are
-  read against the input bar's (exactly so where the cell responds linearly to the wave's shape).
-* ``bar_modulus``: each output bar's modulus over its header's ~ lognormal(0, 3 %), its density kept (the
-  wave speed moves by half as much): a supplier's modulus is good to 2-3 %, a wave speed timed on the
-  bar to 1 %. The bar's force per microstrain and the wave's travel to its gauge both change. The input
-  bar is left out: its measured wave drives the simulation, transported to the cell once.
+The measurement chain beside the gain (a zero drifting, a channel's timing, an amplifier's bandwidth, a bar's
+modulus): :mod:`.chain_faults`, registered after the entries here. The registry itself (:class:`Mechanism`,
+:class:`Context`, :func:`register`, :data:`MECHANISMS`): :mod:`.mechanism_registry`.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
 
@@ -60,84 +45,15 @@ from scipy import stats
 
 from ..models.measurement_chain import Reading
 from ..models.parameters import Parameter
+from .chain_faults import chain_faults
+from .mechanism_registry import MECHANISMS, Context, Mechanism, lognormal, register
 
-Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, Reading], str | None], None]
-"""apply(values, settings, readings, channel): edit the simulator settings and the gauges' measurement chains
-(channel -> :class:`~friction_uq.models.measurement_chain.Reading`) in place."""
-
-
-@dataclass(frozen=True)
-class Context:
-    """Stationary-window means a mechanism needs to state its effective f: sliding speed V (m/s), wall shear
-    stress tau_mean (Pa, eq. 18 from F_eo), slip (m)."""
-
-    V: float
-    tau_mean: float
-    slip: float
-
-
-@dataclass(frozen=True)
-class Mechanism:
-    """One entry of the catalogue (module docstring)."""
-
-    name: str
-    meaning: str
-    signature: str
-    parameters: tuple[Parameter, ...]
-    priors: Mapping[str, Any]
-    start: Mapping[str, float]
-    apply: Apply
-    #: f_effective(values, context): numpy expressions, so that arrays of values give arrays (the implied prior of
-    #: f_effective, :mod:`.effective_prior`, evaluates it over many parameter draws at once)
-    f_effective: Callable[[Mapping[str, Any], Context], Any] = field(default=lambda v, c: v["f"])
-    channels: tuple[str, ...] = ()  # gauge_gain: the gauges it may act on (one fit each)
-    group: str | None = None  # mechanisms of one group replace the same thing (the friction law): one at a time
-    per_gauge: tuple[str, ...] = ()  # a measurement-chain fault fitted on every gauge at once: parameter i is gauge i's
-    neutral: float = 0.0  # per_gauge: the parameter's value where its gauge reads right
-
-    def prior_z(self) -> dict[str, tuple[float, float]]:
-        """Gaussian stand-ins of the priors in each parameter's unbounded coordinate (centre, sd), from the
-        prior's 16 % and 84 % quantiles: what the mode search uses (the exact prior weighs the draws)."""
-        return {p.name: p.gaussian_stand_in(self.priors[p.name]) for p in self.parameters}
-
-    def log_prior(self, values: Mapping[str, float]) -> float:
-        return float(sum(self.priors[p.name].logpdf(values[p.name]) for p in self.parameters))
-
-    def departing_gauge(self, values: Mapping[str, float]) -> tuple[str, Parameter] | None:
-        """For a fault fitted on every gauge at once (``per_gauge``): the gauge whose parameter lies furthest
-        from the neutral value (``neutral``: the gauge reads right), in its prior's sds, and that parameter
-        (None for any other mechanism)."""
-        if not self.per_gauge:
-            return None
-
-        def away(p: Parameter) -> float:
-            return abs(float(values[p.name]) - self.neutral) / float(self.priors[p.name].std())
-
-        i = max(range(len(self.per_gauge)), key=lambda k: away(self.parameters[k]))
-        return self.per_gauge[i], self.parameters[i]
-
-
-MECHANISMS: dict[str, Mechanism] = {}
-
-
-def register(mech: Mechanism) -> Mechanism:
-    """Add a mechanism to the catalogue (names are unique)."""
-    if mech.name in MECHANISMS:
-        raise ValueError(f"mechanism {mech.name!r} is registered twice")
-    missing = [p.name for p in mech.parameters if p.name not in mech.priors or p.name not in mech.start]
-    if missing:
-        raise ValueError(f"mechanism {mech.name!r}: no prior or start for {', '.join(missing)}")
-    MECHANISMS[mech.name] = mech
-    return mech
+__all__ = ["MECHANISMS", "Context", "Mechanism", "register"]
 
 
 def _law(settings: dict[str, Any], law: str, **params: float) -> None:
     settings["friction_law"] = law
     settings["friction_params"] = MappingProxyType({k: float(v) for k, v in params.items()})
-
-
-def _lognormal(median: float, sd_log: float) -> Any:
-    return stats.lognorm(s=sd_log, scale=median)
 
 
 F_S = Parameter("f_s", "-", 0.0, 2.0, "friction coefficient at rest (zero sliding speed, or before any slip)")
@@ -148,7 +64,7 @@ register(Mechanism(
     signature="F_eo/F_io changes with V during the rise (while the sample speeds up) and across tests at "
               "different striker speeds",
     parameters=(F_S, Parameter("v_c", "m/s", 0.0, math.inf, "characteristic sliding speed of the change")),
-    priors={"f_s": stats.halfnorm(scale=0.3), "v_c": _lognormal(5.0, 1.0)},
+    priors={"f_s": stats.halfnorm(scale=0.3), "v_c": lognormal(5.0, 1.0)},
     start={"f_s": 0.08, "v_c": 5.0},
     apply=lambda v, s, g, ch: _law(s, "velocity", f_s=v["f_s"], f_d=v["f"], v_c=v["v_c"]),
     f_effective=lambda v, c: v["f"] + (v["f_s"] - v["f"]) * np.exp(-c.V / v["v_c"]),
@@ -160,7 +76,7 @@ register(Mechanism(
     meaning="the interface's shear strength saturates with pressure: tau = f p / (1 + p / p0)",
     signature="the apparent f falls as the load rises: F_eo/F_io depends on the load level (rise vs plateau)",
     parameters=(Parameter("p0", "Pa", 0.0, math.inf, "pressure at which the friction coefficient has halved"),),
-    priors={"p0": _lognormal(2e8, 1.5)},
+    priors={"p0": lognormal(2e8, 1.5)},
     start={"p0": 1e9},
     apply=lambda v, s, g, ch: _law(s, "hyperbolic", f0=v["f"], p0=v["p0"]),
     # at the window's shear stress: tau = f p / (1 + p/p0) gives tau / p = f - tau / p0
@@ -173,7 +89,7 @@ register(Mechanism(
     meaning="friction changes with slip: f = f + (f_s - f) max(0, 1 - d / d_c), the friction drop at the start",
     signature="F_eo/F_io high at the first slip, then drifting down to its plateau value",
     parameters=(F_S, Parameter("d_c", "m", 0.0, math.inf, "slip over which the coefficient changes")),
-    priors={"f_s": stats.halfnorm(scale=0.3), "d_c": _lognormal(1e-3, 1.0)},
+    priors={"f_s": stats.halfnorm(scale=0.3), "d_c": lognormal(1e-3, 1.0)},
     start={"f_s": 0.08, "d_c": 1e-3},
     apply=lambda v, s, g, ch: _law(s, "slip_weakening", f_s=v["f_s"], f_d=v["f"], d_c=v["d_c"]),
     f_effective=lambda v, c: v["f"] + (v["f_s"] - v["f"]) * np.maximum(0.0, 1.0 - c.slip / v["d_c"]),
@@ -227,7 +143,7 @@ register(Mechanism(
     meaning="a calibration error on one bar gauge: its reading is the true strain times a gain",
     signature="the equilibrium F_i = F_eo + F_io broken by a constant factor; one channel off by a constant ratio",
     parameters=(Parameter("gain", "-", 0.0, 10.0, "recorded / true strain of the gauge"),),
-    priors={"gain": _lognormal(1.0, 0.1)},
+    priors={"gain": lognormal(1.0, 0.1)},
     start={"gain": 1.0},
     apply=_gain,
     channels=("input_bar", "internal_output_bar", "external_output_bar"),
@@ -257,73 +173,5 @@ register(Mechanism(
 ))
 
 
-#: The gauges read against the input bar's (its reading drives the simulation), and the outputs' own
-OUTPUT_GAUGES = ("internal_output_bar", "external_output_bar", "tube_hoop")
-ALL_GAUGES = ("input_bar", *OUTPUT_GAUGES)
-
-
-def _chain_fault(name: str, field: str, gauges: tuple[str, ...], *, unit: str, low: float, prior: Any, start: float,
-                 what: str, meaning: str, signature: str, scale: float = 1.0) -> Mechanism:
-    """A measurement-chain fault fitted on every gauge of ``gauges`` at once: one parameter ``<field>_<gauge>`` per
-    gauge (the :class:`~friction_uq.models.measurement_chain.Reading` field it sets; ``what``: its meaning, with
-    ``{gauge}`` for the gauge), the same prior and start for each."""
-    def apply(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
-        for gauge in gauges:
-            setattr(g[gauge], field, float(v[f"{field}_{gauge}"]))
-
-    return Mechanism(
-        name=name, meaning=meaning, signature=signature,
-        parameters=tuple(Parameter(f"{field}_{c}", unit, low, math.inf, what.format(gauge=c), scale=scale)
-                         for c in gauges),
-        priors={f"{field}_{c}": prior for c in gauges}, start={f"{field}_{c}": start for c in gauges},
-        apply=apply, per_gauge=gauges)
-
-
-register(_chain_fault(
-    "zero_drift", "drift", ALL_GAUGES, unit="1/s", low=-math.inf, prior=stats.norm(0.0, 0.01), start=0.0,
-    scale=1e-2, what="zero drift of {gauge} (strain per second)",
-    meaning="a gauge's zero drifting through the record: the channel reads the strain plus rate x time",
-    signature="a residual growing steadily with time on one channel, before the waves as after them"))
-
-register(_chain_fault(
-    "channel_timing", "delay", OUTPUT_GAUGES, unit="s", low=-math.inf, prior=stats.norm(0.0, 2e-6), start=0.0,
-    scale=1e-6, what="delay of {gauge} against the input bar",
-    meaning="a channel read late or early against the input bar's: a gauge not where the header puts it, or "
-            "digitisers triggered apart",
-    signature="residuals shaped like the derivative of the wave at every front of one channel, opposite in sign "
-              "at its rise and its fall"))
-
-register(_chain_fault(
-    "bandwidth", "time_constant", OUTPUT_GAUGES, unit="s", low=0.0, prior=stats.halfnorm(scale=1e-6), start=0.1e-6,
-    what="low-pass time constant of {gauge}",
-    meaning="an amplifier too slow for the waves: a gauge's reading through a low-pass (equivalent first-order "
-            "time constant)",
-    signature="fronts of one channel late and rounded, the plateau right: residuals at every front, none between"))
-
-
-def _bar_modulus(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
-    app = s["apparatus"]
-    for name in OUTPUT_BARS:
-        k = float(v[f"modulus_factor_{name}"])
-        bar = getattr(app, name)
-        app = replace(app, **{name: replace(bar, young_modulus=bar.young_modulus * k,
-                                            wave_speed=bar.wave_speed * math.sqrt(k))})
-    s["apparatus"] = app
-
-
-OUTPUT_BARS = ("internal_output_bar", "external_output_bar")
-
-register(Mechanism(
-    name="bar_modulus",
-    meaning="an output bar's modulus (and with it its wave speed) not the header's: its force per microstrain "
-            "and the wave's travel time to its gauge both off",
-    signature="one output channel scaled by a constant factor and its fronts early or late by a fraction of a "
-              "microsecond per per cent",
-    parameters=tuple(Parameter(f"modulus_factor_{b}", "-", 0.0, math.inf, f"Young's modulus of the {b} over the "
-                               "header's") for b in OUTPUT_BARS),
-    priors={f"modulus_factor_{b}": _lognormal(1.0, 0.03) for b in OUTPUT_BARS},
-    start={f"modulus_factor_{b}": 1.0 for b in OUTPUT_BARS},
-    apply=_bar_modulus,
-    per_gauge=OUTPUT_BARS,
-    neutral=1.0,
-))
+for _fault in chain_faults():  # after the cell's: the catalogue's order is the order diagnose fits in
+    register(_fault)

@@ -1,0 +1,91 @@
+"""The registry of mechanisms: what an entry of the catalogue declares (:class:`Mechanism`), the stationary
+window's means it states its effective f at (:class:`Context`), and :func:`register`, which adds one to
+:data:`MECHANISMS` (its order is the order in which ``diagnose`` fits them). The entries themselves:
+:mod:`.mechanisms` (the cell and the bar gauges' gain) and :mod:`.chain_faults` (the measurement chain).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from scipy import stats
+
+from ..models.measurement_chain import Reading
+from ..models.parameters import Parameter
+
+Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, Reading], str | None], None]
+"""apply(values, settings, readings, channel): edit the simulator settings and the gauges' measurement chains
+(channel -> :class:`~friction_uq.models.measurement_chain.Reading`) in place."""
+
+
+@dataclass(frozen=True)
+class Context:
+    """Stationary-window means a mechanism needs to state its effective f: sliding speed V (m/s), wall shear
+    stress tau_mean (Pa, eq. 18 from F_eo), slip (m)."""
+
+    V: float
+    tau_mean: float
+    slip: float
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """One entry of the catalogue (module docstring)."""
+
+    name: str
+    meaning: str
+    signature: str
+    parameters: tuple[Parameter, ...]
+    priors: Mapping[str, Any]
+    start: Mapping[str, float]
+    apply: Apply
+    #: f_effective(values, context): numpy expressions, so that arrays of values give arrays (the implied prior of
+    #: f_effective, :mod:`.effective_prior`, evaluates it over many parameter draws at once)
+    f_effective: Callable[[Mapping[str, Any], Context], Any] = field(default=lambda v, c: v["f"])
+    channels: tuple[str, ...] = ()  # gauge_gain: the gauges it may act on (one fit each)
+    group: str | None = None  # mechanisms of one group replace the same thing (the friction law): one at a time
+    per_gauge: tuple[str, ...] = ()  # a measurement-chain fault fitted on every gauge at once: parameter i is gauge i's
+    neutral: float = 0.0  # per_gauge: the parameter's value where its gauge reads right
+
+    def prior_z(self) -> dict[str, tuple[float, float]]:
+        """Gaussian stand-ins of the priors in each parameter's unbounded coordinate (centre, sd), from the
+        prior's 16 % and 84 % quantiles: what the mode search uses (the exact prior weighs the draws)."""
+        return {p.name: p.gaussian_stand_in(self.priors[p.name]) for p in self.parameters}
+
+    def log_prior(self, values: Mapping[str, float]) -> float:
+        return float(sum(self.priors[p.name].logpdf(values[p.name]) for p in self.parameters))
+
+    def departing_gauge(self, values: Mapping[str, float]) -> tuple[str, Parameter] | None:
+        """For a fault fitted on every gauge at once (``per_gauge``): the gauge whose parameter lies furthest
+        from the neutral value (``neutral``: the gauge reads right), in its prior's sds, and that parameter
+        (None for any other mechanism)."""
+        if not self.per_gauge:
+            return None
+
+        def away(p: Parameter) -> float:
+            return abs(float(values[p.name]) - self.neutral) / float(self.priors[p.name].std())
+
+        i = max(range(len(self.per_gauge)), key=lambda k: away(self.parameters[k]))
+        return self.per_gauge[i], self.parameters[i]
+
+
+MECHANISMS: dict[str, Mechanism] = {}
+
+
+def register(mech: Mechanism) -> Mechanism:
+    """Add a mechanism to the catalogue (names are unique)."""
+    if mech.name in MECHANISMS:
+        raise ValueError(f"mechanism {mech.name!r} is registered twice")
+    missing = [p.name for p in mech.parameters if p.name not in mech.priors or p.name not in mech.start]
+    if missing:
+        raise ValueError(f"mechanism {mech.name!r}: no prior or start for {', '.join(missing)}")
+    MECHANISMS[mech.name] = mech
+    return mech
+
+
+
+def lognormal(median: float, sd_log: float) -> Any:
+    """A lognormal prior by its median and the sd of its log."""
+    return stats.lognorm(s=sd_log, scale=median)
