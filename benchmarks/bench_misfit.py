@@ -28,7 +28,7 @@ from scipy import stats
 
 from friction_uq.analysis import prepare
 from friction_uq.discrepancy.check import check_whole_record
-from friction_uq.discrepancy.outcome import HOOP_GAIN_FINDING
+from friction_uq.discrepancy.diagnosis_words import HOOP_GAIN_FINDING
 from friction_uq.errors import FrictionUQError
 from friction_uq.likelihood import Likelihood
 from friction_uq.priors import default_prior_path, load_priors

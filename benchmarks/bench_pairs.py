@@ -33,7 +33,7 @@ from bench_misfit import clean_config  # noqa: E402
 from verdict_records import CHAIN_FAULTS, _axisymmetric, write  # noqa: E402
 
 from friction_uq.discrepancy.diagnose import MAX_CAUSES  # noqa: E402
-from friction_uq.discrepancy.outcome import headline  # noqa: E402
+from friction_uq.discrepancy.diagnosis_words import headline  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
 

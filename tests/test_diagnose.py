@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from friction_uq.analysis import prepare
-from friction_uq.discrepancy import outcome
+from friction_uq.discrepancy import diagnosis_words, outcome
 from friction_uq.discrepancy.diagnose import candidates, diagnose
 from friction_uq.discrepancy.mechanisms import MECHANISMS, Mechanism, register
 from friction_uq.models.parameters import F, HOOP_GAIN, NU
@@ -193,7 +193,7 @@ def test_a_hoop_gauge_calibration_error_is_said_not_named(tmp_path):
                                            channels={"tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3,
                                                                               gain=0.95)}), seed=24)
     assert dg.cause is None, [(r.fit.label, r.delpd, r.se) for r in dg.ranking]
-    assert 0.95 - 0.015 <= dg.final.hoop_gain < 1.0 - outcome.HOOP_GAIN_FINDING
+    assert 0.95 - 0.015 <= dg.final.hoop_gain < 1.0 - diagnosis_words.HOOP_GAIN_FINDING
     doc = outcome.to_json(dg, {"mean": 0.06, "sd": 0.003, "q05": 0.055, "q50": 0.06, "q95": 0.065})
     assert doc["hoop_gain"]["finding"]
     assert f"the tube hoop gauge reads {dg.final.hoop_gain:.2f} times the model" in doc["sentence"]
@@ -213,7 +213,7 @@ def test_plug_friction_is_named_and_f_recovered(tmp_path):
     assert doc["ranking"][0]["ess"] == pytest.approx(doc["ranking"][0]["draws"])  # independent, equally weighted
     assert doc["reference_misfit"][0]["detected"] == dg.misfits[0].detected
     # in an experimentalist's words, with the cause's effect on f: f before -> after it, then the f to quote
-    steps = outcome.f_steps(dg)
+    steps = diagnosis_words.f_steps(dg)
     assert [v.mechanism.name for v, _, _ in steps] == ["plug_friction"] and steps[0][2] < steps[0][1]
     assert "the plug rubbing on the tube (plug_friction), f " in doc["sentence"]
     assert f"f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] with them (the f to quote)" in doc["sentence"]
@@ -228,7 +228,7 @@ def test_an_external_gauge_gain_the_check_cannot_see_is_not_named(tmp_path):
         white=1e-6, ar1=1e-6, ar1_coef=0.6, gain=1.12)}), seed=23)
     assert not dg.misfits[0].detected
     assert dg.cause is None and dg.verdict.kind == "none" and dg.mixture_f is None
-    assert outcome.headline(dg) is None
+    assert diagnosis_words.headline(dg) is None
 
 
 def test_clearance_is_named_and_the_gap_measured(tmp_path):
@@ -247,9 +247,9 @@ def test_a_hoop_calibration_finding_needs_the_baseline_and_the_final_model_to_ag
 
     dg = SimpleNamespace(baseline=SimpleNamespace(hoop_gain=1.0), check_hoop_gain=base,
                          final=SimpleNamespace(hoop_gain=final, predicted={"tube_hoop": None}))
-    assert outcome.hoop_gain_off(dg) is found
+    assert diagnosis_words.hoop_gain_off(dg) is found
     dg.baseline.hoop_gain, dg.check_hoop_gain = base, None  # diagnose alone: its own baseline
-    assert outcome.hoop_gain_off(dg) is found
+    assert diagnosis_words.hoop_gain_off(dg) is found
 
 
 @pytest.mark.slow  # a whole diagnose with exact posteriors, 50-110 s
@@ -264,7 +264,7 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
     assert not dg.misfits[0].detected
     assert dg.cause is None and dg.verdict.kind == "unconfirmed" and dg.verdict.named == "end_friction", \
         [(r.fit.label, r.delpd, r.se) for r in dg.ranking]
-    label, fx = outcome.headline(dg)
+    label, fx = diagnosis_words.headline(dg)
     assert label.startswith("mixture of") and "end_friction" in dg.mixture_weights
     assert fx["q05"] <= 0.05 <= fx["q95"], fx
     fe = next(r.fit for r in dg.ranking if r.fit.label == "end_friction").fit.draws["f_e"]

@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 from .._atomic import write_bytes
 from ..analysis import Identification, Prepared
 from ..discrepancy.check import WholeRecordCheck
-from ..discrepancy.outcome import headline as outcome_headline
+from ..discrepancy.diagnosis_words import headline as outcome_headline
 from .quote import quote_line
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..sampler import PosteriorSamples
@@ -92,7 +92,7 @@ def page_summary(r: ReportInputs) -> Figure:
     if r.whole_record is not None:
         lines.append("Whole record: " + r.whole_record.decision.sentence(page=whole_record_page(r)))
     if r.diagnosis is not None:
-        from ..discrepancy.outcome import sentence
+        from ..discrepancy.diagnosis_words import sentence
 
         lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, s["f"].to_json()))
     # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
@@ -213,7 +213,7 @@ def diagnosis_pages(r: ReportInputs) -> list[Figure]:
     """With a diagnosis, its two pages: the ranking and the extended fit."""
     if r.diagnosis is None:
         return []
-    from ..discrepancy.outcome import sentence
+    from ..discrepancy.diagnosis_words import sentence
     from .diagnose_pages import page_extended_fit, page_ranking
 
     test = f"{r.prepared.record.campaign} {r.prepared.record.test_id}"

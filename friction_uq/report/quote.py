@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from ..discrepancy.outcome import headline
+from ..discrepancy.diagnosis_words import headline
 
 
 def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, Mapping[str, float]]:

@@ -62,7 +62,7 @@ RUN_SCHEMA_VERSION = 2
 def quoted_f(f_stationary: dict[str, float], diagnosis=None) -> dict[str, object]:
     """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`), the model it comes from
     and, under named causes, how its posterior was approximated and the Pareto k that judges it."""
-    from ..discrepancy.outcome import headline
+    from ..discrepancy.diagnosis_words import headline
     from ..report.quote import f_to_quote
 
     source, fx = f_to_quote(f_stationary, diagnosis)

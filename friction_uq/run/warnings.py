@@ -65,7 +65,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     """What to do about a misfit: diagnose it, or (diagnosed) quote f under the causes it named."""
     if diagnosis is None:
         return "`friction-uq diagnose` names the cause and gives f under it."
-    from ..discrepancy.outcome import headline
+    from ..discrepancy.diagnosis_words import headline
 
     if diagnosis.mixture_f is not None:  # unexplained, or candidates (fitted in turn or not) the record leaves open
         fm = headline(diagnosis)[1]

@@ -1,0 +1,210 @@
+"""What ``diagnose`` says in words: the sentence for the terminal and the summary page, each cause in an
+experimentalist's words (a measurement-chain fault with its gauge and how much), the headline's f (the named
+model's or the candidates' stacking mixture), and the hoop gauge's calibration finding. The JSON and the
+DataTree groups: :mod:`.outcome`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..models.parameters import Parameter, summarize_draws
+from .diagnose import Diagnosis
+from .extended import Variant
+from .whole_record import CHANNEL_LABELS
+
+#: A hoop gain this far from 1 (its most probable value under its 5 % prior) is reported as a calibration finding
+#: (clean records: see benchmarks/bench_misfit.py for how often a right gauge reads this far off).
+HOOP_GAIN_FINDING = 0.02
+
+
+def mixture_label(dg: Diagnosis) -> str:
+    """'mixture of clearance (0.61), dispersion (0.33)': the models whose stacking mixture gives f, with their
+    weights ("reference": the model without causes, written as "no cause")."""
+    parts = [f"{'no cause' if k == 'reference' else k} ({w:.2f})" for k, w in dg.mixture_weights.items()]
+    return "mixture of " + ", ".join(parts)
+
+
+def unresolved(dg: Diagnosis) -> bool:
+    """A first round of candidates whose rivals no later round named: the causes fitted are not named, and f is
+    the mixture of the candidates (``Diagnosis.mixture_f``)."""
+    return bool(dg.causes) and dg.mixture_f is not None
+
+
+def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
+    """The headline f of a diagnosed record: the final model's label and its f when a cause was named; the
+    stacking mixture's when the record named candidates or an unexplained misfit (:mod:`.verdict`); None when
+    nothing needed explaining (the headline is then the stationary analysis' f)."""
+    if dg.mixture_f is not None:
+        return mixture_label(dg), summarize_draws(dg.mixture_f)
+    if dg.causes:
+        return dg.final.label, dg.final.f_summary()
+    return None
+
+
+#: Each mechanism in an experimentalist's words (docs/glossary.md has the longer entries).
+PLAIN_NAMES = {
+    "velocity_friction": "wall friction that changes with the sliding speed",
+    "pressure_friction": "wall friction that changes with the wall pressure",
+    "slip_friction": "wall friction that changes with the distance slid",
+    "clearance": "a radial gap between sample and tube",
+    "plug_friction": "the plug rubbing on the tube",
+    "gauge_gain": "a bar gauge's calibration",
+    "dispersion": "wave dispersion in the bars",
+    "end_friction": "friction on the sample's end faces",
+    "zero_drift": "a gauge's zero drifting through the record",
+    "channel_timing": "a channel read late or early (a gauge's position, a trigger's skew)",
+    "bandwidth": "an amplifier too slow for the waves",
+    "bar_modulus": "an output bar's modulus off its header",
+}
+
+#: How a measurement-chain parameter is said: unit -> (factor, unit in words)
+CHAIN_UNITS = {"s": (1e6, "us"), "1/s": (1e3, "microstrain per ms"), "-": (1.0, "times the header's")}
+
+
+def _describe(dg: Diagnosis) -> str:
+    """Where the simple model (eq. 17 with the 1-D simulation) misses most, in words (largest level misfit)."""
+    comp = dg.baseline_comparison
+    worst = max(comp.figures, key=lambda f: abs(f.level))
+    direction = "above" if worst.relative_level > 0 else "below"
+    return (f"the {CHANNEL_LABELS[worst.channel]} gauge reads {abs(worst.relative_level) * 100:.1f} % {direction} the "
+            f"simple model over the {worst.phase} phase")
+
+
+def f_steps(dg: Diagnosis) -> list[tuple[Variant, float, float]]:
+    """Each named cause with the median f before and after it was added, in the order named: round k's
+    reference model is the one with the first k causes (diagnose.diagnose)."""
+    out, before = [], float(np.median(dg.baseline.f_effective))
+    for k, v in enumerate(dg.causes):
+        chosen = next((r.fit for r in dg.rounds[k] if r.fit.variants[-1] == v), None) if k < len(dg.rounds) else None
+        after = before if chosen is None else float(np.median(chosen.f_effective))
+        out.append((v, before, after))
+        before = after
+    return out
+
+
+def chain_gauge(v: Variant, dg: Diagnosis | None) -> tuple[str, Parameter, float] | None:
+    """For a measurement-chain fault fitted on every gauge (``per_gauge``): the gauge it names, the parameter and
+    its posterior median, from the final model's draws when it holds the fault (else the round's fit)."""
+    if dg is None or not v.mechanism.per_gauge:
+        return None
+    fit = dg.final if v in dg.final.variants else next(
+        (r.fit for rk in dg.rounds for r in rk if r.fit.variants[-1] == v), None)
+    if fit is None:
+        return None
+    medians = {k: float(np.median(d)) for k, d in fit.fit.draws.items()}
+    gauge, p = v.mechanism.departing_gauge(medians)
+    return gauge, p, medians[p.name]
+
+
+def cause_words(v: Variant, dg: Diagnosis | None = None) -> str:
+    where = f" on the {CHANNEL_LABELS.get(v.channel, v.channel)} gauge" if v.channel else ""
+    chain = chain_gauge(v, dg)
+    if chain is not None:  # say which gauge, and how much
+        gauge, p, value = chain
+        factor, unit = CHAIN_UNITS.get(p.unit, (1.0, p.unit))
+        x = f"{value * factor:.3g}" if p.unit == "-" else f"{value * factor:+.2g}"
+        where = f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({x} {unit})"
+    return f"{PLAIN_NAMES.get(v.mechanism.name, v.mechanism.name)}{where} ({v.mechanism.name})"
+
+
+def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
+    """One line for the terminal and the summary page, in an experimentalist's words: the causes, the one that
+    moves f most first, with f before and after each; then f to quote; then where the simple model missed."""
+    fx = dg.final.f_summary()
+    if not dg.causes and dg.mixture_f is not None:
+        return _mixture_sentence(dg, f_without)
+    if not dg.causes and dg.misfits and not dg.misfits[0].detected:
+        return (f"The simulated test reproduces every gauge within what two simulators of the same test differ by: "
+                f"nothing to explain (closest cause: {dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- "
+                f"{dg.ranking[0].se:.1f} nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
+                f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
+    if not dg.causes:
+        return (f"No cause of the catalogue explains the record clearly better than the simple model (closest: "
+                f"{dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f} "
+                f"nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
+                f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
+    steps = sorted(f_steps(dg), key=lambda s: -abs(s[2] - s[1]))
+    named = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
+    if dg.channels_not_separable:
+        alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
+        named += f" (the same on {alt} gauge explains the record about as well)"
+    first = dg.ranking[0]
+    if unresolved(dg):  # candidates no later round told apart: the one fitted first is no more the cause than its
+        # rivals, and f is their mixture
+        fx = summarize_draws(dg.mixture_f)
+        lead = ("Candidates, not a cause: this record does not tell apart "
+                f"{', '.join(dg.not_separable or [v.mechanism.name for v in dg.causes])}; fitted in turn: {named}.")
+        quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
+        evidence = "strongest candidate"
+        sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
+    else:
+        lead = f"Causes found, the one that moves f most first: {named}."
+        quote = "with them (the f to quote)"
+        evidence = "first cause"
+        sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
+            if dg.not_separable else ""
+    return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from "
+            f"the stationary analysis without them. Why: {_describe(dg)}; the {evidence}'s evidence is "
+            f"{first.delpd:.0f} +- {first.se:.0f} nats.{sep}"
+            f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
+
+
+def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
+    """The sentence of a record whose misfit no single cause explains (candidates, or unexplained)."""
+    fm = summarize_draws(dg.mixture_f)
+    shares = ", ".join(f"{'no cause' if k == 'reference' else _words_of(dg, k)} {100 * w:.0f} %"
+                       for k, w in dg.mixture_weights.items())
+    v = dg.verdict
+    if v.kind == "unconfirmed":
+        what = (f"{_words_of(dg, v.named)} predicts the record better than the simple model, but the simple model "
+                "already reproduces every gauge within what two simulators of the same test differ by: not named.")
+    elif v.kind == "candidates":
+        what = (f"This record does not tell apart {', '.join(dg.not_separable) or 'the candidates'}"
+                f"{'; ' + dg.separate_by + ' would' if dg.separate_by else ''}.")
+    else:
+        where = _where(dg)
+        what = (f"Unexplained misfit{where}: no cause of the catalogue explains it clearly, over the whole record "
+                "and better than every other.")
+    return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the candidates weighted by how well "
+            f"each predicts the record ({shares}; the f to quote, wide enough for whichever is right), "
+            f"{f_without['q50']:.3f} from the stationary analysis.")
+
+
+def _words_of(dg: Diagnosis, label: str) -> str:
+    fit = next((r.fit for r in dg.ranking if r.fit.label == label), None)
+    return label if fit is None else cause_words(fit.variants[-1], dg)
+
+
+def _where(dg: Diagnosis) -> str:
+    """' on the internal transmitted gauge, rise phase': the first cell the whole-record check flagged."""
+    cells = dg.misfits[0].flagged() if dg.misfits else []
+    if not cells:
+        return ""
+    c = cells[0]
+    return f" on the {CHANNEL_LABELS.get(c.channel, c.channel)} gauge, {c.phase} phase"
+
+
+def baseline_hoop_gain(dg: Diagnosis) -> float:
+    """The hoop factor without the causes: the whole-record check's (f and nu free) when run made one, else
+    diagnose's own baseline's (which also frees the sample's modulus, and lets it absorb part of it)."""
+    return dg.baseline.hoop_gain if dg.check_hoop_gain is None else dg.check_hoop_gain
+
+
+def hoop_gain_off(dg: Diagnosis) -> bool:
+    """The hoop calibration factor (most probable under its prior) is more than HOOP_GAIN_FINDING from 1, on
+    the same side, without the causes and under the final model. A mechanism that changes the hoop's
+    level (a clearance) moves the factor with it: on the bundled set-up A (a right hoop gauge, a
+    clearance) the check read 0.96-0.97 and the final models 1.01-1.12; only a reading both agree on
+    is a calibration finding."""
+    if "tube_hoop" not in dg.final.predicted:
+        return False
+    a, b = baseline_hoop_gain(dg) - 1.0, dg.final.hoop_gain - 1.0
+    return abs(a) > HOOP_GAIN_FINDING and abs(b) > HOOP_GAIN_FINDING and a * b > 0
+
+
+def _hoop_finding(dg: Diagnosis) -> str:
+    if not hoop_gain_off(dg):
+        return ""
+    g = dg.final.hoop_gain
+    return (f"the tube hoop gauge reads {g:.2f} times the model's strain, {baseline_hoop_gain(dg):.2f} without "
+            "the causes (its calibration factor, most probable value under a 5 % prior)")
