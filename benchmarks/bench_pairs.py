@@ -10,8 +10,9 @@ of the measurement chain). Each record goes through ``diagnose`` with all its ro
 Per record it prints the pair, each round's verdict, the causes named, the quoted f (the headline's: the
 named model's, or the stacking mixture's; the baseline's when nothing needed explaining) against the truth
 (the wall's coefficient at the window's mean sliding speed, pressure and slip), and the time. The table:
-per simulator, how often both effects were named, one, a wrong cause named, a record ended as candidates or
-unexplained, and f covered by its 90 % interval.
+per simulator, how often both effects were named (as the JSON's ``verdict`` and ``causes`` say: a record that
+ends as candidates not told apart names none), one, a wrong cause named, both among the named causes and the
+candidates listed, f covered by its 90 % interval, and the first round's verdicts.
 
     python benchmarks/bench_pairs.py [--seed 29] [--only 1d,axisymmetric] [--first 0] [--count 8]
 """
@@ -33,7 +34,7 @@ from bench_misfit import clean_config  # noqa: E402
 from verdict_records import CHAIN_FAULTS, _axisymmetric, write  # noqa: E402
 
 from friction_uq.discrepancy.diagnose import MAX_CAUSES  # noqa: E402
-from friction_uq.discrepancy.diagnosis_words import headline  # noqa: E402
+from friction_uq.discrepancy.diagnosis_words import headline, unresolved  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
 
@@ -71,8 +72,23 @@ def make_pair(pair: tuple[str, str], axisymmetric: bool, k: int, r: np.random.Ge
 
 
 def named_causes(dg) -> list[str]:
-    """The mechanisms a round named outright (a round of candidates names none)."""
-    return [v.mechanism.name for v, verdict in zip(dg.causes, dg.verdicts) if verdict.kind == "named"]
+    """The causes the record is said to have, as the JSON's ``verdict`` and ``causes`` say: every cause of the
+    search when the verdict is "named" (a first round's candidates whose rivals later rounds named count), none
+    when the record ends as candidates not told apart, unexplained or unconfirmed."""
+    return [v.mechanism.name for v in dg.causes] if dg.causes and not unresolved(dg) else []
+
+
+def candidates_of(dg) -> list[str]:
+    """The mechanisms a round listed as candidates: under "candidates" the best and its rivals, under
+    "unexplained" or "unconfirmed" the models that carry the stacking weight."""
+    out = []
+    for verdict in dg.verdicts:
+        by = {c.label: c.mechanism for c in verdict.candidates}
+        if verdict.kind == "candidates":
+            out += [by[label] for label in (verdict.named, *verdict.rivals)]
+        elif verdict.kind in ("unexplained", "unconfirmed"):
+            out += [by[label] for label in verdict.supported if label in by]
+    return list(dict.fromkeys(out))
 
 
 def score(pair: tuple[str, str], dg, cfg, prep) -> dict:
@@ -80,8 +96,10 @@ def score(pair: tuple[str, str], dg, cfg, prep) -> dict:
     head = headline(dg)
     fx = head[1] if head is not None else dg.final.f_summary()
     truth = true_f(cfg, prep)
+    among = set(named) | set(candidates_of(dg))
     return {"both": set(pair) <= set(named), "one": len(set(pair) & set(named)) == 1,
             "wrong": bool(set(named) - set(pair)), "kind": dg.verdicts[0].kind if dg.verdicts else "none",
+            "both_among": set(pair) <= among, "candidates": candidates_of(dg),
             "covered": fx["q05"] <= truth <= fx["q95"], "named": named, "f": fx, "truth": truth,
             "rounds": [v.kind for v in dg.verdicts]}
 
@@ -117,19 +135,20 @@ def main() -> None:
                 continue
             secs.append(time.perf_counter() - t)
             s = score(pair, dg, cfg, prep)
-            for key in ("both", "one", "wrong", "covered"):
+            for key in ("both", "one", "wrong", "covered", "both_among"):
                 c[key] += s[key]
             c[f"first:{s['kind']}"] += 1
             fx = s["f"]
-            print(f"{sim}-{k} ({note}): rounds {s['rounds']}, named {s['named']}; f {fx['q50']:.4f} "
+            print(f"{sim}-{k} ({note}): rounds {s['rounds']}, named {s['named']}, candidates {s['candidates']}; "
+                  f"f {fx['q50']:.4f} "
                   f"[{fx['q05']:.4f}, {fx['q95']:.4f}] truth {s['truth']:.4f}; {secs[-1]:.0f} s", flush=True)
             os.remove(path)
-    print(f"\n{'simulator':<13} {'n':>3} {'both':>5} {'one':>4} {'wrong':>6} {'f covered':>9} {'refused':>7}  "
-          "first round's verdict")
+    print(f"\n{'simulator':<13} {'n':>3} {'both':>5} {'one':>4} {'wrong':>6} {'both among':>10} {'f covered':>9} "
+          f"{'refused':>7}  first round's verdict")
     for sim, c in tally.items():
         kinds = ", ".join(f"{k.split(':', 1)[1]} {v}" for k, v in sorted(c.items()) if k.startswith("first:"))
-        print(f"{sim:<13} {c['n']:>3} {c['both']:>5} {c['one']:>4} {c['wrong']:>6} {c['covered']:>9} "
-              f"{c['refused']:>7}  {kinds}")
+        print(f"{sim:<13} {c['n']:>3} {c['both']:>5} {c['one']:>4} {c['wrong']:>6} {c['both_among']:>10} "
+              f"{c['covered']:>9} {c['refused']:>7}  {kinds}")
     if secs:
         print(f"time per record: median {np.median(secs):.0f} s, range {min(secs):.0f}-{max(secs):.0f} s")
 
