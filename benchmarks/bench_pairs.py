@@ -10,8 +10,8 @@ of the measurement chain). Each record goes through ``diagnose`` with all its ro
 Per record it prints the pair, each round's verdict, the causes named, the quoted f (the headline's: the
 named model's, or the stacking mixture's; the baseline's when nothing needed explaining) against the truth
 (the wall's coefficient at the window's mean sliding speed, pressure and slip), and the time. The table:
-per simulator, how often both effects were named (as the JSON's ``verdict`` and ``causes`` say: a record that
-ends as candidates not told apart names none), one, a wrong cause named, both among the named causes and the
+per simulator, how often both effects were named (as the JSON's ``causes`` says: a candidate fitted in turn
+whose rivals no later round named is not named), one, a wrong cause named, both among the named causes and the
 candidates listed, f covered by its 90 % interval, and the first round's verdicts.
 
     python benchmarks/bench_pairs.py [--seed 29] [--only 1d,axisymmetric] [--first 0] [--count 8]
@@ -34,7 +34,7 @@ from bench_misfit import clean_config  # noqa: E402
 from verdict_records import CHAIN_FAULTS, _axisymmetric, write  # noqa: E402
 
 from friction_uq.discrepancy.diagnose import MAX_CAUSES  # noqa: E402
-from friction_uq.discrepancy.diagnosis_words import headline, unresolved  # noqa: E402
+from friction_uq.discrepancy.diagnosis_words import headline, sentence  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
 
@@ -72,10 +72,9 @@ def make_pair(pair: tuple[str, str], axisymmetric: bool, k: int, r: np.random.Ge
 
 
 def named_causes(dg) -> list[str]:
-    """The causes the record is said to have, as the JSON's ``verdict`` and ``causes`` say: every cause of the
-    search when the verdict is "named" (a first round's candidates whose rivals later rounds named count), none
-    when the record ends as candidates not told apart, unexplained or unconfirmed."""
-    return [v.mechanism.name for v in dg.causes] if dg.causes and not unresolved(dg) else []
+    """The causes the record is said to have, as the JSON's ``causes`` says (``Diagnosis.named_causes``: each
+    round's named cause, and a round's candidate fitted in turn whose rivals later rounds named)."""
+    return [v.mechanism.name for v in dg.named_causes]
 
 
 def candidates_of(dg) -> list[str]:
@@ -110,6 +109,7 @@ def main() -> None:
     ap.add_argument("--only", default="1d,axisymmetric", help="simulators: 1d, axisymmetric or both")
     ap.add_argument("--first", type=int, default=0, help="first pair of each list to analyse")
     ap.add_argument("--count", type=int, default=8, help="pairs of each list to analyse")
+    ap.add_argument("--sentences", action="store_true", help="print each record's diagnosis sentence")
     a = ap.parse_args()
     priors = load_priors(default_prior_path("I1"))
     rng = np.random.default_rng(a.seed)
@@ -142,6 +142,8 @@ def main() -> None:
             print(f"{sim}-{k} ({note}): rounds {s['rounds']}, named {s['named']}, candidates {s['candidates']}; "
                   f"f {fx['q50']:.4f} "
                   f"[{fx['q05']:.4f}, {fx['q95']:.4f}] truth {s['truth']:.4f}; {secs[-1]:.0f} s", flush=True)
+            if a.sentences:
+                print("    " + sentence(dg, dg.baseline.f_summary()), flush=True)
             os.remove(path)
     print(f"\n{'simulator':<13} {'n':>3} {'both':>5} {'one':>4} {'wrong':>6} {'both among':>10} {'f covered':>9} "
           f"{'refused':>7}  first round's verdict")

@@ -40,7 +40,7 @@ def test_run_and_campaign_stay_the_functions_once_their_subpackages_load():
 
 
 def test_read_result_reads_the_json_and_refuses_others(tmp_path):
-    doc = {"schema": "friction-uq/run-result", "schema_version": 2, "test_id": "A-03", "warnings": ["w"],
+    doc = {"schema": "friction-uq/run-result", "schema_version": 3, "test_id": "A-03", "warnings": ["w"],
            "f": {"mean": 0.05, "q05": 0.04, "q50": 0.05, "q95": 0.06, "model": "stationary"}}
     (tmp_path / "A_A-03.json").write_text(json.dumps(doc))
     res = fu.read_result(tmp_path / "A_A-03.nc")  # the stem, the .nc or the .json

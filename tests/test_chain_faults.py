@@ -94,7 +94,8 @@ def test_candidates_a_record_does_not_tell_apart_are_said_as_candidates_not_caus
     lab = identify(prep, nu=0.4)
     dg = diagnose(prep, log_prior, {"f": lab.f, "nu": 0.4}, hoop=True, seed=7)
     doc = outcome.to_json(dg, {"mean": 0.114, "sd": 0.005, "q05": 0.106, "q50": 0.114, "q95": 0.122})
-    assert doc["round_verdicts"][0] == "candidates" and doc["causes"], doc["round_verdicts"]
+    assert doc["round_verdicts"][0] == "candidates" and doc["fitted_in_turn"], doc["round_verdicts"]
+    assert doc["causes"] == [] and doc["cause"] is None and doc["open_candidates"][0] == doc["fitted_in_turn"][0]
     assert doc["verdict"] == "candidates" and doc["mixture"] is not None
     assert doc["sentence"].startswith("Candidates, not a cause: this record does not tell apart ")
     assert "Causes found" not in doc["sentence"]

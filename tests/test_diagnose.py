@@ -335,3 +335,47 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
         assert dd["posterior_method"] in ("importance (second proposal)", "emcee")
     assert not any("Pareto k" in w for w in doc["warnings"])
     assert any("which is the f to quote" in w for w in doc["warnings"])
+
+
+def _verdict(kind, named=None, rivals=(), labels=()):
+    """A round's verdict over candidates given by label ('gauge_gain[input_bar]'); the model labels are the same."""
+    from friction_uq.discrepancy.verdict import Candidate, Verdict
+
+    def cand(label):
+        name, _, ch = label.partition("[")
+        return Candidate(label, name, ch.rstrip("]") or None, 10.0, 2.0, 9.0, 2.0, 0.3, True, True)
+
+    return Verdict(kind, tuple(cand(x) for x in dict.fromkeys((*labels, *(n for n in (named,) if n), *rivals))),
+                   named=named, rivals=tuple(rivals))
+
+
+@pytest.mark.parametrize("verdicts, fitted, named, open_", [
+    # a cause named, then a second round of candidates left open: the first stays named
+    ([("named", "clearance", ()), ("candidates", "velocity_friction", ("pressure_friction", "bandwidth"))],
+     ["clearance", "velocity_friction"], ["clearance"], ("velocity_friction", "pressure_friction", "bandwidth")),
+    # candidates never told apart: nothing named
+    ([("candidates", "gauge_gain[input_bar]", ("zero_drift",)), ("none", None, ())],
+     ["gauge_gain[input_bar]"], [], ("gauge_gain[input_bar]", "zero_drift")),
+    # candidates whose rival a later round names: both are second causes, both named
+    ([("candidates", "clearance", ("dispersion",)), ("named", "dispersion", ())],
+     ["clearance", "dispersion"], ["clearance", "dispersion"], ()),
+    # candidates left open, then a cause named in a later round: the later cause is named, the first is not
+    ([("candidates", "velocity_friction", ("pressure_friction",)), ("named", "plug_friction", ())],
+     ["velocity_friction", "plug_friction"], ["plug_friction"], ("velocity_friction", "pressure_friction")),
+    # a gain whose rival is the same mechanism on another gauge: named, its gauge uncertain
+    ([("candidates", "gauge_gain[external_output_bar]", ("gauge_gain[input_bar]",))],
+     ["gauge_gain[external_output_bar]"], ["gauge_gain[external_output_bar]"], ()),
+])
+def test_named_causes_are_the_rounds_named_and_the_candidates_later_rounds_resolved(verdicts, fitted, named, open_):
+    from friction_uq.discrepancy.diagnose import Diagnosis
+    from friction_uq.discrepancy.extended import Variant
+
+    def variant(label):
+        name, _, ch = label.partition("[")
+        return Variant(MECHANISMS[name], ch.rstrip("]") or None)
+
+    dg = Diagnosis(baseline=None, rounds=(), misfits=(), causes=tuple(variant(x) for x in fitted), not_separable=(),
+                   separate_by=None, final=None, verdicts=tuple(_verdict(*v) for v in verdicts))
+    assert [v.label for v in dg.named_causes] == named
+    assert dg.open_candidates == open_
+    assert (dg.cause.label if dg.cause else None) == (named[0] if named else None)

@@ -178,7 +178,7 @@ def _outputs_intact(old: RecordResult, out_dir: Path) -> bool:
 
 
 def _summary(doc: dict[str, Any]) -> dict[str, dict[str, float]]:
-    """The stationary analysis' summaries (its f is ``f_stationary`` in a run JSON of schema version 2)."""
+    """The stationary analysis' summaries (its f is ``f_stationary`` in a run JSON of schema version 2 or later)."""
     key = {"f": "f_stationary"} if "f_stationary" in doc else {}
     return {k: {s: float(doc[key.get(k, k)][s]) for s in ("mean", "sd", "q05", "q50", "q95")}
             for k in SUMMARY_VARIABLES}

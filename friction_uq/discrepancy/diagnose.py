@@ -132,8 +132,29 @@ class Diagnosis:
         return self.verdicts[0] if self.verdicts else None
 
     @property
+    def named_causes(self) -> tuple[Variant, ...]:
+        """The causes the record names: each round's named cause, and a round's best candidate whose rivals
+        later rounds named (they were second causes, not alternatives); not a candidate fitted in turn whose
+        rivals stay open (``causes`` holds every mechanism of the final model)."""
+        open_rounds = set(unresolved_rounds(self.causes, self.verdicts))
+        return tuple(v for k, v in enumerate(self.causes) if k not in open_rounds)
+
+    @property
+    def open_candidates(self) -> tuple[str, ...]:
+        """The mechanisms (a gain with its gauge: ``gauge_gain[input_bar]``) of the first round of candidates no
+        later round told apart, the one fitted in turn first, whose stacking mixture gives f; () when none."""
+        rounds = unresolved_rounds(self.causes, self.verdicts)
+        if not rounds:
+            return ()
+        v = self.verdicts[rounds[0]]
+        by = {c.label: c.mechanism + (f"[{c.channel}]" if c.channel else "") for c in v.candidates}
+        return tuple(by[label] for label in (v.named, *v.rivals))
+
+    @property
     def cause(self) -> Variant | None:
-        return self.causes[0] if self.causes else None
+        """The first named cause (None when the record names none)."""
+        named = self.named_causes
+        return named[0] if named else None
 
     @property
     def ranking(self) -> tuple[Ranked, ...]:
@@ -259,19 +280,31 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
     return st
 
 
+def unresolved_rounds(causes, verdicts) -> tuple[int, ...]:
+    """The rounds whose verdict was candidates and one of whose rivals is a mechanism no round put in the
+    model (an alternative to the candidate fitted in turn, not a second cause): the record does not tell them
+    apart. A rival that is the same mechanism on another gauge does not count (the mechanism is named, its
+    gauge uncertain)."""
+    named = {v.mechanism.name for v in causes}
+    out = []
+    for k, verdict in enumerate(verdicts):
+        if verdict.kind == "candidates":
+            by = {c.label: c for c in verdict.candidates}
+            if any(by[label].mechanism not in named for label in verdict.rivals):
+                out.append(k)
+    return tuple(out)
+
+
 def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
                   seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
     is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
-    fits, weighted by that round's stacking weights; (None, {}, None) when every rival was resolved."""
+    fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved."""
     named = {v.mechanism.name for v in causes}
-    for k, verdict in enumerate(verdicts):
-        if verdict.kind != "candidates":
-            continue
+    for k in unresolved_rounds(causes, verdicts)[:1]:
+        verdict = verdicts[k]
         by = {c.label: c for c in verdict.candidates}
         left = [label for label in verdict.rivals if by[label].mechanism not in named]
-        if not left:
-            continue
         fits = {r.fit.label: r.fit for r in rounds[k]}
         draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
         w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}

@@ -25,8 +25,9 @@ def mixture_label(dg: Diagnosis) -> str:
 
 
 def unresolved(dg: Diagnosis) -> bool:
-    """A first round of candidates whose rivals no later round named: the causes fitted are not named, and f is
-    the mixture of the candidates (``Diagnosis.mixture_f``)."""
+    """A round of candidates whose rivals no later round named: the candidate fitted in turn is not named
+    (``Diagnosis.named_causes`` holds the causes that are), and f is the mixture of the candidates
+    (``Diagnosis.mixture_f``, ``Diagnosis.open_candidates``)."""
     return bool(dg.causes) and dg.mixture_f is not None
 
 
@@ -129,13 +130,21 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
         named += f" (the same on {alt} gauge explains the record about as well)"
     first = dg.ranking[0]
-    if unresolved(dg):  # candidates no later round told apart: the one fitted first is no more the cause than its
-        # rivals, and f is their mixture
+    if unresolved(dg):  # candidates no later round told apart: the one fitted in turn is no more the cause than
+        # its rivals, and f is their mixture
         fx = summarize_draws(dg.mixture_f)
-        lead = ("Candidates, not a cause: this record does not tell apart "
-                f"{', '.join(dg.not_separable or [v.mechanism.name for v in dg.causes])}; fitted in turn: {named}.")
+        found = [s for s in steps if s[0] in dg.named_causes]
+        turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v not in dg.named_causes)
+        rivals = ", ".join(dg.open_candidates)
+        if found:
+            lead = (f"Causes found, the one that moves f most first: "
+                    f"{'; '.join(f'{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}' for v, a, b in found)}. A further "
+                    f"cause this record does not tell apart: {rivals} (fitted in turn: {turn}).")
+        else:
+            lead = ("Candidates, not a cause: this record does not tell apart "
+                    f"{', '.join(dg.not_separable) or rivals}; fitted in turn: {named}.")
         quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
-        evidence = "strongest candidate"
+        evidence = "first cause" if found else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     else:
         lead = f"Causes found, the one that moves f most first: {named}."

@@ -9,7 +9,7 @@ from ..models.parameters import effective_sample_size, summarize_draws
 from ..stats import khat_threshold
 from ..stats.streams import stream
 from .diagnose import Diagnosis, ModelFit, Ranked
-from .diagnosis_words import baseline_hoop_gain, chain_gauge, hoop_gain_off, mixture_label, sentence, unresolved
+from .diagnosis_words import baseline_hoop_gain, chain_gauge, hoop_gain_off, mixture_label, sentence
 from .effective_prior import log_prior_f_effective
 from .extended import IMPORTANCE_DRAWS
 
@@ -52,9 +52,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
     hoop = dg.final.hoop_gain
     v = dg.verdict
     return {
-        # the record's: named when causes were (a first round's candidates resolved by later rounds); candidates
-        # whose rivals stay unresolved: "candidates" (the causes fitted in turn are in `causes`, f is `mixture`'s)
-        "verdict": (("candidates" if unresolved(dg) else "named") if dg.causes
+        # the record's: named when a cause is (a round's candidates resolved by later rounds count); candidates
+        # when none is but a candidate was fitted in turn (`fitted_in_turn`; `open_candidates`, f is `mixture`'s)
+        "verdict": ("named" if dg.named_causes else "candidates" if dg.causes
                     else (v.kind if v is not None else None)),
         "round_verdicts": [r.kind for r in dg.verdicts],
         "stacking_weights": dict(v.weights) if v is not None else {},
@@ -65,7 +65,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
         # a measurement-chain fault fitted on every gauge: the gauge whose parameter departs most from reading right
         "cause_gauge": (chain_gauge(cause, dg) or (None,))[0] if cause else None,
         "cause_channel_not_separable": list(dg.channels_not_separable),
-        "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.causes],
+        "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.named_causes],
+        "fitted_in_turn": [c.label for c in dg.causes],
+        "open_candidates": list(dg.open_candidates),
         "not_separable": list(dg.not_separable),
         "separate_by": dg.separate_by,
         "ranking": [_entry(r, v) for r in dg.ranking],

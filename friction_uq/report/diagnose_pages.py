@@ -33,7 +33,7 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
 
     rows, labels, named, seps, colours = [], [], [], [], []
     for k, rnd in enumerate(dg.rounds):
-        cause = dg.causes[k] if k < len(dg.causes) else None
+        cause = dg.causes[k] if k < len(dg.causes) and dg.causes[k] in dg.named_causes else None
         judged = {c.label: c for c in dg.verdicts[k].candidates} if k < len(dg.verdicts) else {}
         for r in rnd:
             c = judged.get(r.fit.label)
@@ -87,7 +87,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
              f"(nu {np.median(dg.final.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.final)):.4f})",
              f"hoop gauge gain (final model, most probable under its 5 % prior): {dg.final.hoop_gain:.3f}", ""]
     for v in dg.causes:
-        lines.append(f"{v.mechanism.name}{' (' + v.channel + ')' if v.channel else ''}: {v.mechanism.meaning}")
+        turn = "" if v in dg.named_causes else " (a candidate fitted in turn, not named)"
+        lines.append(f"{v.mechanism.name}{' (' + v.channel + ')' if v.channel else ''}{turn}: {v.mechanism.meaning}")
         for p in v.mechanism.parameters:
             x = dg.final.fit.draws[p.name]
             q = np.quantile(x, [0.05, 0.5, 0.95])

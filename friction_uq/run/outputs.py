@@ -56,7 +56,7 @@ def reproducible(dt):
 #: The run's JSON: its schema name and version (2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
-RUN_SCHEMA_VERSION = 2
+RUN_SCHEMA_VERSION = 3
 
 
 def quoted_f(f_stationary: dict[str, float], diagnosis=None) -> dict[str, object]:

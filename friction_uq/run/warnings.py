@@ -70,15 +70,21 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     if diagnosis.mixture_f is not None:  # unexplained, or candidates (fitted in turn or not) the record leaves open
         fm = headline(diagnosis)[1]
         q05, q50, q95 = fm["q05"], fm["q50"], fm["q95"]
-        what = "no single cause explains it" if not diagnosis.causes and diagnosis.verdict.kind == "unexplained" \
-            else "the record does not tell its candidate causes apart" + (
-                f" ({', '.join(diagnosis.not_separable)})" if diagnosis.not_separable else "")
+        named = ", ".join(v.label for v in diagnosis.named_causes)
+        open_ = diagnosis.not_separable or diagnosis.open_candidates
+        listed = f" ({', '.join(open_)})" if open_ else ""
+        if not diagnosis.causes and diagnosis.verdict.kind == "unexplained":
+            what = "no single cause explains it"
+        elif named:
+            what = f"it names {named}, and a further cause among candidates the record does not tell apart{listed}"
+        else:
+            what = f"the record does not tell its candidate causes apart{listed}"
         return (f"`diagnose`: {what}; f from their stacking mixture is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the "
                 "JSON's f), wide enough for whichever is right: quote that, with this warning.")
     if not diagnosis.causes:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
     fx = diagnosis.final.f_summary()
-    names = ", ".join(v.label for v in diagnosis.causes)
+    names = ", ".join(v.label for v in diagnosis.named_causes)
     return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "
             "(the JSON's f), which is the f to quote.")
 
