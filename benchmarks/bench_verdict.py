@@ -28,7 +28,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from friction_uq.discrepancy.diagnose import Ranked, mixture
+from friction_uq.discrepancy.candidates_mixture import mixture
+from friction_uq.discrepancy.diagnose import Ranked
 from friction_uq.discrepancy.elpd import Elpd, elpd_difference
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS

@@ -379,3 +379,26 @@ def test_named_causes_are_the_rounds_named_and_the_candidates_later_rounds_resol
     assert [v.label for v in dg.named_causes] == named
     assert dg.open_candidates == open_
     assert (dg.cause.label if dg.cause else None) == (named[0] if named else None)
+
+
+def test_a_misfit_left_after_the_named_causes_is_said():
+    """After a named cause, a round that finds the misfit the check still flags unexplained: the sentence says a
+    misfit remains, where, and the candidates that carry the weight; nothing is said when the last round found
+    nothing to explain."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.diagnosis_words import _remaining
+
+    left = replace(_verdict("unexplained", labels=("gauge_gain[external_output_bar]", "dispersion", "clearance")),
+                   weights={"reference": 0.1, "gauge_gain[external_output_bar]": 0.6, "dispersion": 0.35,
+                            "clearance": 0.0})
+    cell = SimpleNamespace(channel="external_output_bar", phase="stationary")
+    misfits = (SimpleNamespace(flagged=lambda: [cell]),) * 2
+    dg = SimpleNamespace(verdicts=(_verdict("named", "plug_friction"), left), misfits=misfits)
+    said = _remaining(dg)
+    assert said.startswith(" A misfit remains with them on the external transmitted gauge, stationary phase"), said
+    assert "(candidates: gauge_gain[external_output_bar], dispersion)" in said, said
+    assert _remaining(SimpleNamespace(verdicts=(_verdict("named", "plug_friction"), _verdict("none")),
+                                      misfits=misfits)) == ""
+    assert _remaining(SimpleNamespace(verdicts=(left,), misfits=misfits[:1])) == ""  # no cause named before it

@@ -29,18 +29,16 @@ import numpy as np
 
 from ..analysis import Prepared
 from ..stats import RULE
-from ..stats.streams import stream
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide
-from .verdict import NamingRule, Verdict, mixture_draws
+from .candidates_mixture import mixture, rival_mixture, unresolved_rounds
+from .verdict import NamingRule, Verdict
 from .whole_record import WholeRecord, compare_whole_record
 
 #: The naming rule of every round (:mod:`.verdict`).
 NAMING = NamingRule()
-#: Draws of the stacking mixture that gives f when no single cause is named.
-MIXTURE_DRAWS = 1000
 
 MAX_CAUSES = 4
 #: Processes fitting one round's extended models by default.
@@ -278,62 +276,6 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
         st.causes.append(best.fit.variants[-1])
         st.reference = best.fit
     return st
-
-
-def unresolved_rounds(causes, verdicts) -> tuple[int, ...]:
-    """The rounds whose verdict was candidates and one of whose rivals is a mechanism no round put in the
-    model (an alternative to the candidate fitted in turn, not a second cause): the record does not tell them
-    apart. A rival that is the same mechanism on another gauge does not count (the mechanism is named, its
-    gauge uncertain)."""
-    named = {v.mechanism.name for v in causes}
-    out = []
-    for k, verdict in enumerate(verdicts):
-        if verdict.kind == "candidates":
-            by = {c.label: c for c in verdict.candidates}
-            if any(by[label].mechanism not in named for label in verdict.rivals):
-                out.append(k)
-    return tuple(out)
-
-
-def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
-                  seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
-    """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
-    is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
-    fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved."""
-    named = {v.mechanism.name for v in causes}
-    for k in unresolved_rounds(causes, verdicts)[:1]:
-        verdict = verdicts[k]
-        by = {c.label: c for c in verdict.candidates}
-        left = [label for label in verdict.rivals if by[label].mechanism not in named]
-        fits = {r.fit.label: r.fit for r in rounds[k]}
-        draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
-        w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
-        if sum(w.values()) <= 0.0:
-            w = {label: 1.0 for label in w}
-        return _draw_mixture(draws, w, seed)
-    return None, {}, None
-
-
-def mixture(base: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict,
-            seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
-    """f's draws from the stacking mixture of the models that carry the weight (:mod:`.verdict`), their weights
-    and each draw's model, when the first round named no single cause but found candidates or an unexplained
-    misfit; (None, {}, None) otherwise."""
-    if verdict.kind not in ("candidates", "unexplained", "unconfirmed"):
-        return None, {}, None
-    fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
-    keep = [k for k in verdict.supported if verdict.weights[k] > 0.0]
-    w = {k: verdict.weights[k] for k in keep}
-    return _draw_mixture({k: fits[k].f_effective for k in keep}, w, seed)
-
-
-def _draw_mixture(draws: dict[str, np.ndarray], weights: dict[str, float],
-                  seed: int) -> tuple[np.ndarray, dict[str, float], np.ndarray]:
-    """:data:`MIXTURE_DRAWS` draws of the mixture (the "mixture" stream of ``seed``), the weights normalised, and
-    each draw's model."""
-    x, which = mixture_draws(draws, weights, n=MIXTURE_DRAWS, rng=stream(seed, "mixture"))
-    total = sum(weights.values())
-    return x, {k: v / total for k, v in weights.items()}, which
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

@@ -154,8 +154,23 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
             if dg.not_separable else ""
     return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from "
             f"the stationary analysis without them. Why: {_describe(dg)}; the {evidence}'s evidence is "
-            f"{first.delpd:.0f} +- {first.se:.0f} nats.{sep}"
+            f"{first.delpd:.0f} +- {first.se:.0f} nats.{sep}{_remaining(dg)}"
             f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
+
+
+def _remaining(dg: Diagnosis) -> str:
+    """' A misfit remains with them (on the ... gauge, ... phase) that no further cause explains clearly (candidates:
+    ...).' when the round after the last cause found the misfit the check still flags unexplained; '' otherwise."""
+    last = dg.verdicts[-1] if len(dg.verdicts) > 1 else None
+    if last is None or last.kind != "unexplained":
+        return ""
+    cells = dg.misfits[-1].flagged() if dg.misfits else []
+    where = f" on the {CHANNEL_LABELS.get(cells[0].channel, cells[0].channel)} gauge, {cells[0].phase} phase" \
+        if cells else ""
+    by = {c.label: c.mechanism + (f"[{c.channel}]" if c.channel else "") for c in last.candidates}
+    listed = [by[label] for label in last.supported if label in by]
+    return (f" A misfit remains with them{where} that no further cause explains clearly"
+            f"{' (candidates: ' + ', '.join(listed) + ')' if listed else ''}.")
 
 
 def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
