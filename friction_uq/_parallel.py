@@ -197,7 +197,11 @@ class ForkedPool:
             if _POOLED is not None:
                 raise RuntimeError("one ForkedPool at a time per process")
             _POOLED = self._fn
-            self._pool = multiprocessing.get_context("fork").Pool(self._workers, initializer=end_with_parent)
+            try:
+                self._pool = multiprocessing.get_context("fork").Pool(self._workers, initializer=end_with_parent)
+            except BaseException:  # no pool (the fork failed): nothing holds the function any more
+                _POOLED = None
+                raise
         return self
 
     def __exit__(self, *exc: object) -> None:

@@ -53,9 +53,14 @@ def test_up_to_date_needs_same_record_settings_prior_version_and_outputs(tmp_pat
     import hashlib
 
     (tmp_path / "A_A-01.nc").write_bytes(b"draws")  # the run JSON names the .nc's checksum
-    (tmp_path / "A_A-01.json").write_text(json.dumps({"outputs": {"netcdf": {
-        "file": "A_A-01.nc", "sha256": hashlib.sha256(b"draws").hexdigest()}, "pdf": None}}))
+    from friction_uq.run.outputs import RUN_SCHEMA_VERSION
+
+    run_json = {"schema_version": RUN_SCHEMA_VERSION, "outputs": {"netcdf": {
+        "file": "A_A-01.nc", "sha256": hashlib.sha256(b"draws").hexdigest()}, "pdf": None}}
+    (tmp_path / "A_A-01.json").write_text(json.dumps(run_json | {"schema_version": RUN_SCHEMA_VERSION - 1}))
     old = _result(outputs={"json": "A_A-01.json", "netcdf": "A_A-01.nc"})
+    assert not _up_to_date(old, _result(status="failed"), tmp_path)  # an older run's JSON: its keys meant other things
+    (tmp_path / "A_A-01.json").write_text(json.dumps(run_json))
     assert _up_to_date(old, _result(status="failed"), tmp_path)
     for change in ({"record_sha256": "ff" * 32}, {"prior_sha256": "ee" * 32}, {"friction_uq_version": "0.0.1"},
                    {"settings": old.settings | {"seed": 6}}, {"settings": old.settings | {"dispersion": True}}):

@@ -159,12 +159,17 @@ def _up_to_date(old: RecordResult, new: RecordResult, out_dir: Path) -> bool:
 
 
 def _outputs_intact(old: RecordResult, out_dir: Path) -> bool:
-    """The stored outputs are there and are the bytes their run wrote: the run JSON names the sha256 of the
-    ``.nc`` and the ``.pdf``. Anything missing, unreadable or changed: False (the record is analysed again)."""
+    """The stored outputs are there, are the bytes their run wrote (the run JSON names the sha256 of the ``.nc``
+    and the ``.pdf``) and the run JSON is of this package's schema version. Anything missing, unreadable, changed
+    or older: False (the record is analysed again)."""
     try:
         if not all((out_dir / name).is_file() for name in old.outputs.values()):
             return False
         doc = json.loads((out_dir / old.outputs["json"]).read_text())
+        from ..run.outputs import RUN_SCHEMA_VERSION
+
+        if doc.get("schema_version") != RUN_SCHEMA_VERSION:  # written by an older run: its keys meant other things
+            return False
         for kind in ("netcdf", "pdf"):
             if kind not in old.outputs:
                 continue

@@ -126,10 +126,11 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
                 f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     steps = sorted(f_steps(dg), key=lambda s: -abs(s[2] - s[1]))
     named = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
-    if dg.channels_not_separable:
+    gauges = ""  # the first round's cause, a gain, about as good on another gauge
+    if dg.channels_not_separable and dg.cause is dg.causes[0]:
         alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
-        named += f" (the same on {alt} gauge explains the record about as well)"
-    first = dg.ranking[0]
+        gauges = f" (the same on {alt} gauge explains the record about as well)"
+    first = _evidence_of(dg, dg.cause) if dg.cause is not None else dg.ranking[0]
     if unresolved(dg):  # candidates no later round told apart: the one fitted in turn is no more the cause than
         # its rivals, and f is their mixture
         fx = summarize_draws(dg.mixture_f)
@@ -138,8 +139,8 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         rivals = ", ".join(dg.open_candidates)
         if found:
             lead = (f"Causes found, the one that moves f most first: "
-                    f"{'; '.join(f'{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}' for v, a, b in found)}. A further "
-                    f"cause this record does not tell apart: {rivals} (fitted in turn: {turn}).")
+                    f"{'; '.join(f'{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}' for v, a, b in found)}{gauges}. A "
+                    f"further cause this record does not tell apart: {rivals} (fitted in turn: {turn}).")
         else:
             lead = ("Candidates, not a cause: this record does not tell apart "
                     f"{', '.join(dg.not_separable) or rivals}; fitted in turn: {named}.")
@@ -147,7 +148,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         evidence = "first cause" if found else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     else:
-        lead = f"Causes found, the one that moves f most first: {named}."
+        lead = f"Causes found, the one that moves f most first: {named}{gauges}."
         quote = "with them (the f to quote)"
         evidence = "first cause"
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
@@ -156,6 +157,13 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
             f"the stationary analysis without them. Why: {_describe(dg)}; the {evidence}'s evidence is "
             f"{first.delpd:.0f} +- {first.se:.0f} nats.{sep}{_remaining(dg)}"
             f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
+
+
+def _evidence_of(dg: Diagnosis, cause: Variant):
+    """The ranking entry (dELPD +- SE over its round's reference) of a cause, from the round that fitted it."""
+    k = dg.causes.index(cause)
+    return next((r for r in dg.rounds[k] if r.fit.variants[-1] == cause), dg.ranking[0]) if k < len(dg.rounds) \
+        else dg.ranking[0]
 
 
 def _remaining(dg: Diagnosis) -> str:

@@ -64,7 +64,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
         "cause_channel": cause.channel if cause else None,
         # a measurement-chain fault fitted on every gauge: the gauge whose parameter departs most from reading right
         "cause_gauge": (chain_gauge(cause, dg) or (None,))[0] if cause else None,
-        "cause_channel_not_separable": list(dg.channels_not_separable),
+        # the first round's: said of the cause only when it is the one that round fitted
+        "cause_channel_not_separable": list(dg.channels_not_separable) if cause is not None and cause is dg.causes[0]
+        else [],
         "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.named_causes],
         "fitted_in_turn": [c.label for c in dg.causes],
         "open_candidates": list(dg.open_candidates),

@@ -19,6 +19,9 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, 
     if named is not None:
         label, fx = named
         if diagnosis.mixture_f is not None:  # unexplained, or candidates the record does not tell apart
+            named = ", ".join(v.label for v in diagnosis.named_causes)
+            if named:  # a cause named, a later round's candidates left open
+                return f"the {label}: the causes diagnose named ({named}) and candidates it could not tell apart", fx
             return f"the {label}, candidates diagnose could not tell apart", fx
         return f"the model with the causes diagnose named ({label})", fx
     return "the stationary analysis (eq. 17 and the hoop gauge)", f_stationary

@@ -53,7 +53,8 @@ def reproducible(dt):
 
 
 
-#: The run's JSON: its schema name and version (2: ``f`` is the f to quote, the stationary analysis' f is
+#: The run's JSON: its schema name and version (3: ``discrepancy.causes`` holds only the named causes, beside
+#: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
 RUN_SCHEMA_VERSION = 3

@@ -71,7 +71,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
         fm = headline(diagnosis)[1]
         q05, q50, q95 = fm["q05"], fm["q50"], fm["q95"]
         named = ", ".join(v.label for v in diagnosis.named_causes)
-        open_ = diagnosis.not_separable or diagnosis.open_candidates
+        open_ = diagnosis.open_candidates if named else (diagnosis.not_separable or diagnosis.open_candidates)
         listed = f" ({', '.join(open_)})" if open_ else ""
         if not diagnosis.causes and diagnosis.verdict.kind == "unexplained":
             what = "no single cause explains it"
