@@ -170,8 +170,10 @@ def test_a_record_locked_by_a_dying_worker_is_waited_for(good_record, tmp_path, 
 def _stored(tmp_path: Path, nc: bytes = b"netcdf bytes") -> job.RecordResult:
     import hashlib
 
+    from friction_uq.run.outputs import RUN_SCHEMA_VERSION
+
     (tmp_path / "s.nc").write_bytes(nc)
-    (tmp_path / "s.json").write_text(json.dumps({"outputs": {"netcdf": {
+    (tmp_path / "s.json").write_text(json.dumps({"schema_version": RUN_SCHEMA_VERSION, "outputs": {"netcdf": {
         "file": "s.nc", "sha256": hashlib.sha256(b"netcdf bytes").hexdigest()}, "pdf": None}}))
     return job.RecordResult(path="r.h5", status="done", outputs={"netcdf": "s.nc", "json": "s.json"})
 
