@@ -26,14 +26,16 @@ def unresolved_rounds(causes, verdicts) -> tuple[int, ...]:
     model (an alternative to the candidate fitted in turn, not a second cause): the record does not tell them
     apart. A rival that is the same mechanism on another gauge does not count (the mechanism is named, its
     gauge uncertain)."""
+    return tuple(k for k, verdict in enumerate(verdicts) if _open_rivals(verdict, causes))
+
+
+def _open_rivals(verdict: Verdict, causes) -> list[str]:
+    """The labels of a round of candidates' rivals whose mechanism no round put in the model ([] otherwise)."""
+    if verdict.kind != "candidates":
+        return []
     named = {v.mechanism.name for v in causes}
-    out = []
-    for k, verdict in enumerate(verdicts):
-        if verdict.kind == "candidates":
-            by = {c.label: c for c in verdict.candidates}
-            if any(by[label].mechanism not in named for label in verdict.rivals):
-                out.append(k)
-    return tuple(out)
+    by = {c.label: c.mechanism for c in verdict.candidates}
+    return [label for label in verdict.rivals if by[label] not in named]
 
 
 def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
@@ -41,11 +43,9 @@ def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes
     """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
     is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
     fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved."""
-    named = {v.mechanism.name for v in causes}
     for k in unresolved_rounds(causes, verdicts)[:1]:
         verdict = verdicts[k]
-        by = {c.label: c for c in verdict.candidates}
-        left = [label for label in verdict.rivals if by[label].mechanism not in named]
+        left = _open_rivals(verdict, causes)
         fits = {r.fit.label: r.fit for r in rounds[k]}
         draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
         w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}

@@ -145,7 +145,7 @@ class Diagnosis:
         if not rounds:
             return ()
         v = self.verdicts[rounds[0]]
-        by = {c.label: c.mechanism + (f"[{c.channel}]" if c.channel else "") for c in v.candidates}
+        by = {c.label: c.variant for c in v.candidates}
         return tuple(by[label] for label in (v.named, *v.rivals))
 
     @property

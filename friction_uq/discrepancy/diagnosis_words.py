@@ -175,7 +175,7 @@ def _remaining(dg: Diagnosis) -> str:
     cells = dg.misfits[-1].flagged() if dg.misfits else []
     where = f" on the {CHANNEL_LABELS.get(cells[0].channel, cells[0].channel)} gauge, {cells[0].phase} phase" \
         if cells else ""
-    by = {c.label: c.mechanism + (f"[{c.channel}]" if c.channel else "") for c in last.candidates}
+    by = {c.label: c.variant for c in last.candidates}
     listed = [by[label] for label in last.supported if label in by]
     return (f" A misfit remains with them{where} that no further cause explains clearly"
             f"{' (candidates: ' + ', '.join(listed) + ')' if listed else ''}.")

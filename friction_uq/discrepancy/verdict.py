@@ -67,6 +67,11 @@ class Candidate:
     def passes(self) -> bool:
         return self.decisive and self.spread
 
+    @property
+    def variant(self) -> str:
+        """The mechanism as fitted, a gain with its gauge (``gauge_gain[input_bar]``; ``Variant.label``'s form)."""
+        return self.mechanism + (f"[{self.channel}]" if self.channel else "")
+
 
 @dataclass(frozen=True)
 class Verdict:
