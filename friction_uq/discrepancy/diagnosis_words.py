@@ -7,11 +7,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..models.parameters import Parameter, summarize_draws
+from ..models.parameters import Parameter
+from ..quoted import quoted_summary
 from .diagnose import Diagnosis
 from .extended import Variant
+from .record_likelihood import GAIN_SD
 from .whole_record import CHANNEL_LABELS
 
+#: The part of eq. 17's ratio's calibration sd the whole-record fits already marginalise (each output bar gauge's
+#: gain): the f to quote folds in the rest (:func:`friction_uq.quoted.quoted_summary`).
+RATIO_GAIN_SD = float(np.hypot(GAIN_SD["internal_output_bar"], GAIN_SD["external_output_bar"]))
 #: A hoop gain this far from 1 (its most probable value under its 5 % prior) is reported as a calibration finding
 #: (clean records: see benchmarks/bench_misfit.py for how often a right gauge reads this far off).
 HOOP_GAIN_FINDING = 0.02
@@ -34,11 +39,12 @@ def unresolved(dg: Diagnosis) -> bool:
 def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
     """The headline f of a diagnosed record: the final model's label and its f when a cause was named; the
     stacking mixture's when the record named candidates or an unexplained misfit (:mod:`.verdict`); None when
-    nothing needed explaining (the headline is then the stationary analysis' f)."""
+    nothing needed explaining (the headline is then the stationary analysis' f). The f's summary carries the output
+    bars' calibration (:mod:`friction_uq.quoted`), as the JSON's ``f`` does."""
     if dg.mixture_f is not None:
-        return mixture_label(dg), summarize_draws(dg.mixture_f)
+        return mixture_label(dg), quoted_summary(dg.mixture_f, marginalised_sd=RATIO_GAIN_SD)
     if dg.causes:
-        return dg.final.label, dg.final.f_summary()
+        return dg.final.label, quoted_summary(dg.final.f_effective, marginalised_sd=RATIO_GAIN_SD)
     return None
 
 
@@ -110,8 +116,8 @@ def cause_words(v: Variant, dg: Diagnosis | None = None) -> str:
 
 def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     """One line for the terminal and the summary page, in an experimentalist's words: the causes, the one that
-    moves f most first, with f before and after each; then f to quote; then where the simple model missed."""
-    fx = dg.final.f_summary()
+    moves f most first, with f before and after each; then f to quote (:func:`headline`'s); then where the simple
+    model missed. ``f_without``: the stationary analysis' f to quote."""
     if not dg.causes and dg.mixture_f is not None:
         return _mixture_sentence(dg, f_without)
     if not dg.causes and dg.misfits and not dg.misfits[0].detected:
@@ -133,7 +139,6 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     first = _evidence_of(dg, dg.cause) if dg.cause is not None else dg.ranking[0]
     if unresolved(dg):  # candidates no later round told apart: the one fitted in turn is no more the cause than
         # its rivals, and f is their mixture
-        fx = summarize_draws(dg.mixture_f)
         found = [s for s in steps if s[0] in dg.named_causes]
         turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v not in dg.named_causes)
         rivals = ", ".join(dg.open_candidates)
@@ -153,6 +158,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         evidence = "first cause"
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
+    fx = headline(dg)[1]
     return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from "
             f"the stationary analysis without them. Why: {_describe(dg)}; the {evidence}'s evidence is "
             f"{first.delpd:.0f} +- {first.se:.0f} nats.{sep}{_remaining(dg)}"
@@ -183,7 +189,7 @@ def _remaining(dg: Diagnosis) -> str:
 
 def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     """The sentence of a record whose misfit no single cause explains (candidates, or unexplained)."""
-    fm = summarize_draws(dg.mixture_f)
+    fm = headline(dg)[1]
     shares = ", ".join(f"{'no cause' if k == 'reference' else _words_of(dg, k)} {100 * w:.0f} %"
                        for k, w in dg.mixture_weights.items())
     v = dg.verdict

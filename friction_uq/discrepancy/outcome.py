@@ -46,8 +46,11 @@ def _entry(r: Ranked, verdict=None) -> dict[str, object]:
             "draws": int(len(r.fit.f_effective)), "ess": _ess(r.fit.fit.log_weights)}
 
 
-def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
-    """The JSON ``discrepancy`` block."""
+def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[str, float] | None = None
+            ) -> dict[str, object]:
+    """The JSON ``discrepancy`` block: the posteriors' summaries (given the bars' header values) and the sentence,
+    which quotes ``f_without_quoted`` (the stationary f with the bars' calibration, as the JSON's ``f``; default
+    ``f_without``) where the stationary f stands."""
     cause = dg.cause
     hoop = dg.final.hoop_gain
     v = dg.verdict
@@ -104,7 +107,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
                 "plus the calibration data (hoop gauge factor 1 +- 5 %, the header's sample modulus +- 10 %) each left "
                 "out in turn (calibration_elpd per model)",
         "seconds": dg.seconds,
-        "sentence": sentence(dg, f_without),
+        "sentence": sentence(dg, f_without if f_without_quoted is None else f_without_quoted),
     }
 
 

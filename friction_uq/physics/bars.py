@@ -76,3 +76,15 @@ def trapezoid_pulse(t: ArrayLike, *, rise_time: float, end: float, amplitude: fl
     up = np.clip(t / rise_time, 0.0, 1.0)
     down = np.clip((end - t) / rise_time, 0.0, 1.0)
     return amplitude * np.minimum(up, down)
+
+
+#: Relative standard deviation of one output bar's force E A eps from its calibration: the modulus (~1 %), the
+#: section (~1 %, 0.5 % on a diameter) and the gauge's factor with its amplifier (~1 %), independent.
+BAR_FORCE_CALIBRATION_SD = float(np.sqrt(3.0)) * 0.01
+#: Relative standard deviation of eq. 17's ratio F_eo / F_io from the two output bars' calibrations, which the
+#: stationary phase cannot tell from f (the equilibrium with the input bar checks the forces' sum, within that bar's
+#: own calibration): sqrt(2) x :data:`BAR_FORCE_CALIBRATION_SD`,
+#: 2.45 %. f = ln(1 + r) / beta(nu) (eq. 17) moves by r / ((1 + r) ln(1 + r)) of the ratio's relative error (0.93
+#: at r = 0.15, below 1 for every r > 0): taken as 1, a slightly wider interval of f.
+FORCE_RATIO_CALIBRATION_SD = float(np.sqrt(2.0)) * BAR_FORCE_CALIBRATION_SD
+

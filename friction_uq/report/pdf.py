@@ -19,6 +19,7 @@ from ..discrepancy.check import WholeRecordCheck
 from ..discrepancy.diagnosis_words import headline as outcome_headline
 from .quote import quote_line
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
+from ..quoted import quoted_summary
 from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
@@ -59,6 +60,11 @@ def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
 
+def stationary_quoted(r: ReportInputs) -> dict[str, float]:
+    """The stationary analysis' f to quote: its posterior with the output bars' calibration (as the JSON's)."""
+    return quoted_summary(r.samples.flat("f"))
+
+
 def page_summary(r: ReportInputs) -> Figure:
     """Page: the answer first, in words and one table."""
     rec = r.prepared.record
@@ -72,7 +78,8 @@ def page_summary(r: ReportInputs) -> Figure:
                   if named is not None else "The stationary analysis: ")
     lines = [f"WARNING: {w}" for w in r.warnings] + [
         stationary + f"f = {f.q50:.4f}, 90 % credible interval [{f.q05:.4f}, {f.q95:.4f}] "
-        f"(posterior mean {f.mean:.4f}, sd {f.sd:.4f}).",
+        f"(posterior mean {f.mean:.4f}, sd {f.sd:.4f}; given the output bars' header values, whose calibration "
+        "the first line includes).",
         f"Poisson ratio nu = {nu.q50:.3f} [{nu.q05:.3f}, {nu.q95:.3f}]; the forces fix only "
         f"kappa = f nu/(1-nu) = {s['kappa'].q50:.4f} [{s['kappa'].q05:.4f}, {s['kappa'].q95:.4f}] (eq. 17).",
         f"{100 * share:.0f} % of the variance of f comes from the uncertainty of nu (law of total variance).",
@@ -94,10 +101,10 @@ def page_summary(r: ReportInputs) -> Figure:
     if r.diagnosis is not None:
         from ..discrepancy.diagnosis_words import sentence
 
-        lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, s["f"].to_json()))
+        lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, stationary_quoted(r)))
     # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
     # together where they would run into the table below them
-    first = "\n".join(textwrap.wrap(quote_line(f.to_json(), r.diagnosis, len(r.warnings)), 80))
+    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings)), 80))
     ax.text(0.0, 1.0, first, fontsize=13, va="top", transform=ax.transAxes, weight="bold",
             color="firebrick" if r.warnings else "black")
     top = 0.97 - 0.06 * (first.count("\n") + 1)
@@ -217,9 +224,10 @@ def diagnosis_pages(r: ReportInputs) -> list[Figure]:
     from .diagnose_pages import page_extended_fit, page_ranking
 
     test = f"{r.prepared.record.campaign} {r.prepared.record.test_id}"
-    fw = r.summary["f"].to_json()
     n = whole_record_page(r) + 2
-    return [page_ranking(r.diagnosis, f_without=fw, sentence=sentence(r.diagnosis, fw), test=f"{n}. {test}"),
+    return [page_ranking(r.diagnosis, f_without=r.summary["f"].to_json(), sentence=sentence(r.diagnosis,
+                                                                                         stationary_quoted(r)),
+                         test=f"{n}. {test}"),
             page_extended_fit(r.diagnosis, test=f"{n + 1}. {test}")]
 
 

@@ -14,7 +14,8 @@ from ..discrepancy.diagnosis_words import headline
 
 
 def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, Mapping[str, float]]:
-    """(where it comes from, its summary: q05, q50, q95, ...)."""
+    """(where it comes from, its summary: q05, q50, q95, ...). ``f_stationary``: the stationary analysis' f to
+    quote (its posterior with the output bars' calibration, :mod:`friction_uq.quoted`), as the diagnosis's is."""
     named = None if diagnosis is None else headline(diagnosis)
     if named is not None:
         label, fx = named
@@ -28,9 +29,11 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, 
 
 
 def quote_line(f_stationary: Mapping[str, float], diagnosis=None, n_warnings: int = 0) -> str:
-    """'Headline f = 0.0487 [0.0445, 0.0531] (90 %), from ...; every check passed' (or the warnings' count)."""
+    """'Headline f = 0.0487 [0.0445, 0.0531] (90 %, the output bars' calibration included), from ...; every check
+    passed' (or the warnings' count)."""
     source, fx = f_to_quote(f_stationary, diagnosis)
     trust = ("every check passed" if n_warnings == 0 else
              f"{n_warnings} warning{'s' if n_warnings > 1 else ''}: read {'them' if n_warnings > 1 else 'it'} "
              "before quoting it")
-    return f"Headline f = {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] (90 %), from {source}; {trust}."
+    return (f"Headline f = {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] (90 %, the output bars' calibration "
+            f"included), from {source}; {trust}.")

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..diagnostics import Convergence, VariableSummary
 from ..errors import OutputError, os_error_text
+from ..models.parameters import summarize_draws
 from ..prior_sensitivity import PriorDataConflict
 
 
@@ -53,24 +54,40 @@ def reproducible(dt):
 
 
 
-#: The run's JSON: its schema name and version (3: ``discrepancy.causes`` holds only the named causes, beside
+#: The run's JSON: its schema name and version (4: ``f``'s interval carries the output bars' calibration, the
+#: posterior's own is ``f.given_bar_headers``; 3: ``discrepancy.causes`` holds only the named causes, beside
 #: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
-RUN_SCHEMA_VERSION = 3
+RUN_SCHEMA_VERSION = 4
 
 
-def quoted_f(f_stationary: dict[str, float], diagnosis=None) -> dict[str, object]:
-    """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`), the model it comes from
-    and, under named causes, how its posterior was approximated and the Pareto k that judges it."""
-    from ..discrepancy.diagnosis_words import headline
+def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],
+             diagnosis=None) -> dict[str, object]:
+    """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`, with the output bars'
+    calibration: :mod:`friction_uq.quoted`), the model it comes from, the calibration's sd (the budget, and what was
+    folded in beyond what the model's likelihood carries) and the same f given
+    the bars' header values (``given_bar_headers``, the posterior's own); under named causes, how its posterior
+    was approximated and the Pareto k that judges it. ``f_stationary``: the stationary f to quote,
+    ``f_stationary_posterior`` its posterior summary."""
+    from ..discrepancy.diagnosis_words import RATIO_GAIN_SD, headline
+    from ..physics.bars import FORCE_RATIO_CALIBRATION_SD
+    from ..quoted import folded_sd
     from ..report.quote import f_to_quote
 
     source, fx = f_to_quote(f_stationary, diagnosis)
     named = None if diagnosis is None else headline(diagnosis)
     model = "stationary" if named is None else named[0]
+    if named is None:
+        given = f_stationary_posterior
+    else:
+        draws = diagnosis.mixture_f if diagnosis.mixture_f is not None else diagnosis.final.f_effective
+        given = summarize_draws(draws)
     out: dict[str, object] = ({"model": model, "source": source}
-                              | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")})
+                              | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
+                              | {"bar_calibration_sd": FORCE_RATIO_CALIBRATION_SD,
+                                 "calibration_folded_in_sd": folded_sd(0.0 if named is None else RATIO_GAIN_SD),
+                                 "given_bar_headers": {k: given[k] for k in ("mean", "sd", "q05", "q50", "q95")}})
     if diagnosis is not None and diagnosis.causes:
         out |= {"posterior_method": diagnosis.posterior_method, "pareto_k": diagnosis.pareto_k}
     return out
@@ -81,7 +98,7 @@ def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary],
                   findings: list[str] | None = None) -> str:
     """The table the terminal ends with."""
     units = {"p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
-    lines = [f"{campaign} {test_id}: posterior (90 % credible intervals)",
+    lines = [f"{campaign} {test_id}: posterior (90 % credible intervals), given the output bars' header values",
              f"{'quantity':<10} {'unit':<5} {'q50':>10} {'q05':>10} {'q95':>10} {'mean':>10} {'sd':>10}"]
     for name in ("f", "nu", "kappa", "hoop_gain", "ratio", "p_mean", "tau_mean", "V"):
         if name not in allv:

@@ -43,6 +43,7 @@ from ..errors import OutputError, SamplingError, check_seed, os_error_text
 from ..likelihood import Likelihood, LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import default_prior_path, load_priors
+from ..quoted import quoted_summary
 from ..record import read_record
 from ..sampler import PosteriorSamples, sample_posterior, stderr_progress
 from ..settings import AnalysisSettings
@@ -192,6 +193,7 @@ def run_file(
         share = nu_variance_share(samples)
         ppc = ratio_ppc(samples, prep.data, seed=seed, likelihood=likelihood)
         V = sliding_velocity_summary(prep)
+        f_quoted = quoted_summary(samples.flat("f"))  # the stationary f to quote: with the bars' calibration
         stages["analysis"] = time.perf_counter() - t
         t = time.perf_counter()
         posterior_part = None
@@ -242,7 +244,7 @@ def run_file(
 
         seconds = time.perf_counter() - t_start
         doc: dict[str, object] = {"schema": RUN_SCHEMA, "schema_version": RUN_SCHEMA_VERSION, "warnings": warns,
-                                  "f": quoted_f(summary["f"].to_json(), diag)}
+                                  "f": quoted_f(f_quoted, summary["f"].to_json(), diag)}
         allv = dict(summary) | {"V": V}
         for name in JSON_VARIABLES:
             v = allv[name]
@@ -280,7 +282,7 @@ def run_file(
         if wrc is not None:
             doc["misfit"] = wrc.to_json()
         if diag is not None:
-            doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json())
+            doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json(), f_quoted)
         js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
         write_together({names["netcdf"]: nc_bytes, names["pdf"]: pdf_bytes, names["json"]: js_bytes},
                        last=names["json"])
@@ -290,7 +292,7 @@ def run_file(
     if table:
         from ..report.quote import quote_line
 
-        print(quote_line(summary["f"].to_json(), diag, len(warns)))
+        print(quote_line(f_quoted, diag, len(warns)))
         for w in warns:
             print(f"WARNING: {w}")
         lines = []

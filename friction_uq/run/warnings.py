@@ -83,7 +83,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
                 "JSON's f), wide enough for whichever is right: quote that, with this warning.")
     if not diagnosis.causes:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
-    fx = diagnosis.final.f_summary()
+    fx = headline(diagnosis)[1]  # the JSON's f: the named model's, with the bars' calibration
     names = ", ".join(v.label for v in diagnosis.named_causes)
     return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "
             "(the JSON's f), which is the f to quote.")

@@ -1,0 +1,85 @@
+"""The f to quote: draws times an independent lognormal factor (the output bars' calibration)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.stats import norm
+
+from friction_uq.models.parameters import summarize_draws
+from friction_uq.physics.bars import BAR_FORCE_CALIBRATION_SD, FORCE_RATIO_CALIBRATION_SD
+from friction_uq.quoted import quoted_summary
+from friction_uq.stats.factor import times_lognormal_factor
+
+
+def _lognormal_grid(mu: float, a: float, n: int) -> np.ndarray:
+    """n draws at the quantiles (j - 1/2)/n of a lognormal: a deterministic stand-in for its draws."""
+    return np.exp(mu + a * norm.ppf((np.arange(n) + 0.5) / n))
+
+
+def test_calibration_budget():
+    # three independent 1 % terms per bar (modulus, section, gauge), two bars in the ratio
+    assert BAR_FORCE_CALIBRATION_SD == pytest.approx(0.01732, abs=1e-5)
+    assert FORCE_RATIO_CALIBRATION_SD == pytest.approx(0.0245, abs=1e-4)
+
+
+def test_no_factor_is_the_draws_own_summary():
+    x = _lognormal_grid(np.log(0.05), 0.04, 4001)
+    assert times_lognormal_factor(x, 0.0) == pytest.approx(summarize_draws(x), rel=1e-12)
+
+
+@pytest.mark.parametrize(("a", "s"), [(0.02, 0.0245), (0.06, 0.0245), (0.01, 0.05)])
+def test_lognormal_times_lognormal_is_lognormal(a, s):
+    """ln X ~ N(mu, a^2) and ln G ~ N(0, s^2): ln XG ~ N(mu, a^2 + s^2), its quantiles, mean and sd in closed form.
+    The tolerance is the grid's own error (20001 draws: the grid's quantiles are within 1e-4 of the exact ones)."""
+    mu, n = np.log(0.05), 20001
+    got = times_lognormal_factor(_lognormal_grid(mu, a, n), s)
+    b = np.hypot(a, s)
+    for key, p in (("q05", 0.05), ("q50", 0.5), ("q95", 0.95)):
+        assert got[key] == pytest.approx(np.exp(mu + b * norm.ppf(p)), rel=2e-4), key
+    mean = np.exp(mu + b * b / 2)
+    assert got["mean"] == pytest.approx(mean, rel=2e-4)
+    assert got["sd"] == pytest.approx(mean * np.sqrt(np.expm1(b * b)), rel=5e-3)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(0.01, 0.2), min_size=2, max_size=60), st.floats(0.0, 0.1))
+def test_ordered_and_inside_the_factors_reach(values, s):
+    x = np.asarray(values)
+    got = times_lognormal_factor(x, s)
+    assert got["q05"] <= got["q50"] <= got["q95"]
+    reach = np.exp(8 * s) * (1 + 1e-9)
+    assert x.min() / reach <= got["q05"] and got["q95"] <= x.max() * reach
+    assert got["sd"] >= 0 and x.min() <= got["mean"] / np.exp(s * s / 2) * (1 + 1e-9) <= x.max() * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("bad", [[0.05], [0.05, -0.01], [0.05, np.nan]])
+def test_bad_draws_are_refused(bad):
+    with pytest.raises(ValueError):
+        times_lognormal_factor(np.asarray(bad), 0.02)
+
+
+def test_quoted_summary_uses_the_ratio_calibration():
+    x = _lognormal_grid(np.log(0.05), 0.02, 4001)
+    assert quoted_summary(x) == times_lognormal_factor(x, FORCE_RATIO_CALIBRATION_SD)
+
+
+def test_diagnose_folds_in_what_its_fits_do_not_carry():
+    """The whole-record fits marginalise a 1 % gain on each output bar gauge: the f to quote under diagnose folds
+    in the rest of the budget, sqrt(0.0245^2 - 2 x 0.01^2) = 0.020, and the stationary f the whole budget."""
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.diagnosis_words import RATIO_GAIN_SD, headline
+    from friction_uq.quoted import folded_sd
+
+    assert folded_sd(RATIO_GAIN_SD) == pytest.approx(0.0200, abs=1e-4)
+    assert folded_sd() == FORCE_RATIO_CALIBRATION_SD
+    with pytest.raises(ValueError):
+        folded_sd(0.03)
+    x = _lognormal_grid(np.log(0.05), 0.02, 4001)
+    dg = SimpleNamespace(mixture_f=x, mixture_weights={"clearance": 0.6, "reference": 0.4}, causes=())
+    label, fx = headline(dg)
+    assert label == "mixture of clearance (0.60), no cause (0.40)"
+    assert fx == times_lognormal_factor(x, folded_sd(RATIO_GAIN_SD))
