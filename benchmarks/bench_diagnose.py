@@ -10,8 +10,10 @@ ranges (as ``bench_misfit.py``), both bundled set-ups; plus clean records. Each 
 
 Prints, per hidden mechanism: how often the first named cause is it (exact), how often it is
 named or listed as not separable from the named one (named-or-inseparable), false alarms on clean
-records, the coverage of f's 90 % interval under the chosen model (truth: the wall's coefficient
-at the window's mean sliding speed, pressure and slip), and the time per record.
+records, the coverage of the 90 % interval of the f to quote (the JSON's: the chosen model's posterior with
+the output bars' calibration folded in, ``friction_uq.quoted``) and of that posterior's own interval (given
+the bars' header values) (truth: the wall's coefficient at the window's mean sliding speed, pressure and
+slip), and the time per record.
 """
 
 from __future__ import annotations
@@ -33,9 +35,11 @@ from bench_misfit import clean_config, with_gain  # noqa: E402
 
 from friction_uq.analysis import prepare  # noqa: E402
 from friction_uq.discrepancy.diagnose import diagnose  # noqa: E402
+from friction_uq.discrepancy.diagnosis_words import RATIO_GAIN_SD, headline  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.likelihood import Likelihood  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+from friction_uq.quoted import quoted_summary  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
 from friction_uq.sampler import LogPosterior, start_ball  # noqa: E402
 from friction_uq.simulate import simulate_to_file  # noqa: E402
@@ -137,24 +141,31 @@ def main() -> None:
         else:
             c["exact"] += named == hidden
             c["named_or_inseparable"] += named == hidden or hidden in dg.not_separable
-            fx = dg.final.f_summary()
+            head = headline(dg)  # the f to quote (the output bars' calibration included), as the JSON's
+            fx = head[1] if head is not None else quoted_summary(dg.final.f_effective, marginalised_sd=RATIO_GAIN_SD)
             tf = true_f(cfg, prep)
             c["covered"] += fx["q05"] <= tf <= fx["q95"]
+            given = dg.final.f_summary()  # the posterior's own, given the bars' header values
+            c["covered_given_headers"] += given["q05"] <= tf <= given["q95"]
         print(f"{k:4d} {hidden:<18} named {named} causes {[v.label for v in dg.causes]} not_sep {list(dg.not_separable)} "
               f"f {dg.final.f_summary()['q50']:.4f} [{dg.final.f_summary()['q05']:.4f}, {dg.final.f_summary()['q95']:.4f}] "
               f"{secs[-1]:.1f} s", file=sys.stderr, flush=True)
         os.remove(path)
     names = ["clean"] + list(HIDDEN)
-    print(f"{'hidden':<18} {'n':>3} {'exact':>6} {'named/insep':>11} {'f covered':>9} {'alarm':>6} {'refused':>7}  first named cause")
+    print(f"{'hidden':<18} {'n':>3} {'exact':>6} {'named/insep':>11} {'f covered':>9} {'given hdr':>9} {'alarm':>6} "
+          f"{'refused':>7}  first named cause")
     for h in names:
         c = stats.get(h, Counter())
         n = max(c["n"] - c["refused"], 1)
         tally = ", ".join(f"{k.split(':', 1)[1]} {v}" for k, v in sorted(c.items()) if k.startswith("named:"))
         if h == "clean":
-            print(f"{h:<18} {c['n']:>3} {'-':>6} {'-':>11} {'-':>9} {c['alarm'] / n:>6.2f} {c['refused']:>7}  {tally}")
+            print(f"{h:<18} {c['n']:>3} {'-':>6} {'-':>11} {'-':>9} {'-':>9} {c['alarm'] / n:>6.2f} {c['refused']:>7}  "
+                  f"{tally}")
         else:
             print(f"{h:<18} {c['n']:>3} {c['exact'] / n:>6.2f} {c['named_or_inseparable'] / n:>11.2f} "
-                  f"{c['covered'] / n:>9.2f} {'-':>6} {c['refused']:>7}  {tally}")
+                  f"{c['covered'] / n:>9.2f} {c['covered_given_headers'] / n:>9.2f} {'-':>6} {c['refused']:>7}  {tally}")
+    print("f covered: the f to quote (the JSON's: the output bars' calibration included); given hdr: the final "
+          "model's posterior, given the bars' header values")
     eff = [h for h in HIDDEN if h in stats]  # with --only, the groups analysed
     tot = sum(stats[h]["n"] - stats[h]["refused"] for h in eff)
     if tot == 0:
