@@ -153,10 +153,30 @@ def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int) 
         return [fn(x) for x in items]
     _MAPPED = (fn, items)
     try:
-        with multiprocessing.get_context("fork").Pool(workers, initializer=end_with_parent) as pool:
-            return pool.map(_mapped, range(len(items)), chunksize=1)
+        with _executor(workers) as pool:
+            return _gather(pool, _mapped, range(len(items)), 1, getattr(fn, "__name__", "work"))
     finally:
         _MAPPED = None
+
+
+def _executor(workers: int) -> Any:
+    """``workers`` forked processes (all forked now, before the executor starts its own thread): a worker that
+    dies (killed, out of memory) breaks the pool, and every wait on it ends with that error; a
+    ``multiprocessing.Pool`` waits for ever for the dead worker's values."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"), initializer=end_with_parent)
+
+
+def _gather(pool: Any, fn: Callable[[Any], Any], items: Sequence[Any], chunk: int, name: str) -> list[Any]:
+    """``list(pool.map(fn, items))``, a broken pool said as :class:`~friction_uq.errors.BackgroundError`."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    try:
+        return list(pool.map(fn, items, chunksize=chunk))
+    except BrokenProcessPool:
+        raise BackgroundError(f"a process working beside this one ({name}) ended without handing back its "
+                              "result: it was killed, or ran out of memory") from None
 
 
 
@@ -168,9 +188,9 @@ def _pooled(x: Any) -> Any:
 
 
 class ForkedPool:
-    """``fn`` on ``workers`` forked processes for many calls of :meth:`map` (a sampler's steps), forked once
-    on entering the ``with`` block; in turn, in this process, where :func:`can_fork` says no or one worker
-    is asked for. ``fn`` reaches the workers by the fork (it need not pickle: a closure over a likelihood);
+    """``fn`` on ``workers`` forked processes for many calls of :meth:`map` (a sampler's steps), forked once,
+    at the first call; in turn, in this process, where :func:`can_fork` says no or one worker is asked for. A
+    worker that dies ends the call with :class:`~friction_uq.errors.BackgroundError`. ``fn`` reaches the workers by the fork (it need not pickle: a closure over a likelihood);
     each call's items and values are pickled. ``fn`` must be pure, so that the values do not depend on
     ``workers``. One pool at a time per process."""
 
@@ -189,7 +209,7 @@ class ForkedPool:
         if self._pool is None or len(items) <= 1:
             return [self._fn(x) for x in items]
         chunk = max(1, len(items) // (4 * self._workers))
-        return self._pool.map(_pooled, items, chunksize=chunk)
+        return _gather(self._pool, _pooled, items, chunk, getattr(self._fn, "__name__", "work"))
 
     def __enter__(self) -> ForkedPool:
         global _POOLED
@@ -198,7 +218,7 @@ class ForkedPool:
                 raise RuntimeError("one ForkedPool at a time per process")
             _POOLED = self._fn
             try:
-                self._pool = multiprocessing.get_context("fork").Pool(self._workers, initializer=end_with_parent)
+                self._pool = _executor(self._workers)
             except BaseException:  # no pool (the fork failed): nothing holds the function any more
                 _POOLED = None
                 raise
@@ -207,7 +227,6 @@ class ForkedPool:
     def __exit__(self, *exc: object) -> None:
         global _POOLED
         if self._pool is not None:
-            self._pool.terminate()
-            self._pool.join()
+            self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
             _POOLED = None

@@ -205,13 +205,51 @@ def test_an_exception_in_a_pool_worker_reaches_the_caller_and_the_pool_is_releas
 
 
 def test_a_pool_that_cannot_be_made_leaves_nothing_behind(monkeypatch):
-    class NoFork:
-        def Pool(self, *args, **kwargs):  # noqa: N802 - multiprocessing's name
-            raise OSError("Cannot allocate memory")
+    def no_fork(workers):
+        raise OSError("Cannot allocate memory")
 
     monkeypatch.setattr(_parallel, "can_fork", lambda: True)  # no process is forked: the fork itself fails
-    monkeypatch.setattr(_parallel.multiprocessing, "get_context", lambda method: NoFork())
+    monkeypatch.setattr(_parallel, "_executor", no_fork)
     with pytest.raises(OSError, match="allocate"):
         with _parallel.ForkedPool(abs, workers=2):
             pass
     assert _parallel._POOLED is None  # a later pool may be made
+
+
+KILLED_WORKER = """
+import os, signal
+from friction_uq import _parallel
+from friction_uq.errors import BackgroundError
+parent = os.getpid()
+
+def dies_at_three(x):
+    if x == 3 and os.getpid() != parent:  # only ever in a worker
+        os.kill(os.getpid(), signal.SIGKILL)
+    return x
+
+assert _parallel.can_fork()
+try:
+    with _parallel.ForkedPool(dies_at_three, workers=2) as pool:
+        pool.map(range(8))
+except BackgroundError as exc:
+    print("pool:", exc)
+assert _parallel._POOLED is None
+try:
+    _parallel.forked_map(dies_at_three, range(8), workers=2)
+except BackgroundError as exc:
+    print("map:", exc)
+print("later:", _parallel.forked_map(dies_at_three, [0, 1, 2], workers=2))
+"""
+
+
+def test_a_worker_killed_is_one_sentence_not_a_wait_for_ever():
+    """A worker killed (out of memory, a user's kill) ends the wait with BackgroundError, in a pool of many calls
+    and in a map of one; a multiprocessing.Pool waited for ever for its values. In a fresh interpreter (one
+    thread, so it may fork), with a time limit: a wait for ever fails the test instead of hanging the suite."""
+    out = subprocess.run([sys.executable, "-c", KILLED_WORKER], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0].startswith("pool: a process working beside this one (dies_at_three) ended without handing back")
+    assert lines[0].endswith("it was killed, or ran out of memory")
+    assert lines[1].startswith("map: a process working beside this one (dies_at_three)")
+    assert lines[2] == "later: [0, 1, 2]"
