@@ -35,11 +35,10 @@ from bench_misfit import clean_config, with_gain  # noqa: E402
 
 from friction_uq.analysis import prepare  # noqa: E402
 from friction_uq.discrepancy.diagnose import diagnose  # noqa: E402
-from friction_uq.discrepancy.diagnosis_words import RATIO_GAIN_SD, headline  # noqa: E402
+from friction_uq.discrepancy.diagnosis_words import quoted_of  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.likelihood import Likelihood  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
-from friction_uq.quoted import quoted_summary  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
 from friction_uq.sampler import LogPosterior, start_ball  # noqa: E402
 from friction_uq.simulate import simulate_to_file  # noqa: E402
@@ -141,8 +140,9 @@ def main() -> None:
         else:
             c["exact"] += named == hidden
             c["named_or_inseparable"] += named == hidden or hidden in dg.not_separable
-            head = headline(dg)  # the f to quote (the output bars' calibration included), as the JSON's
-            fx = head[1] if head is not None else quoted_summary(dg.final.f_effective, marginalised_sd=RATIO_GAIN_SD)
+            # the diagnosed f with the output bars' calibration: the JSON's f when a cause or candidates were found
+            # (when nothing needed explaining the JSON quotes the stationary f; this is the whole-record baseline's)
+            fx = quoted_of(dg)
             tf = true_f(cfg, prep)
             c["covered"] += fx["q05"] <= tf <= fx["q95"]
             given = dg.final.f_summary()  # the posterior's own, given the bars' header values

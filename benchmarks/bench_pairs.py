@@ -35,10 +35,9 @@ from bench_misfit import clean_config  # noqa: E402
 from verdict_records import CHAIN_FAULTS, _axisymmetric, write  # noqa: E402
 
 from friction_uq.discrepancy.diagnose import MAX_CAUSES  # noqa: E402
-from friction_uq.discrepancy.diagnosis_words import RATIO_GAIN_SD, headline, sentence  # noqa: E402
+from friction_uq.discrepancy.diagnosis_words import quoted_of, sentence  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
-from friction_uq.quoted import quoted_summary  # noqa: E402
 
 #: Pairs on the 1-D simulation: the issue's two (a clearance with a velocity law; plug friction with a gauge's
 #: gain), others of the cell with each other, and faults of the chain with effects of the cell.
@@ -94,8 +93,9 @@ def candidates_of(dg) -> list[str]:
 
 def score(pair: tuple[str, str], dg, cfg, prep) -> dict:
     named = named_causes(dg)
-    head = headline(dg)  # the f to quote: with the output bars' calibration (friction_uq.quoted)
-    fx = head[1] if head is not None else quoted_summary(dg.final.f_effective, marginalised_sd=RATIO_GAIN_SD)
+    # the diagnosed f with the output bars' calibration (friction_uq.quoted): the JSON's f when a cause or candidates
+    # were found (when nothing needed explaining the JSON quotes the stationary f; this is the whole-record baseline's)
+    fx = quoted_of(dg)
     draws = dg.mixture_f if dg.mixture_f is not None else dg.final.f_effective
     given = np.quantile(draws, [0.05, 0.95])  # the posterior's own interval, given the bars' header values
     truth = true_f(cfg, prep)

@@ -16,10 +16,15 @@ from typing import Any
 from .errors import BackgroundError
 
 
+#: True in a worker of :class:`ForkedPool` or :func:`forked_map` (set by :func:`end_with_parent`): a worker does its
+#: share in line and forks nothing of its own (an executor's workers are not daemon processes).
+_IN_WORKER = False
+
+
 def can_fork() -> bool:
     """Whether this process may fork workers safely (module docstring)."""
     return ("fork" in multiprocessing.get_all_start_methods() and not multiprocessing.current_process().daemon
-            and threading.active_count() == 1)
+            and not _IN_WORKER and threading.active_count() == 1)
 
 
 def end_with_parent() -> None:
@@ -31,6 +36,8 @@ def end_with_parent() -> None:
     import signal
     import sys
 
+    global _IN_WORKER
+    _IN_WORKER = True
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle: it stops the child
     if not sys.platform.startswith("linux"):
         return
@@ -152,20 +159,37 @@ def forked_map(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int) 
     if workers <= 1 or not can_fork():
         return [fn(x) for x in items]
     _MAPPED = (fn, items)
+    pool, done = _executor(workers), False
     try:
-        with _executor(workers) as pool:
-            return _gather(pool, _mapped, range(len(items)), 1, getattr(fn, "__name__", "work"))
+        values = _gather(pool, _mapped, range(len(items)), 1, getattr(fn, "__name__", "work"))
+        done = True
+        return values
     finally:
+        _stop(pool, kill=not done)
         _MAPPED = None
 
 
 def _executor(workers: int) -> Any:
-    """``workers`` forked processes (all forked now, before the executor starts its own thread): a worker that
-    dies (killed, out of memory) breaks the pool, and every wait on it ends with that error; a
+    """``workers`` forked processes (forked at the first call, before the executor starts its own thread): a
+    worker that dies (killed, out of memory) breaks the pool, and every wait on it ends with that error; a
     ``multiprocessing.Pool`` waits for ever for the dead worker's values."""
     from concurrent.futures import ProcessPoolExecutor
 
     return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"), initializer=end_with_parent)
+
+
+def _stop(pool: Any, *, kill: bool) -> None:
+    """Shut the executor down; ``kill``: its workers stopped first (leaving on an error or Ctrl-C, nothing of
+    theirs is wanted, and they ignore Ctrl-C: waiting for them would hold the caller for a fit or more).
+    Python 3.14's ``terminate_workers``, else the executor's table of its processes."""
+    if kill:
+        stop = getattr(pool, "terminate_workers", None)
+        if stop is not None:
+            stop()
+        else:
+            for proc in list((getattr(pool, "_processes", None) or {}).values()):
+                proc.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _gather(pool: Any, fn: Callable[[Any], Any], items: Sequence[Any], chunk: int, name: str) -> list[Any]:
@@ -176,7 +200,8 @@ def _gather(pool: Any, fn: Callable[[Any], Any], items: Sequence[Any], chunk: in
         return list(pool.map(fn, items, chunksize=chunk))
     except BrokenProcessPool:
         raise BackgroundError(f"a process working beside this one ({name}) ended without handing back its "
-                              "result: it was killed, or ran out of memory") from None
+                              "result: it was killed, ran out of memory, or its result could not be passed "
+                              "back") from None
 
 
 
@@ -227,6 +252,6 @@ class ForkedPool:
     def __exit__(self, *exc: object) -> None:
         global _POOLED
         if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
+            _stop(self._pool, kill=exc[0] is not None)
             self._pool = None
             _POOLED = None

@@ -45,7 +45,9 @@ class Result:
 
     @property
     def f(self) -> dict[str, Any]:
-        """The f to quote: ``mean``, ``sd``, ``q05``, ``q50``, ``q95``, ``model``, ``source``."""
+        """The f to quote: ``mean``, ``sd``, ``q05``, ``q50``, ``q95`` (the output bars' calibration folded in), ``model``,
+        ``source``, ``bar_calibration_sd``, ``calibration_folded_in_sd`` and ``given_bar_headers`` (the posterior's
+        own summary); docs/outputs.md."""
         return self.doc["f"]
 
     @property

@@ -4,33 +4,40 @@ Every model of a record (the stationary analysis, the whole-record fits of ``dia
 forces through their bars' header values (modulus, section, gauge factor), as eq. 2-4 say, and none of them can
 tell a few per cent on one bar's calibration from a few per cent on f: eq. 17's ratio F_eo / F_io scales with
 the two calibrations, and f with the ratio. The posteriors are therefore conditional on the headers, and so are
-the draws the campaign pools (it has its own calibration offset per set-up, shared by that set-up's tests). The
-f a person or a script quotes carries that uncertainty as well: f times an independent factor G, ln G ~ N(0,
-s^2), s = :data:`~friction_uq.physics.bars.FORCE_RATIO_CALIBRATION_SD` (2.45 %: three 1 % terms on each of the
-two bars), less what the model's likelihood already marginalises (the whole-record fits of ``diagnose``: a 1 %
-gain on each output bar gauge, which leaves 2.0 % to fold in). On a ``diagnose`` interval of +-2 % this nearly
-doubles the width; on the stationary analysis', which nu's uncertainty sets at +-10 %, it adds little.
+the draws the campaign pools (it has its own calibration offset for every set-up but the first, shared by that
+set-up's tests). The f a person or a script quotes carries that uncertainty as well: f times an independent
+factor G, ln G ~ N(0, s^2). Each output bar's force is uncertain by
+:data:`~friction_uq.physics.bars.BAR_FORCE_CALIBRATION_SD` (1.73 %: three 1 % terms); s^2 sums, over the two
+bars, what of that the model's likelihood does not carry already: the stationary analysis carries none (s =
+2.45 %), the whole-record fits of ``diagnose`` a 1 % gain on each output gauge (s = 2.0 %), and a model with
+a bar's own calibration fault fitted (a gauge's gain, the bars' moduli) carries that bar's whole term. On a
+``diagnose`` interval of +-2 % this nearly doubles the width; on the stationary analysis', which nu's
+uncertainty sets at +-10 %, it adds little.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
-from .physics.bars import FORCE_RATIO_CALIBRATION_SD
+from .physics.bars import BAR_FORCE_CALIBRATION_SD
 from .stats.factor import times_lognormal_factor
 
+#: The two bars whose forces make eq. 17's ratio.
+OUTPUT_BARS = ("internal_output_bar", "external_output_bar")
 
-def folded_sd(marginalised_sd: float = 0.0) -> float:
-    """The log sd folded into f: the ratio's calibration sd less, in quadrature, ``marginalised_sd`` (the part the
-    model's likelihood already carries: the whole-record fits marginalise a 1 % gain on each output bar gauge,
-    sqrt(2) x 1 % on the ratio)."""
-    left = FORCE_RATIO_CALIBRATION_SD ** 2 - marginalised_sd ** 2
-    if left < 0:
-        raise ValueError(f"the likelihood's calibration sd {marginalised_sd:g} exceeds the budget "
-                         f"{FORCE_RATIO_CALIBRATION_SD:g}")
+
+def folded_sd(carried: Mapping[str, float] | None = None) -> float:
+    """The log sd folded into f: over the two output bars, the bar's calibration sd less, in quadrature, what the
+    model's likelihood already carries of it (``carried``: bar -> sd; absent: none; at least the bar's whole
+    term: nothing left of it)."""
+    carried = carried or {}
+    left = sum(max(0.0, BAR_FORCE_CALIBRATION_SD ** 2 - float(carried.get(bar, 0.0)) ** 2) for bar in OUTPUT_BARS)
     return float(np.sqrt(left))
 
 
-def quoted_summary(f_draws: np.ndarray, *, marginalised_sd: float = 0.0) -> dict[str, float]:
-    """mean, sd, q05, q50, q95 of f with the output bars' calibration (module docstring; :func:`folded_sd`)."""
-    return times_lognormal_factor(f_draws, folded_sd(marginalised_sd))
+def quoted_summary(f_draws: np.ndarray, log_sd: float | np.ndarray | None = None) -> dict[str, float]:
+    """mean, sd, q05, q50, q95 of f with the output bars' calibration (module docstring): ``log_sd`` the sd folded
+    in, one number or one per draw (:func:`folded_sd`; default: the stationary analysis', the whole budget)."""
+    return times_lognormal_factor(f_draws, folded_sd() if log_sd is None else log_sd)

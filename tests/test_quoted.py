@@ -10,7 +10,7 @@ from scipy.stats import norm
 
 from friction_uq.models.parameters import summarize_draws
 from friction_uq.physics.bars import BAR_FORCE_CALIBRATION_SD, FORCE_RATIO_CALIBRATION_SD
-from friction_uq.quoted import quoted_summary
+from friction_uq.quoted import folded_sd, quoted_summary
 from friction_uq.stats.factor import times_lognormal_factor
 
 
@@ -55,7 +55,7 @@ def test_ordered_and_inside_the_factors_reach(values, s):
     assert got["sd"] >= 0 and x.min() <= got["mean"] / np.exp(s * s / 2) * (1 + 1e-9) <= x.max() * (1 + 1e-9)
 
 
-@pytest.mark.parametrize("bad", [[0.05], [0.05, -0.01], [0.05, np.nan]])
+@pytest.mark.parametrize("bad", [[0.05], [0.05, -0.01], [0.05, np.nan], [0.05, np.inf]])
 def test_bad_draws_are_refused(bad):
     with pytest.raises(ValueError):
         times_lognormal_factor(np.asarray(bad), 0.02)
@@ -63,23 +63,54 @@ def test_bad_draws_are_refused(bad):
 
 def test_quoted_summary_uses_the_ratio_calibration():
     x = _lognormal_grid(np.log(0.05), 0.02, 4001)
-    assert quoted_summary(x) == times_lognormal_factor(x, FORCE_RATIO_CALIBRATION_SD)
+    assert quoted_summary(x) == times_lognormal_factor(x, folded_sd())
 
 
-def test_diagnose_folds_in_what_its_fits_do_not_carry():
-    """The whole-record fits marginalise a 1 % gain on each output bar gauge: the f to quote under diagnose folds
-    in the rest of the budget, sqrt(0.0245^2 - 2 x 0.01^2) = 0.020, and the stationary f the whole budget."""
+def test_zero_draws_stay_at_zero():
+    """A friction law clipped at 0 (pressure_friction's f_effective) gives draws of exactly 0: 0 times G is 0."""
+    x = np.concatenate([np.zeros(100), _lognormal_grid(np.log(0.05), 0.02, 900)])
+    got = times_lognormal_factor(x, 0.02)
+    assert got["q05"] == 0.0 and 0.0 < got["q50"] < got["q95"]
+    assert got["mean"] == pytest.approx(np.mean(x) * np.exp(0.02 ** 2 / 2))
+    all_zero = times_lognormal_factor(np.zeros(10), 0.02)
+    assert all_zero["q05"] == all_zero["q95"] == all_zero["mean"] == 0.0
+
+
+def test_a_factor_per_draw_is_the_mixture_of_the_two():
+    """Draws of two models with their own factors: the quantiles of the mixture of the two lognormals."""
+    a, b = _lognormal_grid(np.log(0.05), 0.02, 4001), _lognormal_grid(np.log(0.06), 0.02, 4001)
+    got = times_lognormal_factor(np.concatenate([a, b]), np.concatenate([np.full(a.size, 0.03), np.zeros(b.size)]))
+    sa = np.hypot(0.02, 0.03)
+    for key, p in (("q05", 0.05), ("q50", 0.5), ("q95", 0.95)):
+        v = np.log(got[key])
+        mix = 0.5 * norm.cdf((v - np.log(0.05)) / sa) + 0.5 * norm.cdf((v - np.log(0.06)) / 0.02)
+        assert mix == pytest.approx(p, abs=2e-4), key
+
+
+def test_what_a_model_carries_is_not_folded_in_again():
+    """The stationary analysis carries none of the bars' calibration (2.45 % folded in); the whole-record fits a
+    1 % gain per output gauge (2.0 %); a model with a bar's own calibration fault fitted, all of that bar's."""
     from types import SimpleNamespace
 
-    from friction_uq.discrepancy.diagnosis_words import RATIO_GAIN_SD, headline
-    from friction_uq.quoted import folded_sd
+    from friction_uq.discrepancy.diagnosis_words import folded_sd_of, headline
+    from friction_uq.discrepancy.extended import Variant
+    from friction_uq.discrepancy.mechanisms import MECHANISMS as REGISTRY
 
-    assert folded_sd(RATIO_GAIN_SD) == pytest.approx(0.0200, abs=1e-4)
-    assert folded_sd() == FORCE_RATIO_CALIBRATION_SD
-    with pytest.raises(ValueError):
-        folded_sd(0.03)
+    assert folded_sd() == pytest.approx(FORCE_RATIO_CALIBRATION_SD)
+    assert folded_sd_of(()) == pytest.approx(0.0200, abs=1e-4)
+    clearance = Variant(REGISTRY["clearance"])
+    assert folded_sd_of((clearance,)) == folded_sd_of(())
+    gain = Variant(REGISTRY["gauge_gain"], "internal_output_bar")
+    assert folded_sd_of((clearance, gain)) == pytest.approx(np.sqrt(BAR_FORCE_CALIBRATION_SD ** 2 - 0.01 ** 2))
+    assert folded_sd_of((Variant(REGISTRY["gauge_gain"], "input_bar"),)) == folded_sd_of(())
+    assert folded_sd_of((Variant(REGISTRY["bar_modulus"]),)) == 0.0
     x = _lognormal_grid(np.log(0.05), 0.02, 4001)
-    dg = SimpleNamespace(mixture_f=x, mixture_weights={"clearance": 0.6, "reference": 0.4}, causes=())
+    fits = {k: SimpleNamespace(label=k, variants=v) for k, v in (("clearance", (clearance,)), ("gauge_gain[internal_"
+                                                                 "output_bar]", (gain,)))}
+    dg = SimpleNamespace(mixture_f=np.concatenate([x, x]), mixture_weights={"clearance": 0.6, "reference": 0.4},
+                         mixture_source=np.repeat([0, 1], x.size), causes=(), final=fits["clearance"],
+                         baseline=SimpleNamespace(label="reference", variants=()), rounds=[[SimpleNamespace(fit=f)
+                                                                                             for f in fits.values()]])
     label, fx = headline(dg)
     assert label == "mixture of clearance (0.60), no cause (0.40)"
-    assert fx == times_lognormal_factor(x, folded_sd(RATIO_GAIN_SD))
+    assert fx == times_lognormal_factor(dg.mixture_f, folded_sd_of(()))  # both models carry the gains only

@@ -57,7 +57,9 @@ class TrendFit:
 
 def load_result(path: str | os.PathLike[str]) -> TestResult:
     """Read one ``<campaign>_<test_id>.json`` written by ``friction-uq run``; refuse, in one sentence naming the
-    file and the key, one that is not a JSON object with the ids as text and each summary as finite numbers."""
+    file and the key, one that is not a JSON object with the ids as text and each summary as finite numbers. Its
+    f is the stationary analysis' (``f_stationary``, given the bars' header values, as its kappa; ``f`` in a
+    file of schema 1)."""
     import math
 
     from ..plausible import MAX_TEXT_BYTES, escaped, unprintable
@@ -76,6 +78,9 @@ def load_result(path: str | os.PathLike[str]) -> TestResult:
     missing = [k for k in REQUIRED if k not in doc]
     if missing:
         raise FrictionUQError(f"{p}: not a friction-uq run result: key(s) {', '.join(missing)} missing")
+    # schema >= 2: f_stationary is the stationary f, given the bars' header values as kappa is (f: the f to quote)
+    field = {"f": "f_stationary"} if "f_stationary" in doc else {}
+    doc = doc | {k: doc[v] for k, v in field.items()}
     for key in ("campaign", "test_id"):
         if not isinstance(doc[key], str) or not doc[key].strip() or unprintable(doc[key]):
             shown = escaped(doc[key]) if isinstance(doc[key], str) else repr(doc[key])
@@ -85,10 +90,10 @@ def load_result(path: str | os.PathLike[str]) -> TestResult:
         bad = [s for s in STATISTICS if not isinstance(v, dict) or isinstance(v.get(s), bool)
                or not isinstance(v.get(s), (int, float)) or not math.isfinite(v[s])]
         if bad:
-            raise FrictionUQError(f"{p}: key {key!r} must hold finite numbers {', '.join(STATISTICS)}; "
+            raise FrictionUQError(f"{p}: key {field.get(key, key)!r} must hold finite numbers {', '.join(STATISTICS)}; "
                                   f"{', '.join(bad)} {'is' if len(bad) == 1 else 'are'} not")
         if v["sd"] < 0 or (key == "kappa" and v["sd"] == 0):
-            raise FrictionUQError(f"{p}: key '{key}': sd is {v['sd']!r}, it must be > 0")
+            raise FrictionUQError(f"{p}: key '{field.get(key, key)}': sd is {v['sd']!r}, it must be > 0")
     return TestResult(doc["campaign"], doc["test_id"], doc["f"], doc["kappa"], doc["nu"], doc["V"], doc["p_mean"],
                       str(p))
 

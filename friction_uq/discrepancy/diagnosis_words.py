@@ -5,18 +5,20 @@ DataTree groups: :mod:`.outcome`."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..models.parameters import Parameter
-from ..quoted import quoted_summary
+from ..quoted import OUTPUT_BARS, folded_sd, quoted_summary
 from .diagnose import Diagnosis
 from .extended import Variant
 from .record_likelihood import GAIN_SD
 from .whole_record import CHANNEL_LABELS
 
-#: The part of eq. 17's ratio's calibration sd the whole-record fits already marginalise (each output bar gauge's
-#: gain): the f to quote folds in the rest (:func:`friction_uq.quoted.quoted_summary`).
-RATIO_GAIN_SD = float(np.hypot(GAIN_SD["internal_output_bar"], GAIN_SD["external_output_bar"]))
+#: Mechanisms that fit an output bar's own calibration (its gauge's gain; the bars' moduli): a model with one
+#: carries that bar's whole calibration term, and the f to quote folds in none of it.
+BAR_CALIBRATION_FAULTS = ("gauge_gain", "bar_modulus")
 #: A hoop gain this far from 1 (its most probable value under its 5 % prior) is reported as a calibration finding
 #: (clean records: see benchmarks/bench_misfit.py for how often a right gauge reads this far off).
 HOOP_GAIN_FINDING = 0.02
@@ -36,15 +38,54 @@ def unresolved(dg: Diagnosis) -> bool:
     return bool(dg.causes) and dg.mixture_f is not None
 
 
+def folded_sd_of(variants) -> float:
+    """The calibration sd folded into the f of a whole-record model with these causes (:mod:`friction_uq.quoted`):
+    its likelihood carries a gain of :data:`~.record_likelihood.GAIN_SD` on each output gauge, and all of a bar's
+    term when one of :data:`BAR_CALIBRATION_FAULTS` on that bar is in the model."""
+    carried = dict(GAIN_SD)
+    for v in variants:
+        if v.mechanism.name == "bar_modulus":
+            carried |= {bar: math.inf for bar in OUTPUT_BARS}
+        elif v.mechanism.name in BAR_CALIBRATION_FAULTS and v.channel in OUTPUT_BARS:
+            carried[v.channel] = math.inf
+    return folded_sd(carried)
+
+
+def _variants_of(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
+    """The causes of the model ``label`` (a mixture's member; "reference": the model without causes)."""
+    if label == "reference":
+        return ()
+    fits = [dg.final, dg.baseline] + [r.fit for rnd in dg.rounds for r in rnd]
+    return next((m.variants for m in fits if m.label == label), ())
+
+
+def _folded(dg: Diagnosis) -> float | np.ndarray:
+    """The sd folded into the f to quote: the final model's, or per draw of the mixture its model's."""
+    if dg.mixture_f is None:
+        return folded_sd_of(dg.final.variants)
+    sds = np.array([folded_sd_of(_variants_of(dg, k)) for k in dg.mixture_weights])
+    return sds[np.asarray(dg.mixture_source, int)] if dg.mixture_source is not None else float(sds.max())
+
+
+def quoted_of(dg: Diagnosis) -> dict[str, float]:
+    """The diagnosed f to quote (the mixture's, else the final model's) with the output bars' calibration."""
+    return quoted_summary(dg.mixture_f if dg.mixture_f is not None else dg.final.f_effective, _folded(dg))
+
+
+def folded_of(dg: Diagnosis) -> float:
+    """The sd :func:`quoted_of` folded in (the largest over a mixture's models)."""
+    return float(np.max(_folded(dg)))
+
+
 def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
     """The headline f of a diagnosed record: the final model's label and its f when a cause was named; the
     stacking mixture's when the record named candidates or an unexplained misfit (:mod:`.verdict`); None when
     nothing needed explaining (the headline is then the stationary analysis' f). The f's summary carries the output
     bars' calibration (:mod:`friction_uq.quoted`), as the JSON's ``f`` does."""
     if dg.mixture_f is not None:
-        return mixture_label(dg), quoted_summary(dg.mixture_f, marginalised_sd=RATIO_GAIN_SD)
+        return mixture_label(dg), quoted_of(dg)
     if dg.causes:
-        return dg.final.label, quoted_summary(dg.final.f_effective, marginalised_sd=RATIO_GAIN_SD)
+        return dg.final.label, quoted_of(dg)
     return None
 
 

@@ -80,6 +80,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     fx = dg.final.f_summary()
     fb = dg.baseline.f_summary()
     lines = [sentence, "",
+             "The posteriors below are given the output bars' header values; the f to quote (the sentence's, and the "
+             "first line of page 1) also carries the bars' calibration.",
              f"f, stationary phase (eq. 17 + hoop): {f_without['q50']:.4f} [{f_without['q05']:.4f}, {f_without['q95']:.4f}]",
              f"f, baseline over the whole record: {fb['q50']:.4f} [{fb['q05']:.4f}, {fb['q95']:.4f}] "
              f"(nu {np.median(dg.baseline.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.baseline)):.4f})",
@@ -96,8 +98,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     m0 = dg.misfits[0] if dg.misfits else None
     if dg.mixture_f is not None:
         fm = np.quantile(dg.mixture_f, [0.05, 0.5, 0.95])
-        lines.insert(6, f"f, stacking mixture ({', '.join(f'{k} {w:.2f}' for k, w in dg.mixture_weights.items())}): "
-                        f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (the f to quote)")
+        lines.insert(7, f"f, stacking mixture ({', '.join(f'{k} {w:.2f}' for k, w in dg.mixture_weights.items())}): "
+                        f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (given the headers; the sentence's f to quote adds the bars' calibration)")
     lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
                   "round's reference is > 4 and > 2 SE, still is with the 5 % of blocks most in its favour left "
                   "out, and beats every other mechanism by the same margin; several that pass but do not beat each "

@@ -70,7 +70,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     the bars' header values (``given_bar_headers``, the posterior's own); under named causes, how its posterior
     was approximated and the Pareto k that judges it. ``f_stationary``: the stationary f to quote,
     ``f_stationary_posterior`` its posterior summary."""
-    from ..discrepancy.diagnosis_words import RATIO_GAIN_SD, headline
+    from ..discrepancy.diagnosis_words import folded_of, headline
     from ..physics.bars import FORCE_RATIO_CALIBRATION_SD
     from ..quoted import folded_sd
     from ..report.quote import f_to_quote
@@ -86,7 +86,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     out: dict[str, object] = ({"model": model, "source": source}
                               | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
                               | {"bar_calibration_sd": FORCE_RATIO_CALIBRATION_SD,
-                                 "calibration_folded_in_sd": folded_sd(0.0 if named is None else RATIO_GAIN_SD),
+                                 "calibration_folded_in_sd": folded_sd() if named is None else folded_of(diagnosis),
                                  "given_bar_headers": {k: given[k] for k in ("mean", "sd", "q05", "q50", "q95")}})
     if diagnosis is not None and diagnosis.causes:
         out |= {"posterior_method": diagnosis.posterior_method, "pareto_k": diagnosis.pareto_k}
