@@ -49,7 +49,8 @@ def _summary_page(ca: CampaignAnalysis, doc: dict[str, Any]):
         tab.auto_set_font_size(False)
         tab.set_fontsize(8)
     fig.text(0.01, 0.01, "f: under each test's diagnosed model where diagnose ran, else the stationary analysis "
-             "(eq. 17 with the hoop gauge).", fontsize=8)
+             "(eq. 17 with the hoop gauge), given the bars' header values (the laws carry each set-up's calibration "
+             "offset); each test's f to quote, with its bars' calibration, is in its own JSON.", fontsize=8)
     return fig
 
 
