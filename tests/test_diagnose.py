@@ -322,8 +322,14 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
     first = " ".join(PdfReader(tmp_path / "B_B-02.pdf").pages[0].extract_text().split())
     head = doc["f"]  # the f to quote (schema version 2)
     assert head["model"] == dd["model"]
-    assert first.startswith(f"Headline f = {head['q50']:.4f} [{head['q05']:.4f}, {head['q95']:.4f}] (90 %), from the "
-                            "model with the causes"), first[:300]
+    assert first.startswith(f"Headline f = {head['q50']:.4f} [{head['q05']:.4f}, {head['q95']:.4f}] (90 %, the output "
+                            "bars' calibration included), from the model with the causes"), first[:300]
+    # the f to quote is the posterior's with the bars' calibration folded in: the same centre, a wider interval
+    given = head["given_bar_headers"]
+    posterior = dd["mixture"]["f"] if dd["mixture"] is not None else dd["f_extended"]
+    assert given["q50"] == pytest.approx(posterior["q50"], rel=1e-9) and head["calibration_folded_in_sd"] > 0
+    assert head["q05"] < given["q05"] and head["q95"] > given["q95"]
+    assert head["q05"] <= 0.0504 <= head["q95"]
     # the headline's posterior says how it was approximated and how importance sampling judges that; a k over the
     # threshold is a warning, and the stationary f's misfit warning points at the headline f
     assert head["posterior_method"] == dd["posterior_method"] and head["pareto_k"] == dd["pareto_k"]
