@@ -9,8 +9,9 @@ set-up's tests). The f a person or a script quotes carries that uncertainty as w
 factor G, ln G ~ N(0, s^2). Each output bar's force is uncertain by
 :data:`~friction_uq.physics.bars.BAR_FORCE_CALIBRATION_SD` (1.73 %: three 1 % terms); s^2 sums, over the two
 bars, what of that the model's likelihood does not carry already: the stationary analysis carries none (s =
-2.45 %), the whole-record fits of ``diagnose`` a 1 % gain on each output gauge (s = 2.0 %), and a model with
-a bar's own calibration fault fitted (a gauge's gain, the bars' moduli) carries that bar's whole term. On a
+2.45 %), the whole-record fits of ``diagnose`` a 1 % gain on each output gauge (s = 2.0 %); a model with a
+bar's own calibration fault fitted (a gauge's gain, the bars' moduli) reads f partly against the input bar,
+whose calibration none carries, and folds in the whole budget. On a
 ``diagnose`` interval of +-2 % this nearly doubles the width; on the stationary analysis', which nu's
 uncertainty sets at +-10 %, it adds little.
 """

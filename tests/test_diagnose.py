@@ -328,6 +328,7 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
     given = head["given_bar_headers"]
     posterior = dd["mixture"]["f"] if dd["mixture"] is not None else dd["f_extended"]
     assert given["q50"] == pytest.approx(posterior["q50"], rel=1e-9) and head["calibration_folded_in_sd"] > 0
+    assert head["q50"] == pytest.approx(given["q50"], rel=0.01)  # an independent factor of median 1: the same centre
     assert head["q05"] < given["q05"] and head["q95"] > given["q95"]
     assert head["q05"] <= 0.0504 <= head["q95"]
     # the headline's posterior says how it was approximated and how importance sampling judges that; a k over the

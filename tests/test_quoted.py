@@ -89,28 +89,32 @@ def test_a_factor_per_draw_is_the_mixture_of_the_two():
 
 def test_what_a_model_carries_is_not_folded_in_again():
     """The stationary analysis carries none of the bars' calibration (2.45 % folded in); the whole-record fits a
-    1 % gain per output gauge (2.0 %); a model with a bar's own calibration fault fitted, all of that bar's."""
+    1 % gain per output gauge (2.0 %); a model with an output bar's calibration fault fitted reads f partly against
+    the input bar, whose calibration none carries (the whole budget again). A mixture's draws each take their
+    model's, found by the draw's source index in the weights' order; a label not found, the whole-record fits'."""
     from types import SimpleNamespace
 
     from friction_uq.discrepancy.diagnosis_words import folded_sd_of, headline
     from friction_uq.discrepancy.extended import Variant
-    from friction_uq.discrepancy.mechanisms import MECHANISMS as REGISTRY
+    from friction_uq.discrepancy.mechanisms import MECHANISMS
 
     assert folded_sd() == pytest.approx(FORCE_RATIO_CALIBRATION_SD)
     assert folded_sd_of(()) == pytest.approx(0.0200, abs=1e-4)
-    clearance = Variant(REGISTRY["clearance"])
+    clearance = Variant(MECHANISMS["clearance"])
+    gain = Variant(MECHANISMS["gauge_gain"], "internal_output_bar")
     assert folded_sd_of((clearance,)) == folded_sd_of(())
-    gain = Variant(REGISTRY["gauge_gain"], "internal_output_bar")
-    assert folded_sd_of((clearance, gain)) == pytest.approx(np.sqrt(BAR_FORCE_CALIBRATION_SD ** 2 - 0.01 ** 2))
-    assert folded_sd_of((Variant(REGISTRY["gauge_gain"], "input_bar"),)) == folded_sd_of(())
-    assert folded_sd_of((Variant(REGISTRY["bar_modulus"]),)) == 0.0
+    assert folded_sd_of((clearance, gain)) == folded_sd_of((Variant(MECHANISMS["bar_modulus"]),)) == folded_sd()
+    assert folded_sd_of((Variant(MECHANISMS["gauge_gain"], "input_bar"),)) == folded_sd_of(())
     x = _lognormal_grid(np.log(0.05), 0.02, 4001)
-    fits = {k: SimpleNamespace(label=k, variants=v) for k, v in (("clearance", (clearance,)), ("gauge_gain[internal_"
-                                                                 "output_bar]", (gain,)))}
-    dg = SimpleNamespace(mixture_f=np.concatenate([x, x]), mixture_weights={"clearance": 0.6, "reference": 0.4},
-                         mixture_source=np.repeat([0, 1], x.size), causes=(), final=fits["clearance"],
-                         baseline=SimpleNamespace(label="reference", variants=()), rounds=[[SimpleNamespace(fit=f)
-                                                                                             for f in fits.values()]])
+    fits = [SimpleNamespace(label="clearance", variants=(clearance,)),
+            SimpleNamespace(label="gauge_gain[internal_output_bar]", variants=(gain,))]
+    dg = SimpleNamespace(mixture_f=np.concatenate([x, 1.2 * x, 0.9 * x]), causes=(), final=fits[0],
+                         mixture_weights={"clearance": 0.5, "gauge_gain[internal_output_bar]": 0.3, "unknown": 0.2},
+                         mixture_source=np.repeat([0, 1, 2], x.size),
+                         baseline=SimpleNamespace(label="reference", variants=()),
+                         rounds=[[SimpleNamespace(fit=f) for f in fits]])
     label, fx = headline(dg)
-    assert label == "mixture of clearance (0.60), no cause (0.40)"
-    assert fx == times_lognormal_factor(dg.mixture_f, folded_sd_of(()))  # both models carry the gains only
+    assert label == "mixture of clearance (0.50), gauge_gain[internal_output_bar] (0.30), unknown (0.20)"
+    per_draw = np.repeat([folded_sd_of(()), folded_sd(), folded_sd_of(())], x.size)
+    assert fx == times_lognormal_factor(dg.mixture_f, per_draw)
+    assert fx != times_lognormal_factor(dg.mixture_f, folded_sd_of(()))  # the gain model's draws fold in more
