@@ -65,9 +65,15 @@ def _folded(dg: Diagnosis) -> float | np.ndarray:
     return sds[np.asarray(dg.mixture_source, int)] if dg.mixture_source is not None else float(sds.max())
 
 
+def f_draws_to_quote(dg: Diagnosis) -> np.ndarray:
+    """The draws the diagnosed f to quote comes from: the stacking mixture's, else the final model's (given the
+    bars' header values)."""
+    return dg.mixture_f if dg.mixture_f is not None else dg.final.f_effective
+
+
 def quoted_of(dg: Diagnosis) -> dict[str, float]:
-    """The diagnosed f to quote (the mixture's, else the final model's) with the output bars' calibration."""
-    return quoted_summary(dg.mixture_f if dg.mixture_f is not None else dg.final.f_effective, _folded(dg))
+    """The diagnosed f to quote (:func:`f_draws_to_quote`) with the output bars' calibration."""
+    return quoted_summary(f_draws_to_quote(dg), _folded(dg))
 
 
 def folded_of(dg: Diagnosis) -> float:

@@ -70,7 +70,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     the bars' header values (``given_bar_headers``, the posterior's own); under named causes, how its posterior
     was approximated and the Pareto k that judges it. ``f_stationary``: the stationary f to quote,
     ``f_stationary_posterior`` its posterior summary."""
-    from ..discrepancy.diagnosis_words import folded_of, headline
+    from ..discrepancy.diagnosis_words import f_draws_to_quote, folded_of, headline
     from ..physics.bars import FORCE_RATIO_CALIBRATION_SD
     from ..quoted import folded_sd
     from ..report.quote import f_to_quote
@@ -78,11 +78,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     source, fx = f_to_quote(f_stationary, diagnosis)
     named = None if diagnosis is None else headline(diagnosis)
     model = "stationary" if named is None else named[0]
-    if named is None:
-        given = f_stationary_posterior
-    else:
-        draws = diagnosis.mixture_f if diagnosis.mixture_f is not None else diagnosis.final.f_effective
-        given = summarize_draws(draws)
+    given = f_stationary_posterior if named is None else summarize_draws(f_draws_to_quote(diagnosis))
     out: dict[str, object] = ({"model": model, "source": source}
                               | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
                               | {"bar_calibration_sd": FORCE_RATIO_CALIBRATION_SD,
