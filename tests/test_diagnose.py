@@ -412,3 +412,37 @@ def test_a_misfit_left_after_the_named_causes_is_said():
     assert _remaining(SimpleNamespace(verdicts=(_verdict("named", "plug_friction"), _verdict("none")),
                                       misfits=misfits)) == ""
     assert _remaining(SimpleNamespace(verdicts=(left,), misfits=misfits[:1])) == ""  # no cause named before it
+
+
+def test_the_last_rounds_weight_on_further_mechanisms_gives_f_their_mixture():
+    """After a named cause, a last round that names nothing but puts its stacking weight on further mechanisms
+    (B-05: the plug friction and the velocity weakening it hides, each failing the spread test): f is the mixture
+    of those fits and, where it carries weight, the final model, in the round's proportions; with the weight on
+    the final model alone, or after a round that named its cause, f stays the final model's."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.candidates_mixture import MIXTURE_DRAWS, further_mixture
+    from friction_uq.discrepancy.extended import Variant
+
+    final = SimpleNamespace(label="clearance", f_effective=np.full(500, 0.050))
+    fits = {"clearance+plug_friction": 0.040, "clearance+velocity_friction": 0.045, "clearance+dispersion": 0.051}
+    last_round = [SimpleNamespace(fit=SimpleNamespace(label=k, f_effective=np.full(500, v))) for k, v in fits.items()]
+    causes = [Variant(MECHANISMS["clearance"])]
+    weights = {"reference": 0.30, "clearance+plug_friction": 0.45, "clearance+velocity_friction": 0.20,
+               "clearance+dispersion": 0.05}
+    last = replace(_verdict("none", labels=tuple(fits)), weights=weights)
+    x, w, which = further_mixture(final, [[], last_round], [_verdict("named", "clearance"), last], causes, seed=3)
+    assert set(w) == {"clearance", "clearance+plug_friction", "clearance+velocity_friction"}  # 95 % of the weight
+    assert sum(w.values()) == pytest.approx(1.0) and w["clearance+plug_friction"] == pytest.approx(0.45 / 0.95)
+    assert len(x) == MIXTURE_DRAWS and np.mean(x == 0.040) == pytest.approx(0.45 / 0.95, abs=1.0 / MIXTURE_DRAWS)
+    value = {"clearance": 0.050} | fits
+    assert np.all(x == np.array([value[list(w)[i]] for i in which]))  # each draw from the model it says
+    # the final model carries the weight alone: its f stands
+    alone = replace(last, weights={"reference": 0.95, "clearance+plug_friction": 0.05})
+    assert further_mixture(final, [[], last_round], [_verdict("named", "clearance"), alone], causes, 3)[0] is None
+    # the last round named its cause (the search ended at the most causes): no further mixture
+    named = _verdict("named", "plug_friction")
+    assert further_mixture(final, [last_round], [named], causes, 3)[0] is None
+    # no cause named at all: the first round's mixture (candidates_mixture.mixture) says it, not this one
+    assert further_mixture(final, [last_round], [last], [], 3)[0] is None

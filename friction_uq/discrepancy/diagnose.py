@@ -15,7 +15,10 @@ each round's verdict with the naming rule of :mod:`.verdict`.
   mixture of it and the reference;
 * after a named cause the search goes on with it in the model (the reference becomes baseline + cause),
   for at most four causes, so that a record with several effects gets them in order of evidence; it stops
-  at the first round that names nothing.
+  at the first round that names nothing. When that round's stacking weight lies on further mechanisms none of
+  which it names, f is the mixture of them and the model with the causes (``further_mixture``): the final
+  model alone would be quoted as if nothing more were there (on the bundled B-05 its interval sat 5 % above
+  the true f, while the weight lay on the plug friction and the velocity weakening it hides).
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide
-from .candidates_mixture import mixture, rival_mixture, unresolved_rounds
+from .candidates_mixture import further_mixture, mixture, rival_mixture, unresolved_rounds
 from .verdict import NamingRule, Verdict
 from .whole_record import WholeRecord, compare_whole_record
 
@@ -118,8 +121,9 @@ class Diagnosis:
     #: each round's verdict (:mod:`.verdict`): the first says whether a cause was named, or candidates, or an
     #: unexplained misfit
     verdicts: tuple[Verdict, ...] = ()
-    #: no cause named but candidates or an unexplained misfit: f's draws from the stacking mixture of the models
-    #: that carry the weight, their labels and weights ("reference": the model without causes)
+    #: no cause named but candidates or an unexplained misfit, a cause fitted in turn whose rivals stay open, or
+    #: further mechanisms carrying the last round's weight: f's draws from the stacking mixture of the models that
+    #: carry the weight, their labels and weights ("reference": the model without causes)
     mixture_f: np.ndarray | None = None
     mixture_weights: dict[str, float] = field(default_factory=dict)
     #: for each mixture draw, the index (in mixture_weights' order) of the model it was drawn from
@@ -231,6 +235,8 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         final, ex = dg.exact_posterior(final, workers=workers)
         k, ess, method = ex.pareto_k, ex.ess, ex.method
         mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed)
+        if mix is None:  # the last round's weight on further mechanisms none of which it named
+            mix, mix_w, mix_src = further_mixture(final, rounds, verdicts, causes, seed)
     return Diagnosis(baseline=st.base, rounds=tuple(rounds), misfits=tuple(st.misfits), causes=tuple(causes),
                      not_separable=st.not_sep, channels_not_separable=st.other_channels, separate_by=st.separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,

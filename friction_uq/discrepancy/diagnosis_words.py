@@ -10,6 +10,7 @@ import numpy as np
 
 from ..models.parameters import Parameter
 from ..quoted import OUTPUT_BARS, folded_sd, quoted_summary
+from .candidates_mixture import unresolved_rounds
 from .diagnose import Diagnosis
 from .extended import Variant
 from .record_likelihood import GAIN_SD
@@ -34,7 +35,15 @@ def unresolved(dg: Diagnosis) -> bool:
     """A round of candidates whose rivals no later round named: the candidate fitted in turn is not named
     (``Diagnosis.named_causes`` holds the causes that are), and f is the mixture of the candidates
     (``Diagnosis.mixture_f``, ``Diagnosis.open_candidates``)."""
-    return bool(dg.causes) and dg.mixture_f is not None
+    return bool(unresolved_rounds(dg.causes, dg.verdicts))
+
+
+def further(dg: Diagnosis) -> list[str]:
+    """The further mechanisms the last round's stacking mixture gives f with, beside the model with the causes,
+    none of which it named (:func:`~.candidates_mixture.further_mixture`); [] when f is that model's alone."""
+    if not dg.causes or dg.mixture_f is None or unresolved(dg):
+        return []
+    return [k for k in dg.mixture_weights if k != dg.final.label]
 
 
 def folded_sd_of(variants) -> float:
@@ -197,6 +206,15 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
         evidence = "first cause" if found else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
+    elif further(dg):  # the last round's weight lies on further mechanisms it did not name: f is their mixture
+        lead = f"Causes found, the one that moves f most first: {named}{gauges}."
+        shares = ", ".join(f"{'them' if k == dg.final.label else _further_words(dg, k)} {100 * w:.0f} %"
+                           for k, w in dg.mixture_weights.items())
+        quote = (f"from the model with them and the further causes the record leans to without naming one, weighted "
+                 f"by how well each predicts it ({shares}; the f to quote, wide enough for whichever is right)")
+        evidence = "first cause"
+        sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
+            if dg.not_separable else ""
     else:
         lead = f"Causes found, the one that moves f most first: {named}{gauges}."
         quote = "with them (the f to quote)"
@@ -251,6 +269,12 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the candidates weighted by how well "
             f"each predicts the record ({shares}; the f to quote, wide enough for whichever is right), "
             f"{f_without['q50']:.3f} from the stationary analysis.")
+
+
+def _further_words(dg: Diagnosis, label: str) -> str:
+    """A further mechanism of the last round, in words ('with plug_friction' style: its own mechanism only)."""
+    fit = next((r.fit for r in dg.rounds[-1] if r.fit.label == label), None)
+    return label if fit is None else f"+ {fit.variants[-1].mechanism.name}"
 
 
 def _words_of(dg: Diagnosis, label: str) -> str:
