@@ -81,7 +81,9 @@ GROUPS = {
     "zero_drift": (None, "drift"),
     "gauge_gain": (_gain, None),
     "sign_flipped": (None, "sign"),
-} | {f"hidden_{k}": (v, None) for k, v in HIDDEN.items() if k != "gauge_gain"}
+} | {f"hidden_{k}": (v, None) for k, v in HIDDEN.items() if k != "gauge_gain"} | {
+    # last, so that the groups before it draw the same records as before it was added
+    "axisymmetric_plug_friction": (lambda c, r: _axisymmetric(HIDDEN["plug_friction"](c, r), r), None)}
 
 
 def _edit_strains(noisy: dict, how: str | None, r: np.random.Generator) -> str:
