@@ -272,7 +272,7 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
 
 
 def _further_words(dg: Diagnosis, label: str) -> str:
-    """A further mechanism of the last round, in words ('with plug_friction' style: its own mechanism only)."""
+    """A further mechanism of the last round, as added to the model with the causes ('+ plug_friction')."""
     fit = next((r.fit for r in dg.rounds[-1] if r.fit.label == label), None)
     return label if fit is None else f"+ {fit.variants[-1].mechanism.name}"
 

@@ -54,6 +54,8 @@ class ReportInputs:
 
 #: Top of the summary page's table (axes fraction) for up to ten rows: the sentences above stay clear of it.
 SUMMARY_TABLE_TOP = 0.37
+#: A text line's height over its font size (matplotlib's line spacing 1.2, with the glyphs' own height).
+LINE_SPACING = 1.3
 
 
 def _fmt(v: float) -> str:
@@ -63,6 +65,25 @@ def _fmt(v: float) -> str:
 def stationary_quoted(r: ReportInputs) -> dict[str, float]:
     """The stationary analysis' f to quote: its posterior with the output bars' calibration (as the JSON's)."""
     return quoted_summary(r.samples.flat("f"))
+
+
+def _shrink_to_fit(lines: list[str], room: float, line: float, width: int = 135) -> tuple[list[str], float]:
+    """The lines wrapped, and the largest factor k (<= 1) on their 10 pt font that fits them in ``room`` (axes
+    fraction; ``line``: the height of a 10 pt line, the same unit): a smaller font takes more characters on a line
+    of the page's width, so the lines are wrapped at ``width / k`` (the block keeps the page's width instead of
+    narrowing with its font)."""
+    def wrapped(k: float) -> tuple[list[str], float]:
+        texts = ["\n".join(textwrap.wrap(line_, int(width / k))) for line_ in lines]
+        return texts, k * sum(line * (t.count("\n") + 1.5) for t in texts)
+
+    texts, height = wrapped(1.0)
+    if height <= room:
+        return texts, 1.0
+    lo, hi = 0.05, 1.0  # bisection on k: the height at k shrinks with k
+    for _ in range(14):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if wrapped(mid)[1] <= room else (lo, mid)
+    return wrapped(lo)[0], lo
 
 
 def page_summary(r: ReportInputs) -> Figure:
@@ -104,18 +125,18 @@ def page_summary(r: ReportInputs) -> Figure:
         lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, stationary_quoted(r)))
     # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
     # together where they would run into the table below them
-    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings)), 80))
+    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings)), 100))
     ax.text(0.0, 1.0, first, fontsize=13, va="top", transform=ax.transAxes, weight="bold",
             color="firebrick" if r.warnings else "black")
-    top = 0.97 - 0.06 * (first.count("\n") + 1)
-    texts = ["\n".join(textwrap.wrap(line, 135)) for line in lines]
-    need = sum(0.034 * (t.count("\n") + 1) + 0.016 for t in texts)
-    k = min(1.0, (top - SUMMARY_TABLE_TOP) / need)
+    point = 1.0 / (ax.get_position().height * fig.get_figheight() * 72.0)  # one point, in axes fraction
+    line = 10.0 * LINE_SPACING * point  # a 10 pt line
+    top = 1.0 - 13.0 * LINE_SPACING * point * (first.count("\n") + 1) - line
+    texts, k = _shrink_to_fit(lines, top - SUMMARY_TABLE_TOP, line)
     y = top
-    for line, text in zip(lines, texts):
-        color = "firebrick" if line.startswith("WARNING") else "black"
-        ax.text(0.0, y, text, fontsize=10 * k, va="top", transform=ax.transAxes, color=color)
-        y -= k * (0.034 * (text.count("\n") + 1) + 0.016)
+    for line_, text in zip(lines, texts):
+        color = "firebrick" if line_.startswith("WARNING") else "black"
+        ax.text(0.0, y, text, fontsize=10 * k, va="top", transform=ax.transAxes, color=color, linespacing=1.2)
+        y -= k * line * (text.count("\n") + 1.5)
     rows = []
     for name, v in list(s.items()) + [("V", r.V)]:
         unit, scale = UNITS.get(name, ("", 1.0))
@@ -130,7 +151,7 @@ def page_summary(r: ReportInputs) -> Figure:
     prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
             f"seed {r.samples.seed}, friction-uq {r.version}")
     ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
-    ax.text(0.84, 0.86, "Pages\n 2 raw gauges\n 3 waves, forces, equilibrium\n 4 window and noise\n"
+    ax.text(0.875, SUMMARY_TABLE_TOP - 0.02, "Pages\n 2 raw gauges\n 3 waves, forces, equilibrium\n 4 window and noise\n"
             " 5 posterior vs prior\n 6 nu -> f\n 7 convergence\n 8 predictive check"
             + ("\n 9 hoop gauge vs model" if r.samples.hoop else "")
             + (f"\n{whole_record_page(r):2d} whole test vs gauges" if r.whole_record is not None else "")

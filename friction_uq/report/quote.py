@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from ..discrepancy.diagnosis_words import headline
+from ..discrepancy.diagnosis_words import further, headline
 
 
 def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, Mapping[str, float]]:
@@ -19,6 +19,13 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, 
     named = None if diagnosis is None else headline(diagnosis)
     if named is not None:
         label, fx = named
+        if further(diagnosis):  # the causes named, and further ones the last round leaned to without naming
+            named = ", ".join(v.label for v in diagnosis.named_causes)
+            by = {r.fit.label: r.fit.variants[-1].label for r in diagnosis.rounds[-1]}
+            shares = ", ".join(f"{'none' if k == diagnosis.final.label else '+ ' + by.get(k, k)} {w:.2f}"
+                               for k, w in diagnosis.mixture_weights.items())
+            return (f"the causes diagnose named ({named}) mixed with the further causes the record leans to "
+                    f"without naming one ({shares})", fx)
         if diagnosis.mixture_f is not None:  # unexplained, or candidates the record does not tell apart
             named = ", ".join(v.label for v in diagnosis.named_causes)
             if named:  # a cause named, a later round's candidates left open
