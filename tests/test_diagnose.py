@@ -441,8 +441,40 @@ def test_the_last_rounds_weight_on_further_mechanisms_gives_f_their_mixture():
     # the final model carries the weight alone: its f stands
     alone = replace(last, weights={"reference": 0.95, "clearance+plug_friction": 0.05})
     assert further_mixture(final, [[], last_round], [_verdict("named", "clearance"), alone], causes, 3)[0] is None
-    # the last round named its cause (the search ended at the most causes): no further mixture
-    named = _verdict("named", "plug_friction")
-    assert further_mixture(final, [last_round], [named], causes, 3)[0] is None
+    # the last round named its cause (the search ended at the most causes): no further mixture, whatever its weights
+    named = replace(_verdict("named", "clearance+plug_friction", labels=tuple(fits)), weights=weights)
+    two = causes + [Variant(MECHANISMS["plug_friction"])]
+    assert further_mixture(final, [[], last_round], [_verdict("named", "clearance"), named], two, 3)[0] is None
     # no cause named at all: the first round's mixture (candidates_mixture.mixture) says it, not this one
     assert further_mixture(final, [last_round], [last], [], 3)[0] is None
+
+
+def test_the_words_of_a_further_mixture_name_the_further_causes():
+    """The f to quote's source, the warning and the mixture test agree on a further mixture: the causes named,
+    the further ones with their gauges, and the mixture's f quoted (with the bars' calibration)."""
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.diagnose import Diagnosis
+    from friction_uq.discrepancy.diagnosis_words import further, headline, unresolved
+    from friction_uq.discrepancy.extended import Variant
+    from friction_uq.report.quote import f_to_quote
+    from friction_uq.run.warnings import _next_step
+
+    clearance = Variant(MECHANISMS["clearance"])
+    gain = Variant(MECHANISMS["gauge_gain"], "external_output_bar")
+    fin = SimpleNamespace(label="clearance", variants=(clearance,), f_effective=np.full(10, 0.05))
+    extra = SimpleNamespace(label="clearance+gauge_gain[external_output_bar]", variants=(clearance, gain))
+    x = np.r_[np.full(600, 0.050), np.full(400, 0.044)]
+    dg = Diagnosis(baseline=SimpleNamespace(label="baseline", variants=()), rounds=((), (SimpleNamespace(fit=extra),)),
+                   misfits=(), causes=(clearance,), not_separable=(), separate_by=None, final=fin,
+                   verdicts=(_verdict("named", "clearance"), _verdict("none", labels=(extra.label,))),
+                   mixture_f=x, mixture_weights={"clearance": 0.6, extra.label: 0.4},
+                   mixture_source=np.r_[np.zeros(600, int), np.ones(400, int)])
+    assert not unresolved(dg) and further(dg) == [extra.label]
+    source, fx = f_to_quote({"q05": 0.0, "q50": 0.0, "q95": 0.0}, dg)
+    assert source.startswith("the causes diagnose named (clearance) mixed with the further causes"), source
+    assert "(no further cause 0.60, + gauge_gain[external_output_bar] 0.40)" in source, source
+    assert fx == headline(dg)[1] and fx["q05"] < 0.044 and fx["q95"] > 0.050  # the mixture, the calibration folded in
+    said = _next_step(dg, None)
+    assert "names clearance, and the record leans to a further cause" in said and "gauge_gain[external_output_bar]" \
+        in said and f"{fx['q50']:.4g}" in said, said

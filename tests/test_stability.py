@@ -27,6 +27,7 @@ def test_five_seeds_name_the_same_causes_on_a_bundled_record(tmp_path):
         out = tmp_path / f"seed{seed}"
         out.mkdir()
         doc = diagnose_once(str(DATA / "A" / "A-01.h5"), seed, str(out))
+        assert "error" not in doc, doc
         runs.append((verdict_of(doc), doc["f"]))
     verdicts = {v for v, _ in runs}
     assert len(verdicts) == 1, runs

@@ -74,7 +74,8 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
         return None, {}, None
     fits = {r.fit.label: r.fit for r in rounds[-1]}
     draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in further}
-    w = ({final.label: verdict.weights["reference"]} if "reference" in verdict.supported else {}) \
+    w = ({final.label: verdict.weights["reference"]}
+         if "reference" in verdict.supported and verdict.weights["reference"] > 0.0 else {}) \
         | {label: verdict.weights[label] for label in further}
     return _draw_mixture({k: draws[k] for k in w}, w, seed)
 

@@ -210,8 +210,9 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         lead = f"Causes found, the one that moves f most first: {named}{gauges}."
         shares = ", ".join(f"{'them' if k == dg.final.label else _further_words(dg, k)} {100 * w:.0f} %"
                            for k, w in dg.mixture_weights.items())
-        quote = (f"from the model with them and the further causes the record leans to without naming one, weighted "
-                 f"by how well each predicts it ({shares}; the f to quote, wide enough for whichever is right)")
+        with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
+        quote = (f"from {with_them}the further causes the record leans to without naming one, weighted by how well "
+                 f"each predicts it ({shares}; the f to quote, wide enough for whichever is right)")
         evidence = "first cause"
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
@@ -274,7 +275,7 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
 def _further_words(dg: Diagnosis, label: str) -> str:
     """A further mechanism of the last round, as added to the model with the causes ('+ plug_friction')."""
     fit = next((r.fit for r in dg.rounds[-1] if r.fit.label == label), None)
-    return label if fit is None else f"+ {fit.variants[-1].mechanism.name}"
+    return label if fit is None else f"+ {fit.variants[-1].label}"
 
 
 def _words_of(dg: Diagnosis, label: str) -> str:

@@ -137,9 +137,9 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
                        "log_prior_f_effective": (("chain", "draw"), log_prior[None],
                                                  {"description": "; ".join(notes)})},
                       attrs={"model": mixture_label(dg), "verdict": dg.verdict.kind,
-                             "posterior_method": "stacking mixture: the model with the named causes' exact posterior "
-                                                 "and the other models' normal approximations" if dg.causes else
-                             "stacking mixture of the candidates' normal approximations"})
+                             "posterior_method": "stacking mixture: the final model's draws from its exact posterior "
+                                                 "where it is a member, the other members' normal approximations"
+                             if dg.causes else "stacking mixture of the candidates' normal approximations"})
 
 
 def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:

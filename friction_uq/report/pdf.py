@@ -56,6 +56,8 @@ class ReportInputs:
 SUMMARY_TABLE_TOP = 0.37
 #: A text line's height over its font size (matplotlib's line spacing 1.2, with the glyphs' own height).
 LINE_SPACING = 1.3
+#: The summary lines' font never shrinks below this factor on 10 pt (5 pt): below it they may overflow.
+MIN_FONT_FACTOR = 0.5
 
 
 def _fmt(v: float) -> str:
@@ -79,7 +81,7 @@ def _shrink_to_fit(lines: list[str], room: float, line: float, width: int = 135)
     texts, height = wrapped(1.0)
     if height <= room:
         return texts, 1.0
-    lo, hi = 0.05, 1.0  # bisection on k: the height at k shrinks with k
+    lo, hi = MIN_FONT_FACTOR, 1.0  # bisection on k: the height at k shrinks with k; below the floor, overflow
     for _ in range(14):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if wrapped(mid)[1] <= room else (lo, mid)
