@@ -438,6 +438,15 @@ def test_the_last_rounds_weight_on_further_mechanisms_gives_f_their_mixture():
     assert len(x) == MIXTURE_DRAWS and np.mean(x == 0.040) == pytest.approx(0.45 / 0.95, abs=1.0 / MIXTURE_DRAWS)
     value = {"clearance": 0.050} | fits
     assert np.all(x == np.array([value[list(w)[i]] for i in which]))  # each draw from the model it says
+    # a supported model whose evidence over the final model is not decisive (stacking shares the weight at random
+    # among models that predict alike) is left out; with none decisive, the final model's f stands
+    not_decisive = replace(last, candidates=tuple(replace(c, decisive=c.label != "clearance+plug_friction")
+                                                  for c in last.candidates))
+    _, w2, _ = further_mixture(final, [[], last_round], [_verdict("named", "clearance"), not_decisive], causes, 3)
+    assert set(w2) == {"clearance", "clearance+velocity_friction"}
+    none_decisive = replace(last, candidates=tuple(replace(c, decisive=False) for c in last.candidates))
+    assert further_mixture(final, [[], last_round], [_verdict("named", "clearance"), none_decisive], causes, 3)[0] \
+        is None
     # the final model carries the weight alone: its f stands
     alone = replace(last, weights={"reference": 0.95, "clearance+plug_friction": 0.05})
     assert further_mixture(final, [[], last_round], [_verdict("named", "clearance"), alone], causes, 3)[0] is None

@@ -5,8 +5,8 @@ the models that carry its stacking weight; a round of candidates whose best was 
 second cause) but whose rivals no later round put in the model leaves them open: f is then the mixture of the
 final model and those rivals (:func:`rival_mixture`), and the candidate fitted in turn is not named
 (``Diagnosis.named_causes``). After the last cause, a round that names nothing more may still find that the
-record's stacking weight lies on further mechanisms, none of which passes the naming rule (their evidence sits
-in a few blocks, or no misfit is left to explain): f is then the mixture of the final model and those
+record's stacking weight lies on further mechanisms decisively better than the model with the causes, none of
+which passes the naming rule (their evidence sits in a few blocks): f is then the mixture of the final model and those
 mechanisms (:func:`further_mixture`), not the final model's alone, whose interval would hold the truth only if
 nothing more were there.
 """
@@ -62,14 +62,18 @@ def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes
 def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
                     seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """After at least one cause, when the last round named nothing (none, unexplained or unconfirmed) and the
-    models that carry its stacking weight (:class:`~friction_uq.stats.WeightRule`) include further mechanisms:
+    models that carry its stacking weight (:class:`~friction_uq.stats.WeightRule`) include further mechanisms
+    whose evidence over the model with the causes is decisive by the package's rule (they fail the naming rule
+    on its spread or on their rivals; a model only as good as the final one, among which stacking shares the
+    weight at random, does not count):
     f's draws from the mixture of those mechanisms' fits and, when it is among them, the final model (its exact
     posterior; the round's reference), weighted by the round's stacking weights; (None, {}, None) when the final model carries the
     weight alone, or when the last round named a cause."""
     if not causes or len(verdicts) <= len(causes) or verdicts[-1].kind not in ("none", "unexplained", "unconfirmed"):
         return None, {}, None
     verdict = verdicts[-1]
-    further = [k for k in verdict.supported if k != "reference" and verdict.weights[k] > 0.0]
+    decisive = {c.label for c in verdict.candidates if c.decisive}
+    further = [k for k in verdict.supported if k in decisive and verdict.weights[k] > 0.0]
     if not further:
         return None, {}, None
     fits = {r.fit.label: r.fit for r in rounds[-1]}
