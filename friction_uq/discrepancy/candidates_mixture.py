@@ -77,11 +77,11 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
     if not further:
         return None, {}, None
     fits = {r.fit.label: r.fit for r in rounds[-1]}
-    draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in further}
-    w = ({final.label: verdict.weights["reference"]}
-         if "reference" in verdict.supported and verdict.weights["reference"] > 0.0 else {}) \
-        | {label: verdict.weights[label] for label in further}
-    return _draw_mixture({k: draws[k] for k in w}, w, seed)
+    draws = {label: fits[label].f_effective for label in further}  # heaviest first, as the weights
+    if "reference" in verdict.supported and verdict.weights["reference"] > 0.0:  # the final model carries weight
+        draws = {final.label: final.f_effective} | draws
+    w = {k: verdict.weights["reference" if k == final.label else k] for k in draws}
+    return _draw_mixture(draws, w, seed)
 
 
 def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict,

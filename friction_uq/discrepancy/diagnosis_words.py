@@ -38,12 +38,14 @@ def unresolved(dg: Diagnosis) -> bool:
     return bool(unresolved_rounds(dg.causes, dg.verdicts))
 
 
-def further(dg: Diagnosis) -> list[str]:
+def further(dg: Diagnosis) -> dict[str, str]:
     """The further mechanisms the last round's stacking mixture gives f with, beside the model with the causes,
-    none of which it named (:func:`~.candidates_mixture.further_mixture`); [] when f is that model's alone."""
+    none of which it named (:func:`~.candidates_mixture.further_mixture`): each member's label -> the mechanism it
+    adds to the model with the causes (``gauge_gain[external_output_bar]``); {} when f is that model's alone."""
     if not dg.causes or dg.mixture_f is None or unresolved(dg):
-        return []
-    return [k for k in dg.mixture_weights if k != dg.final.label]
+        return {}
+    added = {r.fit.label: r.fit.variants[-1].label for r in dg.rounds[-1]}
+    return {k: added.get(k, k) for k in dg.mixture_weights if k != dg.final.label}
 
 
 def folded_sd_of(variants) -> float:
@@ -206,9 +208,9 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
         evidence = "first cause" if found else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
-    elif further(dg):  # the last round's weight lies on further mechanisms it did not name: f is their mixture
+    elif more := further(dg):  # the last round's weight lies on further mechanisms it did not name: their mixture
         lead = f"Causes found, the one that moves f most first: {named}{gauges}."
-        shares = ", ".join(f"{'them' if k == dg.final.label else _further_words(dg, k)} {100 * w:.0f} %"
+        shares = ", ".join(f"{'them' if k == dg.final.label else '+ ' + more[k]} {100 * w:.0f} %"
                            for k, w in dg.mixture_weights.items())
         with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
         quote = (f"from {with_them}the further causes the record leans to without naming one, weighted by how well "
@@ -270,12 +272,6 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the candidates weighted by how well "
             f"each predicts the record ({shares}; the f to quote, wide enough for whichever is right), "
             f"{f_without['q50']:.3f} from the stationary analysis.")
-
-
-def _further_words(dg: Diagnosis, label: str) -> str:
-    """A further mechanism of the last round, as added to the model with the causes ('+ plug_friction')."""
-    fit = next((r.fit for r in dg.rounds[-1] if r.fit.label == label), None)
-    return label if fit is None else f"+ {fit.variants[-1].label}"
 
 
 def _words_of(dg: Diagnosis, label: str) -> str:

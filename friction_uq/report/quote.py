@@ -19,10 +19,9 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, 
     named = None if diagnosis is None else headline(diagnosis)
     if named is not None:
         label, fx = named
-        if further(diagnosis):  # the causes named, and further ones the last round leaned to without naming
+        if more := further(diagnosis):  # the causes named, and further ones the last round leaned to unnamed
             named = ", ".join(v.label for v in diagnosis.named_causes)
-            by = {r.fit.label: r.fit.variants[-1].label for r in diagnosis.rounds[-1]}
-            shares = ", ".join(f"{'no further cause' if k == diagnosis.final.label else '+ ' + by.get(k, k)} {w:.2f}"
+            shares = ", ".join(f"{'no further cause' if k == diagnosis.final.label else '+ ' + more[k]} {w:.2f}"
                                for k, w in diagnosis.mixture_weights.items())
             return (f"the causes diagnose named ({named}) mixed with the further causes the record leans to "
                     f"without naming one ({shares})", fx)

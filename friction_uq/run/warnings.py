@@ -67,11 +67,11 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
         return "`friction-uq diagnose` names the cause and gives f under it."
     from ..discrepancy.diagnosis_words import further, headline
 
-    if further(diagnosis):  # causes named, and further ones the record leans to without naming one
+    if more := further(diagnosis):  # causes named, and further ones the record leans to without naming one
         fm = headline(diagnosis)[1]
         names = ", ".join(v.label for v in diagnosis.named_causes)
-        more = ", ".join(k.rsplit("+", 1)[-1] for k in diagnosis.mixture_weights if k != diagnosis.final.label)
-        return (f"`diagnose` names {names}, and the record leans to a further cause without naming one ({more}); "
+        return (f"`diagnose` names {names}, and the record leans to a further cause without naming one "
+                f"({', '.join(more.values())}); "
                 f"f from the stacking mixture is {fm['q50']:.4g} [{fm['q05']:.4g}, {fm['q95']:.4g}] (the JSON's f), "
                 "wide enough for whichever is right: quote that, with this warning.")
     if diagnosis.mixture_f is not None:  # unexplained, or candidates (fitted in turn or not) the record leaves open
