@@ -487,3 +487,51 @@ def test_the_words_of_a_further_mixture_name_the_further_causes():
     said = _next_step(dg, None)
     assert "names clearance, and the record leans to a further cause" in said and "gauge_gain[external_output_bar]" \
         in said and f"{fx['q50']:.4g}" in said, said
+
+
+def test_with_no_cause_named_the_f_to_quote_is_half_the_stationary_analysis():
+    """A first round that names nothing (here an unexplained misfit) gives f from the stationary analysis' draws
+    for half and the candidates' stacking mixture for the other half, in the candidates' proportions; each draw
+    keeps its member, the stationary ones fold in the bars' whole calibration budget, and the sentence, the
+    warning and the JSON's prior of each draw say so. Without the stationary draws the mixture is the candidates'."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.candidates_mixture import MIXTURE_DRAWS, STATIONARY, STATIONARY_SHARE, mixture
+    from friction_uq.discrepancy.diagnose import Diagnosis
+    from friction_uq.discrepancy.diagnosis_words import _folded, folded_sd_of, headline, mixture_label, sentence
+    from friction_uq.quoted import folded_sd
+    from friction_uq.run.warnings import _next_step
+
+    base = SimpleNamespace(label="baseline", variants=(), f_effective=np.full(500, 0.060))
+    from friction_uq.discrepancy.extended import Variant
+
+    fits = {"clearance": 0.070, "dispersion": 0.066}
+    ranked = [SimpleNamespace(fit=SimpleNamespace(label=k, variants=(Variant(MECHANISMS[k]),),
+                                                  f_effective=np.full(500, v)), delpd=9.0, se=2.0)
+              for k, v in fits.items()]
+    v = replace(_verdict("unexplained", labels=tuple(fits)), weights={"reference": 0.0, "clearance": 0.6,
+                                                                       "dispersion": 0.4})
+    stationary = np.full(4000, 0.050)
+    x, w, which = mixture(base, ranked, v, 5, stationary)
+    assert list(w) == [STATIONARY, "clearance", "dispersion"] and sum(w.values()) == pytest.approx(1.0)
+    assert w[STATIONARY] == STATIONARY_SHARE == 0.5 and w["clearance"] == pytest.approx(0.3)
+    assert len(x) == MIXTURE_DRAWS and np.mean(x == 0.050) == pytest.approx(0.5, abs=1.0 / MIXTURE_DRAWS)
+    value = {STATIONARY: 0.050} | fits
+    assert np.all(x == np.array([value[list(w)[i]] for i in which]))
+    x0, w0, _ = mixture(base, ranked, v, 5)  # without: the candidates alone, as the study's stored rounds read it
+    assert STATIONARY not in w0 and w0["clearance"] == pytest.approx(0.6) and not np.any(x0 == 0.050)
+    cell = SimpleNamespace(channel="input_bar", phase="rise")
+    dg = Diagnosis(baseline=base, rounds=(tuple(ranked),), misfits=(SimpleNamespace(flagged=lambda: [cell],
+                                                                                  detected=True),),
+                   causes=(), not_separable=(), separate_by=None, final=base, verdicts=(v,), mixture_f=x,
+                   mixture_weights=w, mixture_source=which)
+    sds = _folded(dg)
+    assert np.all(sds[x == 0.050] == folded_sd()) and np.all(sds[x != 0.050] == folded_sd_of(ranked[0].fit.variants))
+    assert mixture_label(dg).startswith("mixture of stationary analysis (0.50), clearance (0.30)")
+    fx = headline(dg)[1]
+    assert fx["q05"] < 0.050 and fx["q95"] > 0.070  # the interval holds whichever is right
+    said = sentence(dg, {"q05": 0.045, "q50": 0.050, "q95": 0.055})
+    assert "from the stationary analysis (50 %) and the candidates weighted by how well each predicts the record (" \
+           in said and "(clearance) 30 %" in said and "(dispersion) 20 %" in said, said
+    assert "in equal parts" in _next_step(dg, None)

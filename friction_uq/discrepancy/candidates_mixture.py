@@ -9,6 +9,15 @@ record's stacking weight lies on further mechanisms decisively better than the m
 which passes the naming rule (their evidence sits in a few blocks): f is then the mixture of the final model and those
 mechanisms (:func:`further_mixture`), not the final model's alone, whose interval would hold the truth only if
 nothing more were there.
+
+When no cause is named at all (the first round's candidates, unexplained or unconfirmed), the whole-record models
+are not the only answer: the stationary analysis reads f from the window's levels with eq. 17's model-form term,
+while every whole-record model, the reference among them, carries the 1-D model's form over the whole record, and
+on records of another simulation a mechanism may take the weight by absorbing that form (an input bar's gain, a
+clearance) and move f with it. The two answers rest on different parts of the record and no likelihood weighs one
+against the other, so f is then their equal mixture (:data:`STATIONARY_SHARE`, a convention, not a fitted value):
+the stationary analysis' draws for one half, the stacking mixture of the candidates for the other
+(:func:`mixture`, ``stationary_f``; measured in docs/trust.md).
 """
 
 from __future__ import annotations
@@ -23,6 +32,10 @@ from .verdict import Verdict, mixture_draws
 
 #: Draws of the stacking mixture that gives f when no single cause is named.
 MIXTURE_DRAWS = 1000
+#: The label of the stationary analysis' f as a member of a mixture (module docstring).
+STATIONARY = "stationary"
+#: Its share of the f to quote when no cause is named: the two analyses in equal parts (module docstring).
+STATIONARY_SHARE = 0.5
 
 
 def unresolved_rounds(causes, verdicts) -> tuple[int, ...]:
@@ -84,17 +97,23 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
     return _draw_mixture(draws, w, seed)
 
 
-def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict,
-            seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stationary_f: np.ndarray | None = None
+            ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """f's draws from the stacking mixture of the models that carry the weight (:mod:`.verdict`), their weights
-    and each draw's model, when the first round named no single cause but found candidates or an unexplained
-    misfit; (None, {}, None) otherwise."""
+    and each draw's model, when the first round named no single cause but found candidates, an unexplained
+    misfit or an unconfirmed mechanism; (None, {}, None) otherwise. ``stationary_f``: the stationary analysis'
+    draws of f, given :data:`STATIONARY_SHARE` of the weight beside the candidates' (module docstring)."""
     if verdict.kind not in ("candidates", "unexplained", "unconfirmed"):
         return None, {}, None
     fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
     keep = [k for k in verdict.supported if verdict.weights[k] > 0.0]
     w = {k: verdict.weights[k] for k in keep}
-    return _draw_mixture({k: fits[k].f_effective for k in keep}, w, seed)
+    draws = {k: fits[k].f_effective for k in keep}
+    if stationary_f is not None:
+        total = sum(w.values())
+        w = {STATIONARY: STATIONARY_SHARE} | {k: (1.0 - STATIONARY_SHARE) * v / total for k, v in w.items()}
+        draws = {STATIONARY: np.asarray(stationary_f, float)} | draws
+    return _draw_mixture(draws, w, seed)
 
 
 def _draw_mixture(draws: dict[str, np.ndarray], weights: dict[str, float],

@@ -202,13 +202,14 @@ class _Search:
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
              hoop: bool, seed: int, n_draws: int = 1000, progress: Callable[[str], None] | None = None,
              base_scales: Mapping[str, tuple[float, float]] | None = None, max_causes: int = MAX_CAUSES,
-             workers: int | None = None) -> Diagnosis:
+             workers: int | None = None, stationary_f: np.ndarray | None = None) -> Diagnosis:
     """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring).
 
     ``base_scales``: Gaussian stand-ins (centre, sd in the unbounded coordinate) of the f and nu
     priors for the mode search. ``workers``: processes fitting a round's extended models and sharing the
     exact posterior's evaluations (None: the machine's cores, at most :data:`MAX_WORKERS`); the result does
-    not depend on it.
+    not depend on it. ``stationary_f``: the stationary analysis' draws of f, half of the f to quote when no cause
+    is named (:mod:`.candidates_mixture`); None: the candidates' mixture alone.
     """
     t0 = time.perf_counter()
     if workers is None:
@@ -229,7 +230,8 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     b = compare_whole_record(prep, final.predicted)
     k = ess = float("nan")
     method = None
-    mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else mixture(st.base, rounds[0], verdicts[0], seed)
+    mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else \
+        mixture(st.base, rounds[0], verdicts[0], seed, stationary_f)
     if causes:
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final, workers=workers)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..models.parameters import Parameter
 from ..quoted import OUTPUT_BARS, folded_sd, quoted_summary
-from .candidates_mixture import unresolved_rounds
+from .candidates_mixture import STATIONARY, unresolved_rounds
 from .diagnose import Diagnosis
 from .extended import Variant
 from .record_likelihood import GAIN_SD
@@ -24,10 +24,16 @@ BAR_CALIBRATION_FAULTS = ("gauge_gain", "bar_modulus")
 HOOP_GAIN_FINDING = 0.02
 
 
+def member_name(label: str) -> str:
+    """A mixture member's label as printed: "reference" (the whole-record model without causes) is "no cause",
+    :data:`~.candidates_mixture.STATIONARY` "stationary analysis", a model its label."""
+    return {"reference": "no cause", STATIONARY: "stationary analysis"}.get(label, label)
+
+
 def mixture_label(dg: Diagnosis) -> str:
     """'mixture of clearance (0.61), dispersion (0.33)': the models whose stacking mixture gives f, with their
-    weights ("reference": the model without causes, written as "no cause")."""
-    parts = [f"{'no cause' if k == 'reference' else k} ({w:.2f})" for k, w in dg.mixture_weights.items()]
+    weights (:func:`member_name`)."""
+    parts = [f"{member_name(k)} ({w:.2f})" for k, w in dg.mixture_weights.items()]
     return "mixture of " + ", ".join(parts)
 
 
@@ -61,8 +67,8 @@ def folded_sd_of(variants) -> float:
 
 
 def _variants_of(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
-    """The causes of the model ``label`` (a mixture's member; "reference": the model without causes)."""
-    if label == "reference":
+    """The causes of the model ``label`` (a mixture's member; "reference" and the stationary analysis: none)."""
+    if label in ("reference", STATIONARY):
         return ()
     fits = [dg.final, dg.baseline] + [r.fit for rnd in dg.rounds for r in rnd]
     return next((m.variants for m in fits if m.label == label), ())
@@ -72,7 +78,7 @@ def _folded(dg: Diagnosis) -> float | np.ndarray:
     """The sd folded into the f to quote: the final model's, or per draw of the mixture its model's."""
     if dg.mixture_f is None:
         return folded_sd_of(dg.final.variants)
-    sds = np.array([folded_sd_of(_variants_of(dg, k)) for k in dg.mixture_weights])
+    sds = np.array([folded_sd() if k == STATIONARY else folded_sd_of(_variants_of(dg, k)) for k in dg.mixture_weights])
     return sds[np.asarray(dg.mixture_source, int)] if dg.mixture_source is not None else float(sds.max())
 
 
@@ -256,8 +262,8 @@ def _remaining(dg: Diagnosis) -> str:
 def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     """The sentence of a record whose misfit no single cause explains (candidates, or unexplained)."""
     fm = headline(dg)[1]
-    shares = ", ".join(f"{'no cause' if k == 'reference' else _words_of(dg, k)} {100 * w:.0f} %"
-                       for k, w in dg.mixture_weights.items())
+    shares = ", ".join(f"{_words_of(dg, k)} {100 * w:.0f} %" for k, w in dg.mixture_weights.items()
+                       if k != STATIONARY)
     v = dg.verdict
     if v.kind == "unconfirmed":
         what = (f"{_words_of(dg, v.named)} predicts the record better than the simple model, but the simple model "
@@ -269,12 +275,20 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         where = _where(dg)
         what = (f"Unexplained misfit{where}: no cause of the catalogue explains it clearly, over the whole record "
                 "and better than every other.")
+    if STATIONARY in dg.mixture_weights:  # half the stationary analysis' f (candidates_mixture)
+        half = 100 * dg.mixture_weights[STATIONARY]
+        return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the stationary analysis "
+                f"({half:.0f} %) and the candidates weighted by how well each predicts the record ({shares}): the f "
+                f"to quote, wide enough for whichever is right; {f_without['q50']:.3f} from the stationary analysis "
+                "alone.")
     return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the candidates weighted by how well "
             f"each predicts the record ({shares}; the f to quote, wide enough for whichever is right), "
             f"{f_without['q50']:.3f} from the stationary analysis.")
 
 
 def _words_of(dg: Diagnosis, label: str) -> str:
+    if label in ("reference", STATIONARY):
+        return member_name(label)
     fit = next((r.fit for r in dg.ranking if r.fit.label == label), None)
     return label if fit is None else cause_words(fit.variants[-1], dg)
 

@@ -8,6 +8,7 @@ import numpy as np
 from ..models.parameters import effective_sample_size, summarize_draws
 from ..stats import khat_threshold
 from ..stats.streams import stream
+from .candidates_mixture import STATIONARY
 from .diagnose import Diagnosis, ModelFit, Ranked
 from .diagnosis_words import baseline_hoop_gain, chain_gauge, hoop_gain_off, mixture_label, sentence
 from .effective_prior import log_prior_f_effective
@@ -129,8 +130,8 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
     for i, label in enumerate(labels):
         at = dg.mixture_source == i
         rng = stream(dg.seed, "effective prior", f"mixture {label}")
-        log_prior[at], note = log_prior_f_effective(fits[label].variants, dg.context, f_prior, dg.mixture_f[at],
-                                                    rng=rng)
+        variants = () if label == STATIONARY else fits[label].variants  # the stationary f: f itself
+        log_prior[at], note = log_prior_f_effective(variants, dg.context, f_prior, dg.mixture_f[at], rng=rng)
         notes.append(f"{label}: {note}")
     return xr.Dataset({"f_effective": (("chain", "draw"), dg.mixture_f[None]),
                        "model": (("chain", "draw"), np.asarray(labels, dtype=object)[dg.mixture_source][None].astype(str)),
@@ -139,7 +140,8 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
                       attrs={"model": mixture_label(dg), "verdict": dg.verdict.kind,
                              "posterior_method": "stacking mixture: the final model's draws from its exact posterior "
                                                  "where it is a member, the other members' normal approximations"
-                             if dg.causes else "stacking mixture of the candidates' normal approximations"})
+                             if dg.causes else "stacking mixture of the candidates' normal approximations"
+                             + (", half of it the stationary posterior's draws" if STATIONARY in labels else "")})
 
 
 def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:

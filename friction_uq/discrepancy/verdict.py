@@ -27,7 +27,8 @@ Verdicts (:class:`Verdict`): ``named`` (one mechanism passes all three, of a mis
 misses the record, no mechanism passes); ``unconfirmed`` (a mechanism passes, but the check finds no
 misfit: not named); ``none`` (no mechanism passes, no misfit: the simple model stands). Under
 ``candidates``, ``unexplained`` and ``unconfirmed`` the f to quote is the stacking mixture of the models
-that carry the weight (:func:`mixture_draws`): its interval holds the truth whichever of them is right.
+that carry the weight (:func:`mixture_draws`), mixed in equal parts with the stationary analysis' f when ``run``
+gives its draws (:mod:`.candidates_mixture`): its interval holds the truth whichever of them is right.
 """
 
 from __future__ import annotations

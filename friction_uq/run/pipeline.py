@@ -216,7 +216,8 @@ def run_file(
 
                 say("diagnose: fitting each mechanism of the catalogue to the whole record")
                 start = {"f": summary["f"].q50, "nu": summary["nu"].q50}
-                diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say, check=wrc)
+                diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say, check=wrc,
+                                             stationary_f=samples.flat("f"))
                 outcome.add_to_datatree(dt, diag, priors["f"])
         stages["whole_record"] = time.perf_counter() - t
         levels = likelihood.force if isinstance(likelihood.force, LevelForceTerm) else LevelForceTerm(prep.data)

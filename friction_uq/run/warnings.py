@@ -65,6 +65,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     """What to do about a misfit: diagnose it, or (diagnosed) quote f under the causes it named."""
     if diagnosis is None:
         return "`friction-uq diagnose` names the cause and gives f under it."
+    from ..discrepancy.candidates_mixture import STATIONARY
     from ..discrepancy.diagnosis_words import further, headline
 
     if more := further(diagnosis):  # causes named, and further ones the record leans to without naming one
@@ -86,7 +87,8 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
             what = f"it names {named}, and a further cause among candidates the record does not tell apart{listed}"
         else:
             what = f"the record does not tell its candidate causes apart{listed}"
-        return (f"`diagnose`: {what}; f from their stacking mixture is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the "
+        half = " and the stationary analysis in equal parts" if STATIONARY in diagnosis.mixture_weights else ""
+        return (f"`diagnose`: {what}; f from their stacking mixture{half} is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the "
                 "JSON's f), wide enough for whichever is right: quote that, with this warning.")
     if not diagnosis.causes:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
