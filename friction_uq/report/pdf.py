@@ -137,7 +137,11 @@ def page_summary(r: ReportInputs) -> Figure:
     y = top
     for line_, text in zip(lines, texts):
         color = "firebrick" if line_.startswith("WARNING") else "black"
-        ax.text(0.0, y, text, fontsize=10 * k, va="top", transform=ax.transAxes, color=color, linespacing=1.2)
+        # one text per wrapped line, baselines a fixed step apart: matplotlib spaces a block's lines (and places a
+        # text's "top") by the glyphs each line holds, so a line without tall ones ran into the one above it
+        for j, row in enumerate(text.split("\n")):
+            ax.text(0.0, y - k * (10.0 * point + j * line), row, fontsize=10 * k, va="baseline",
+                    transform=ax.transAxes, color=color)
         y -= k * line * (text.count("\n") + 1.5)
     rows = []
     for name, v in list(s.items()) + [("V", r.V)]:
