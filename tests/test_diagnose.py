@@ -535,3 +535,32 @@ def test_with_no_cause_named_the_f_to_quote_is_half_the_stationary_analysis():
     assert "from the stationary analysis (50 %) and the candidates weighted by how well each predicts the record (" \
            in said and "(clearance) 30 %" in said and "(dispersion) 20 %" in said, said
     assert "in equal parts" in _next_step(dg, None)
+
+
+def test_candidates_fitted_in_turn_and_left_open_with_nothing_named_take_the_stationary_half_too():
+    """Round 1's candidates, the best fitted in turn, its rival never named and no cause besides: nothing is named,
+    and f is half the stationary analysis' and half the mixture of the final model and the rival; with a cause
+    named in an earlier round, the mixture is the candidates' alone (the named cause's model is the reference)."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.candidates_mixture import STATIONARY, named_causes, rival_mixture
+    from friction_uq.discrepancy.extended import Variant
+
+    gain = Variant(MECHANISMS["gauge_gain"], "input_bar")
+    final = SimpleNamespace(label="gauge_gain[input_bar]", f_effective=np.full(500, 0.070))
+    rival = SimpleNamespace(fit=SimpleNamespace(label="zero_drift", f_effective=np.full(500, 0.066)))
+    open_round = replace(_verdict("candidates", "gauge_gain[input_bar]", ("zero_drift",)),
+                         weights={"reference": 0.0, "gauge_gain[input_bar]": 0.7, "zero_drift": 0.3})
+    verdicts = [open_round, _verdict("none")]
+    assert named_causes([gain], verdicts) == []
+    x, w, which = rival_mixture(final, [[rival]], verdicts, [gain], 5, np.full(2000, 0.050))
+    assert list(w) == [STATIONARY, "gauge_gain[input_bar]", "zero_drift"]
+    assert w[STATIONARY] == 0.5 and w["gauge_gain[input_bar]"] == pytest.approx(0.35)
+    assert np.mean(x == 0.050) == pytest.approx(0.5, abs=1e-3)
+    # a clearance named first, then the open round: a cause is named, so the candidates' mixture alone
+    clearance = Variant(MECHANISMS["clearance"])
+    later = [_verdict("named", "clearance"), open_round, _verdict("none")]
+    assert named_causes([clearance, gain], later) == [clearance]
+    _, w2, _ = rival_mixture(final, [[], [rival]], later, [clearance, gain], 5, np.full(2000, 0.050))
+    assert STATIONARY not in w2 and set(w2) == {"gauge_gain[input_bar]", "zero_drift"}

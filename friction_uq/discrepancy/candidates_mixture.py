@@ -10,14 +10,15 @@ which passes the naming rule (their evidence sits in a few blocks): f is then th
 mechanisms (:func:`further_mixture`), not the final model's alone, whose interval would hold the truth only if
 nothing more were there.
 
-When no cause is named at all (the first round's candidates, unexplained or unconfirmed), the whole-record models
+When no cause is named at all (the first round's candidates, unexplained or unconfirmed, or candidates fitted
+in turn whose rivals stay open and no cause besides), the whole-record models
 are not the only answer: the stationary analysis reads f from the window's levels with eq. 17's model-form term,
 while every whole-record model, the reference among them, carries the 1-D model's form over the whole record, and
 on records of another simulation a mechanism may take the weight by absorbing that form (an input bar's gain, a
 clearance) and move f with it. The two answers rest on different parts of the record and no likelihood weighs one
 against the other, so f is then their equal mixture (:data:`STATIONARY_SHARE`, a convention, not a fitted value):
 the stationary analysis' draws for one half, the stacking mixture of the candidates for the other
-(:func:`mixture`, ``stationary_f``; measured in docs/trust.md).
+(:func:`mixture` and :func:`rival_mixture`, ``stationary_f``; measured in docs/trust.md).
 """
 
 from __future__ import annotations
@@ -55,11 +56,20 @@ def _open_rivals(verdict: Verdict, causes) -> list[str]:
     return [label for label in verdict.rivals if by[label] not in named]
 
 
-def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
-                  seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+def named_causes(causes, verdicts) -> list:
+    """The causes a record names: all but the candidates fitted in turn whose rivals stay open
+    (:func:`unresolved_rounds`; ``Diagnosis.named_causes``)."""
+    open_rounds = set(unresolved_rounds(causes, verdicts))
+    return [v for k, v in enumerate(causes) if k not in open_rounds]
+
+
+def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant], seed: int,
+                  stationary_f: np.ndarray | None = None) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
     is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
-    fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved."""
+    fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved.
+    ``stationary_f``: the stationary analysis' draws, given half the weight when the record names no cause
+    (module docstring)."""
     for k in unresolved_rounds(causes, verdicts)[:1]:
         verdict = verdicts[k]
         left = _open_rivals(verdict, causes)
@@ -68,6 +78,8 @@ def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes
         w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
         if sum(w.values()) <= 0.0:
             w = {label: 1.0 for label in w}
+        if not named_causes(causes, verdicts):
+            draws, w = _with_stationary(draws, w, stationary_f)
         return _draw_mixture(draws, w, seed)
     return None, {}, None
 
@@ -108,12 +120,19 @@ def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stati
     fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
     keep = [k for k in verdict.supported if verdict.weights[k] > 0.0]
     w = {k: verdict.weights[k] for k in keep}
-    draws = {k: fits[k].f_effective for k in keep}
-    if stationary_f is not None:
-        total = sum(w.values())
-        w = {STATIONARY: STATIONARY_SHARE} | {k: (1.0 - STATIONARY_SHARE) * v / total for k, v in w.items()}
-        draws = {STATIONARY: np.asarray(stationary_f, float)} | draws
+    draws, w = _with_stationary({k: fits[k].f_effective for k in keep}, w, stationary_f)
     return _draw_mixture(draws, w, seed)
+
+
+def _with_stationary(draws: dict[str, np.ndarray], weights: dict[str, float], stationary_f: np.ndarray | None
+                     ) -> tuple[dict[str, np.ndarray], dict[str, float]]:
+    """The candidates' draws and weights with the stationary analysis' draws first, given
+    :data:`STATIONARY_SHARE` of the weight, the candidates the rest in their proportions (unchanged without)."""
+    if stationary_f is None:
+        return draws, weights
+    total = sum(weights.values())
+    return ({STATIONARY: np.asarray(stationary_f, float)} | draws,
+            {STATIONARY: STATIONARY_SHARE} | {k: (1.0 - STATIONARY_SHARE) * v / total for k, v in weights.items()})
 
 
 def _draw_mixture(draws: dict[str, np.ndarray], weights: dict[str, float],

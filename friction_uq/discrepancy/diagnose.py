@@ -36,7 +36,7 @@ from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide
-from .candidates_mixture import further_mixture, mixture, rival_mixture, unresolved_rounds
+from .candidates_mixture import further_mixture, mixture, named_causes, rival_mixture, unresolved_rounds
 from .verdict import NamingRule, Verdict
 from .whole_record import WholeRecord, compare_whole_record
 
@@ -138,8 +138,7 @@ class Diagnosis:
         """The causes the record names: each round's named cause, and a round's best candidate whose rivals
         later rounds named (they were second causes, not alternatives); not a candidate fitted in turn whose
         rivals stay open (``causes`` holds every mechanism of the final model)."""
-        open_rounds = set(unresolved_rounds(self.causes, self.verdicts))
-        return tuple(v for k, v in enumerate(self.causes) if k not in open_rounds)
+        return tuple(named_causes(self.causes, self.verdicts))
 
     @property
     def open_candidates(self) -> tuple[str, ...]:
@@ -236,7 +235,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final, workers=workers)
         k, ess, method = ex.pareto_k, ex.ess, ex.method
-        mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed)
+        mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f)
         if mix is None:  # the last round's weight on further mechanisms none of which it named
             mix, mix_w, mix_src = further_mixture(final, rounds, verdicts, causes, seed)
     return Diagnosis(baseline=st.base, rounds=tuple(rounds), misfits=tuple(st.misfits), causes=tuple(causes),
