@@ -134,6 +134,27 @@ def test_the_mixture_group_holds_each_draws_prior_from_the_model_it_came_from(tm
         assert np.all(np.isfinite(lp)) and not np.allclose(lp[30:], F_PRIOR.logpdf(f[30:]))
 
 
+def test_the_stationary_half_of_a_mixture_keeps_the_f_prior_and_says_so(tmp_path):
+    """With nothing named (candidates fitted in turn and left open: causes not empty), half the mixture's draws are
+    the stationary posterior's: written as model "stationary", each with the f prior's log density (the prior the
+    stationary analysis sampled under), and the group's posterior_method says that half is there."""
+    rng = np.random.default_rng(3)
+    base = _model("baseline", (), rng.normal(0.05, 0.002, 200))
+    vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
+    stationary = rng.normal(0.052, 0.003, 50)
+    f = np.concatenate([stationary, vel.f_effective[:50]])
+    source = np.repeat([0, 1], [50, 50])
+    dg = SimpleNamespace(baseline=base, final=vel, causes=vel.variants, rounds=((SimpleNamespace(fit=vel),),),
+                         posterior_method="importance", context=CTX, seed=4, mixture_f=f, mixture_source=source,
+                         mixture_weights={"stationary": 0.5, "velocity_friction": 0.5},
+                         verdict=SimpleNamespace(kind="candidates"))
+    with _written(dg, tmp_path) as back:
+        m = back["discrepancy_mixture/posterior"]
+        assert list(m["model"].values[0][[0, -1]]) == ["stationary", "velocity_friction"]
+        np.testing.assert_allclose(m["log_prior_f_effective"].values[0][:50], F_PRIOR.logpdf(stationary))
+        assert m.attrs["posterior_method"].endswith("half of it the stationary posterior's draws")
+
+
 def test_a_mixture_member_that_drew_no_draw_is_written_without_one(tmp_path):
     """A candidate whose stacking weight is too small to draw any of the mixture's draws (bundled A-02 under
     diagnose ended in a ValueError on the empty set of its draws): the mixture is written with the others'."""

@@ -232,7 +232,8 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
             if dg.not_separable else ""
     fx = headline(dg)[1]
     return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from "
-            f"the stationary analysis without them. Why: {_describe(dg)}; the {evidence}'s evidence is "
+            f"the stationary analysis {'alone' if STATIONARY in dg.mixture_weights else 'without them'}. Why: "
+            f"{_describe(dg)}; the {evidence}'s evidence is "
             f"{first.delpd:.0f} +- {first.se:.0f} nats.{sep}{_remaining(dg)}"
             f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
 

@@ -100,8 +100,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                 "it exceeds 4 and 2 SE, still does with the 5 % of blocks that favour it most left out (spread over "
                 "the record), and beats every other extended model by the same margin; several that pass but do not "
                 "beat each other are candidates, a misfit none explains is unexplained, and f is then the stacking "
-                "mixture of the models that carry the weight; after a named cause the search goes on with it in the "
-                "model",
+                "mixture of the models that carry the weight (in equal parts with the stationary analysis' f when "
+                "nothing is named, with run); after a named cause the search goes on with it in the model",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "
@@ -138,9 +138,10 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
                        "log_prior_f_effective": (("chain", "draw"), log_prior[None],
                                                  {"description": "; ".join(notes)})},
                       attrs={"model": mixture_label(dg), "verdict": dg.verdict.kind,
-                             "posterior_method": "stacking mixture: the final model's draws from its exact posterior "
-                                                 "where it is a member, the other members' normal approximations"
-                             if dg.causes else "stacking mixture of the candidates' normal approximations"
+                             "posterior_method": ("stacking mixture: the final model's draws from its exact posterior "
+                                                  "where it is a member, the other members' normal approximations"
+                                                  if dg.causes else
+                                                  "stacking mixture of the candidates' normal approximations")
                              + (", half of it the stationary posterior's draws" if STATIONARY in labels else "")})
 
 

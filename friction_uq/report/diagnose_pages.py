@@ -103,7 +103,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
                   "round's reference is > 4 and > 2 SE, still is with the 5 % of blocks most in its favour left "
                   "out, and beats every other mechanism by the same margin; several that pass but do not beat each "
-                  "other are candidates, a misfit none explains is unexplained (f then from the stacking mixture); "
+                  "other are candidates, a misfit none explains is unexplained (f then from the stacking mixture, "
+                  "half of it the stationary analysis' f when nothing is named); "
                   "after a named cause the search goes on with it in the model."]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "

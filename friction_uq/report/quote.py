@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from ..discrepancy.candidates_mixture import STATIONARY
 from ..discrepancy.diagnosis_words import further, headline
 
 
@@ -29,6 +30,9 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None) -> tuple[str, 
             named = ", ".join(v.label for v in diagnosis.named_causes)
             if named:  # a cause named, a later round's candidates left open
                 return f"the {label}: the causes diagnose named ({named}) and candidates it could not tell apart", fx
+            if STATIONARY in diagnosis.mixture_weights:  # nothing named: half the stationary analysis' f
+                return (f"the stationary analysis and the candidates diagnose could not tell apart, in equal parts "
+                        f"({label})"), fx
             return f"the {label}, candidates diagnose could not tell apart", fx
         return f"the model with the causes diagnose named ({label})", fx
     return "the stationary analysis (eq. 17 and the hoop gauge)", f_stationary
