@@ -66,8 +66,9 @@ def folded_sd_of(variants) -> float:
     return folded_sd(GAIN_SD)
 
 
-def _variants_of(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
-    """The causes of the model ``label`` (a mixture's member; "reference" and the stationary analysis: none)."""
+def member_variants(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
+    """The causes of the model ``label`` (a mixture's member; "reference" and the stationary analysis: none): what
+    its calibration budget and its prior of f_effective are read from."""
     if label in ("reference", STATIONARY):
         return ()
     fits = [dg.final, dg.baseline] + [r.fit for rnd in dg.rounds for r in rnd]
@@ -78,7 +79,7 @@ def _folded(dg: Diagnosis) -> float | np.ndarray:
     """The sd folded into the f to quote: the final model's, or per draw of the mixture its model's."""
     if dg.mixture_f is None:
         return folded_sd_of(dg.final.variants)
-    sds = np.array([folded_sd() if k == STATIONARY else folded_sd_of(_variants_of(dg, k)) for k in dg.mixture_weights])
+    sds = np.array([folded_sd() if k == STATIONARY else folded_sd_of(member_variants(dg, k)) for k in dg.mixture_weights])
     return sds[np.asarray(dg.mixture_source, int)] if dg.mixture_source is not None else float(sds.max())
 
 

@@ -10,7 +10,8 @@ from ..stats import khat_threshold
 from ..stats.streams import stream
 from .candidates_mixture import STATIONARY
 from .diagnose import Diagnosis, ModelFit, Ranked
-from .diagnosis_words import baseline_hoop_gain, chain_gauge, hoop_gain_off, mixture_label, sentence
+from .diagnosis_words import (baseline_hoop_gain, chain_gauge, hoop_gain_off, member_variants, mixture_label,
+                              sentence)
 from .effective_prior import log_prior_f_effective
 from .extended import IMPORTANCE_DRAWS
 
@@ -122,16 +123,14 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
     drawn from (what a campaign divides out when it pools the f this record quotes)."""
     import xarray as xr
 
-    fits = ({"reference": dg.baseline} | {r.fit.label: r.fit for rnd in dg.rounds for r in rnd}
-            | {dg.final.label: dg.final})
     labels = list(dg.mixture_weights)
     log_prior = np.empty(len(dg.mixture_f))
     notes = []
     for i, label in enumerate(labels):
         at = dg.mixture_source == i
         rng = stream(dg.seed, "effective prior", f"mixture {label}")
-        variants = () if label == STATIONARY else fits[label].variants  # the stationary f: f itself
-        log_prior[at], note = log_prior_f_effective(variants, dg.context, f_prior, dg.mixture_f[at], rng=rng)
+        log_prior[at], note = log_prior_f_effective(member_variants(dg, label), dg.context, f_prior,
+                                                    dg.mixture_f[at], rng=rng)
         notes.append(f"{label}: {note}")
     return xr.Dataset({"f_effective": (("chain", "draw"), dg.mixture_f[None]),
                        "model": (("chain", "draw"), np.asarray(labels, dtype=object)[dg.mixture_source][None].astype(str)),
