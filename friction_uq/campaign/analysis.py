@@ -84,14 +84,20 @@ def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np
     nu_d = np.clip(rng.normal(nu[0], nu[1], len(x)), 1e-3, 0.499)
     g = fit.kbar * fit.data.to_f(nu_d)
     col = {p: x[:, k] for k, p in enumerate(fit.model.params)}
+    law = fit.model.law
     out: dict[str, np.ndarray] = {}
-    if "a" in col:
-        out["f_ref" if "c" in col else "f"] = col["a"] * g
-    if "s" in col:
+    if law == "constant":
+        out["f"] = col["a"] * g
+    elif law == "pressure":
+        out["f_low_p"], out["f_high_p"] = col["s"] * g, col["d"] * g
+    else:
         out["f_s"], out["f_d"], out["v_c"] = col["s"] * g, col["d"] * g, np.exp(col["log_vc"])
-    if "c" in col:
-        out["c_per_p_ref"] = col["c"]
-        out["df_dp_per_MPa"] = col["c"] / fit.p_ref * 1e6 * (col.get("a", col.get("d")) * g)
+    if "log_pc" in col:
+        pc = np.exp(col["log_pc"])
+        amp = col["s"] - col["d"] if law == "pressure" else col["amp_p"]
+        out["p_c_MPa"] = pc * fit.p_ref * 1e-6
+        # dy/dp at p_ref: -amp exp(-1 / P_c) / (P_c p_ref), per MPa, in f
+        out["df_dp_per_MPa"] = -amp * np.exp(-1.0 / pc) / (pc * fit.p_ref) * 1e6 * g
     for setup in fit.model.cal_setups:
         out[f"calibration_{setup}"] = col[f"cal_{setup}"]
     for setup in fit.model.freed:
@@ -166,7 +172,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     elpds = laws.compare(cal, ())
     law_for_flags = simplest_supported(ca.weights, ca.ranking)
     two = len(setups) == 2
-    pressure_named = any("c" in LAW_PARAMS[law] for law in supported_laws(ca.weights, ca.ranking))
+    pressure_named = any("log_pc" in LAW_PARAMS[law] for law in supported_laws(ca.weights, ca.ranking))
     first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies, every_law=two and pressure_named)
     if not freed and two and pressure_named:
         alt = laws.offset_alternative(offsets[0], cal)

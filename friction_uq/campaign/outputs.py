@@ -48,12 +48,13 @@ SCHEMA_VERSION = 3
 #: The law parameters' meanings and units, as the JSON's ``friction_law.meanings`` and the sentences give them.
 MEANINGS = {
     "f": "f (-)",
-    "f_ref": "f at the campaign's mean wall pressure (-)",
     "f_s": "f at rest, V -> 0 (-)",
     "f_d": "f at high sliding speed (-)",
     "v_c": "speed over which f falls from f_s toward f_d (m/s)",
-    "c_per_p_ref": "relative change of f per mean wall pressure of pressure (-)",
-    "df_dp_per_MPa": "change of f per MPa of wall pressure (1/MPa)",
+    "f_low_p": "f as the wall pressure tends to 0 (-)",
+    "f_high_p": "f at high wall pressure (-)",
+    "p_c_MPa": "wall pressure over which f changes from its low-pressure toward its high-pressure value (MPa)",
+    "df_dp_per_MPa": "change of f per MPa of wall pressure, at the campaign's mean pressure (1/MPa)",
     "scatter_rel": "test-to-test scatter of f beyond each test's own uncertainty (relative)",
 }
 
