@@ -336,7 +336,11 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
     assert head["q05"] <= 0.0504 <= head["q95"]
     # the headline's posterior says how it was approximated and how importance sampling judges that; a k over the
     # threshold is a warning, and the stationary f's misfit warning points at the headline f
-    assert head["posterior_method"] == dd["posterior_method"] and head["pareto_k"] == dd["pareto_k"]
+    if dd["mixture"] is None:
+        assert head["posterior_method"] == dd["posterior_method"] and head["pareto_k"] == dd["pareto_k"]
+    else:  # a mixture's draws: what each member's are; the Pareto k is the final model's importance step's
+        assert head["posterior_method"].startswith("stacking mixture") and head["pareto_k"] == dd["pareto_k"]
+    assert head["pareto_k_model"] == dd["model"]
     assert 0.0 < dd["pareto_k_threshold"] <= 0.7 and dd["importance_ess"] >= 1.0
     # the headline's draws are its exact posterior: importance-weighted when k allows, else sampled
     if dd["pareto_k"] <= dd["pareto_k_threshold"]:

@@ -155,6 +155,27 @@ def test_the_stationary_half_of_a_mixture_keeps_the_f_prior_and_says_so(tmp_path
         assert m.attrs["posterior_method"].endswith("half of it the stationary posterior's draws")
 
 
+def test_the_method_of_the_f_to_quote_is_the_mixtures_where_f_is_one():
+    """The JSON's f says how its draws were obtained: a mixture's members (not the final model's route alone),
+    and the Pareto k it carries is named as the final model's."""
+    from friction_uq.discrepancy.outcome import posterior_method_of
+
+    rng = np.random.default_rng(3)
+    vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
+    one = SimpleNamespace(final=vel, causes=vel.variants, posterior_method="importance", mixture_f=None,
+                          mixture_weights={})
+    assert posterior_method_of(one) == "importance"
+    mixed = SimpleNamespace(final=vel, causes=vel.variants, posterior_method="importance",
+                            mixture_f=rng.normal(0.06, 0.002, 100),
+                            mixture_weights={"stationary": 0.5, "velocity_friction": 0.5})
+    assert posterior_method_of(mixed) == ("stacking mixture: the final model's draws from its exact posterior where "
+                                          "it is a member, the other members' normal approximations, half of it the "
+                                          "stationary posterior's draws")
+    candidates = SimpleNamespace(final=vel, causes=(), posterior_method=None, mixture_f=mixed.mixture_f,
+                                 mixture_weights={"reference": 0.4, "velocity_friction": 0.6})
+    assert posterior_method_of(candidates) == "stacking mixture of the candidates' normal approximations"
+
+
 def test_a_mixture_member_that_drew_no_draw_is_written_without_one(tmp_path):
     """A candidate whose stacking weight is too small to draw any of the mixture's draws (bundled A-02 under
     diagnose ended in a ValueError on the empty set of its draws): the mixture is written with the others'."""

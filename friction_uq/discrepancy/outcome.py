@@ -137,11 +137,18 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
                        "log_prior_f_effective": (("chain", "draw"), log_prior[None],
                                                  {"description": "; ".join(notes)})},
                       attrs={"model": mixture_label(dg), "verdict": dg.verdict.kind,
-                             "posterior_method": ("stacking mixture: the final model's draws from its exact posterior "
-                                                  "where it is a member, the other members' normal approximations"
-                                                  if dg.causes else
-                                                  "stacking mixture of the candidates' normal approximations")
-                             + (", half of it the stationary posterior's draws" if STATIONARY in labels else "")})
+                             "posterior_method": posterior_method_of(dg)})
+
+
+def posterior_method_of(dg: Diagnosis) -> str | None:
+    """How the draws of the f the record quotes were obtained: the final model's route (:data:`POSTERIOR_NOTE`)
+    or, where f is a stacking mixture, what each member's draws are."""
+    if dg.mixture_f is None:
+        return dg.posterior_method
+    return (("stacking mixture: the final model's draws from its exact posterior where it is a member, the other "
+             "members' normal approximations" if dg.causes else
+             "stacking mixture of the candidates' normal approximations")
+            + (", half of it the stationary posterior's draws" if STATIONARY in dg.mixture_weights else ""))
 
 
 def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:

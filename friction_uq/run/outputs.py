@@ -84,8 +84,13 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
                               | {"bar_calibration_sd": FORCE_RATIO_CALIBRATION_SD,
                                  "calibration_folded_in_sd": folded_sd() if named is None else folded_of(diagnosis),
                                  "given_bar_headers": {k: given[k] for k in ("mean", "sd", "q05", "q50", "q95")}})
-    if diagnosis is not None and diagnosis.causes:
-        out |= {"posterior_method": diagnosis.posterior_method, "pareto_k": diagnosis.pareto_k}
+    if diagnosis is not None and (diagnosis.causes or diagnosis.mixture_f is not None):
+        from ..discrepancy.outcome import posterior_method_of
+
+        # the Pareto k judges the importance step of the final model's exact posterior, which a mixture holds in part
+        out |= {"posterior_method": posterior_method_of(diagnosis),
+                "pareto_k": diagnosis.pareto_k if diagnosis.causes else None,
+                "pareto_k_model": diagnosis.final.label if diagnosis.causes else None}
     return out
 
 
