@@ -15,6 +15,7 @@ from matplotlib.figure import Figure
 
 from .._atomic import write_bytes
 from ..analysis import Identification, Prepared
+from ..discrepancy.candidates_mixture import STATIONARY
 from ..discrepancy.check import WholeRecordCheck
 from ..discrepancy.diagnosis_words import headline as outcome_headline
 from .quote import quote_line
@@ -97,8 +98,13 @@ def page_summary(r: ReportInputs) -> Figure:
     f, nu = s["f"], s["nu"]
     share = r.nu_share
     named = None if r.diagnosis is None else outcome_headline(r.diagnosis)  # the JSON's f (the f to quote)
-    stationary = ("The stationary analysis without the named causes (page " f"{whole_record_page(r) + 2} for them): "
-                  if named is not None else "The stationary analysis: ")
+    stationary = "The stationary analysis: "
+    if named is not None and r.diagnosis.named_causes:
+        stationary = f"The stationary analysis without the named causes (page {whole_record_page(r) + 2} for them): "
+    elif named is not None:  # nothing named: a mixture of the candidates (and, from run, of this analysis)
+        half = "half of the f to quote, " if STATIONARY in r.diagnosis.mixture_weights else ""
+        stationary = (f"The stationary analysis ({half}page {whole_record_page(r) + 2} for the candidates diagnose "
+                      "could not tell apart): ")
     lines = [f"WARNING: {w}" for w in r.warnings] + [
         stationary + f"f = {f.q50:.4f}, 90 % credible interval [{f.q05:.4f}, {f.q95:.4f}] "
         f"(posterior mean {f.mean:.4f}, sd {f.sd:.4f}; given the output bars' header values, whose calibration "
