@@ -21,7 +21,8 @@ Laws (the simulator's, ``friction_uq/simulate/friction.py``) and the campaign la
 Per design, simulator and law: campaigns, how often the true law carries the largest stacking weight, how
 often it is among the laws the verdict names, how often "constant" is named on a non-constant law, how
 many set-ups were flagged (false flags: nothing is offset; a test flagged as an outlier is listed apart), with the median weight the offset laws took
-(the 0.9 rule of ``friction_uq.campaign.law_comparison.WEIGHT_RULE``), and the records that failed. The
+(the 0.9 rule of ``friction_uq.campaign.law_comparison.WEIGHT_RULE``), and the records that failed (each campaign's
+line names them, with the reason). The
 weights are the campaign's final ones: after a (false) flag, those of the comparison with the flagged
 set-up's level left out. The 1-D and the axisymmetric campaigns of one seed simulate the same tests.
 
@@ -135,6 +136,7 @@ def one_campaign(design: str, law: str, simulator: str, seed: int, *, workers: i
             "flagged": [f["setup"] for f in doc.get("flagged", []) if "setup" in f],
             "outlier_tests": [f["test"] for f in doc.get("flagged", []) if "test" in f],
             "offset_weight": por.get("weight_with_offset"), "failed": doc["counts"]["failed"],
+            "refused": [f"{r['test_id']}: {r['message']}" for r in doc.get("records", []) if r["status"] == "failed"],
             "seconds_simulate": t_sim, "seconds_campaign": time.perf_counter() - t0,
             "statements": doc.get("statements", [])}
 
@@ -185,6 +187,7 @@ def main() -> None:
                               + ", ".join(f"{k} {v:.2f}" for k, v in r["weights"].items())
                               + f"; named {', '.join(r['supported']) or '-'}; flagged {r['flagged'] or '-'}"
                               + (f", outlying tests {r['outlier_tests']}" if r["outlier_tests"] else "")
+                              + (f"; refused {'; '.join(r['refused'])}" if r["refused"] else "")
                               + f" ({r['seconds_simulate'] + r['seconds_campaign']:.0f} s)", flush=True)
                         if args.save:
                             Path(args.save).write_text(json.dumps(rows, indent=1))

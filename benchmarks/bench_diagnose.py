@@ -6,7 +6,11 @@ ranges (as ``bench_misfit.py``), both bundled set-ups; plus clean records. Each 
 ``friction-uq run --diagnose``'s path (stationary posterior maximum, then
 :func:`friction_uq.discrepancy.diagnose.diagnose`).
 
-    python benchmarks/bench_diagnose.py [--per 8] [--clean 40] [--seed 3]
+    python benchmarks/bench_diagnose.py [--per 8] [--clean 40] [--seed 3] [--as-run]
+
+With ``--as-run`` each record goes through ``friction_uq.run(..., diagnose=True)`` instead (every round of
+``diagnose``, and the stationary posterior's draws as half of the f to quote when no cause is named): "f covered"
+is then the JSON's f, what a user of ``friction-uq run --diagnose`` reads; "given hdr" is left out.
 
 Prints, per hidden mechanism: how often the first named cause is it (exact), how often it is
 named or listed as not separable from the named one (named-or-inseparable), false alarms on clean
@@ -97,6 +101,14 @@ def analyse(path: str, priors, seed: int, max_causes: int):
                           max_causes=max_causes)
 
 
+def analyse_as_run(path: str, out: str, seed: int):
+    """``friction_uq.run(path, diagnose=True)``: the prepared record, the diagnosis and the JSON's f."""
+    import friction_uq as fu
+
+    res = fu.run(path, out_dir=out, seed=seed + 1, pdf=False, diagnose=True)
+    return res.details.prepared, res.details.diagnosis, res.f
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--per", type=int, default=8)
@@ -106,6 +118,8 @@ def main() -> None:
                     help="causes searched in turn (1: the first named cause, what the study scores)")
     ap.add_argument("--only", help="comma-separated groups (clean, or hidden mechanisms) to analyse; the records "
                     "are those of the whole study (the others are drawn and skipped)")
+    ap.add_argument("--as-run", action="store_true", help="through friction_uq.run(..., diagnose=True): the "
+                    "JSON's f, every round (module docstring)")
     args = ap.parse_args()
     only = set(args.only.split(",")) if args.only else None
     priors = load_priors(default_prior_path("I1"))
@@ -127,7 +141,11 @@ def main() -> None:
         c["n"] += 1
         t = time.perf_counter()
         try:
-            prep, dg = analyse(path, priors, seed=k, max_causes=args.max_causes)
+            if args.as_run:
+                prep, dg, f_json = analyse_as_run(path, os.path.join(tmp, "out"), seed=k)
+            else:
+                prep, dg = analyse(path, priors, seed=k, max_causes=args.max_causes)
+                f_json = None
         except FrictionUQError as exc:
             c["refused"] += 1
             print(f"{k:4d} {hidden:<18} refused: {exc}", file=sys.stderr, flush=True)
@@ -142,14 +160,15 @@ def main() -> None:
             c["named_or_inseparable"] += named == hidden or hidden in dg.not_separable
             # the diagnosed f with the output bars' calibration: the JSON's f when a cause or candidates were found
             # (when nothing needed explaining the JSON quotes the stationary f; this is the whole-record baseline's)
-            fx = quoted_of(dg)
+            fx = quoted_of(dg) if f_json is None else f_json
             tf = true_f(cfg, prep)
             c["covered"] += fx["q05"] <= tf <= fx["q95"]
             given = dg.final.f_summary()  # the posterior's own, given the bars' header values
             c["covered_given_headers"] += given["q05"] <= tf <= given["q95"]
+        fq = quoted_of(dg) if f_json is None else f_json
         print(f"{k:4d} {hidden:<18} named {named} causes {[v.label for v in dg.causes]} not_sep {list(dg.not_separable)} "
-              f"f {dg.final.f_summary()['q50']:.4f} [{dg.final.f_summary()['q05']:.4f}, {dg.final.f_summary()['q95']:.4f}] "
-              f"{secs[-1]:.1f} s", file=sys.stderr, flush=True)
+              f"f quoted {fq['q50']:.4f} [{fq['q05']:.4f}, {fq['q95']:.4f}] truth "
+              f"{true_f(cfg, prep):.4f} {secs[-1]:.1f} s", file=sys.stderr, flush=True)
         os.remove(path)
     names = ["clean"] + list(HIDDEN)
     print(f"{'hidden':<18} {'n':>3} {'exact':>6} {'named/insep':>11} {'f covered':>9} {'given hdr':>9} {'alarm':>6} "
