@@ -16,9 +16,9 @@ of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and
 ``posterior`` of the best (else heaviest) law's parameters in f units; ``models``: the same for every
 model; ``meanings``: each parameter in words with its unit; ``next_tests``: when the laws are not separated,
 each candidate test (set-up, V, p) with the expected information it brings on which law holds, most
-informative first (:mod:`.next_test`); ``pressure_or_setup``: with two set-ups and a law with a pressure term
-named, the best law with a free offset on the second set-up against the best without (dELPD, SE, the weight
-the laws with the offset carry among all eight; empty otherwise); ``nu`` the campaign's nu),
+informative first (:mod:`.next_test`); ``pressure_or_setup``: with two set-ups, when a law with a pressure term
+is named or the second set-up is flagged by the weights, the best law with a free offset on that set-up against the
+best without (dELPD, SE, the weight the laws with the offset carry among all eight; empty otherwise); ``nu`` the campaign's nu),
 ``wall_seconds`` (``records``: the records' tasks, ``analysis``: the campaign's own analysis; added by
 ``run_campaign``), ``flagged`` (set-ups and tests; a set-up's entry says the ``basis`` its offset was measured on:
 the law's, or, for a diagnosed campaign, also ``kappa`` of the stationary analysis with
