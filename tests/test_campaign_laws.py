@@ -80,7 +80,8 @@ def test_campaign_outputs_from_the_analysis(three_setups, tmp_path):
     assert set(doc["pooled"]) == {"f", "kappa"} and doc["flagged"][0]["setup"] == "B"
     text = summary_text(doc)
     assert "friction law: velocity (weight " in text and "the law that carries the weight" in text
-    assert "c_per_p_ref" not in text and "scatter_rel" not in text
+    internal = {k for m in law["models"].values() for k in m if "_" in k}  # f_s, scatter_rel, p_c_MPa, ...
+    assert "scatter_rel" in internal and not [k for k in internal if k in text], text
     assert "flagged: set-up B does not follow the shared law: kappa offset +" in text
     pdf = write_campaign_report(three_setups, doc, tmp_path / "campaign.pdf")
     assert pdf.read_bytes()[:4] == b"%PDF" and pdf.read_bytes().count(b"/Type /Page\n") + \

@@ -39,8 +39,10 @@ def test_a_set_up_reading_high_is_flagged_where_pressure_varies_within_each_set_
     ca = analyse_tests(_tests(lambda V, p: 0.035 + 0.040 * np.exp(-V / 8.0), 0.20, p_with_v=False), {}, seed=2)
     assert [f["setup"] for f in ca.flagged if "setup" in f] == ["B"]
     assert "velocity" in supported_laws(ca.weights, ca.ranking)
-    if ca.pressure_or_setup:  # flagged by the weights, not by the offset's ELPD under the simplest law
+    if "sentence" in ca.pressure_or_setup:  # flagged by the weights, not by the offset's ELPD under the simplest law
         assert ca.pressure_or_setup["weight_with_offset"] >= 0.9
+        assert ca.pressure_or_setup["sentence"] in ca.sentences
+        assert "so set-up B is flagged" in ca.pressure_or_setup["sentence"]
     flag = next(f for f in ca.flagged if "setup" in f)
     assert 0.10 < flag["offset"]["q50"] < 0.30  # B's departure, measured
 

@@ -88,8 +88,10 @@ def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np
     out: dict[str, np.ndarray] = {}
     if law == "constant":
         out["f"] = col["a"] * g
-    elif law == "pressure":
-        out["f_low_p"], out["f_high_p"] = col["s"] * g, col["d"] * g
+    elif law == "pressure":  # at the lowest and highest tested pressures: what the tests fix, not the law's limits
+        P = np.array([np.min(fit.data.p), np.max(fit.data.p)]) / fit.p_ref
+        at = col["d"][:, None] + (col["s"] - col["d"])[:, None] * np.exp(-P[None, :] / np.exp(col["log_pc"])[:, None])
+        out["f_at_lowest_p"], out["f_at_highest_p"] = at[:, 0] * g, at[:, 1] * g
     else:
         out["f_s"], out["f_d"], out["v_c"] = col["s"] * g, col["d"] * g, np.exp(col["log_vc"])
     if "log_pc" in col:
@@ -183,19 +185,20 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
             ca.flagged.append(setup_entry(offsets[0], alt["offset"], alt["d_elpd"], alt["d_se"], setups, tallies,
                                           quantity=data.basis) | {"weight_with_offset": alt["weight_with_offset"]})
             freed = [offsets[0]]
-        if freed or pressure_named:
-            ca.pressure_or_setup = alt | {"sentence": offset_sentence(alt, bool(freed), pressure=pressure_named)}
+        ca.pressure_or_setup = alt
+        if freed or pressure_named:  # said where it flagged the set-up or a pressure term may stand for the offset
+            ca.pressure_or_setup |= {"sentence": offset_sentence(alt, bool(freed), pressure=pressure_named)}
     if freed:  # the laws again, the flagged set-ups' levels left out (a free offset each): never fitted by them
         done = laws.offset_models(freed[0], cal) if two else None  # with two set-ups: the offset models themselves
         elpds = laws.compare(cal, tuple(freed), {k: v[0] for k, v in done.items()} if done else None)
         law_for_flags = simplest_supported(ca.weights, ca.ranking)
-        if ca.pressure_or_setup:  # why the set-up was flagged, before what follows from it
+        if "sentence" in ca.pressure_or_setup:  # why the set-up was flagged, before what follows from it
             ca.sentences.append(str(ca.pressure_or_setup["sentence"]))
         ca.sentences.append(f"the friction law is compared with the level of set-up {', '.join(freed)} left out: it "
                             "departs from the shared law beyond its calibration (3 %), a finding for diagnose to "
                             "explain, not a part of any law")
     ca.sentences += verdict(ca.weights, ca.ranking)
-    if ca.pressure_or_setup and not freed:  # the alternative the named law leaves open
+    if "sentence" in ca.pressure_or_setup and not freed:  # the alternative the named law leaves open
         ca.sentences.append(str(ca.pressure_or_setup["sentence"]))
     supported = supported_laws(ca.weights, ca.ranking)
     if len(supported) == 1:

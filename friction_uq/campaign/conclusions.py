@@ -37,8 +37,9 @@ class CampaignAnalysis:
     law_models: dict[str, str] = field(default_factory=dict)
     #: the stationary analysis's pooled f when ``pooled["f"]`` is f under the diagnosed models (else empty)
     pooled_stationary: dict[str, Pooled] = field(default_factory=dict)
-    #: two set-ups, none flagged by the ELPD, a law with a pressure term named: every law with and without the
-    #: second set-up's offset, compared (:meth:`~.law_comparison.LawComparison.offset_alternative`), and the sentence; else empty
+    #: two set-ups, none flagged by the ELPD: every law with and without the second set-up's offset, compared
+    #: (:meth:`~.law_comparison.LawComparison.offset_alternative`), with the sentence where a law with a pressure term
+    #: is named or the set-up is flagged by the eight models' weights; else empty
     pressure_or_setup: dict[str, object] = field(default_factory=dict)
 
     def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:

@@ -222,11 +222,10 @@ def offset_sentence(alt: dict[str, object], flagged: bool, *, pressure: bool = T
     lead = (f"{alt['best_with_offset']} (set-up {alt['setup']} {delta['q50'] * 100:+.0f} % [{delta['q05'] * 100:+.0f}, "
             f"{delta['q95'] * 100:+.0f}] off the shared law) predicts the tests {alt['d_elpd']:+.1f} +- {alt['d_se']:.1f} "
             f"against {alt['best_without']}, and the laws with that offset carry {alt['weight_with_offset']:.2f} of "
-            "the weight of all eight")
-    if not pressure:  # flagged by the weights of every law with and without the offset
-        return (f"with two set-ups, {lead}, so set-up {alt['setup']} is flagged and the laws compared with its level "
-                "left out; `--diagnose` (a plug friction or a gauge's gain fitted per test), or a third set-up, says "
-                "which set-up is off")
+            "the weight of all eight models (the four laws with and without the offset)")
+    if not pressure:  # the weights of every law with and without the offset, no pressure term named
+        return (f"with two set-ups, {lead}" + (f", so set-up {alt['setup']} is flagged; `--diagnose` (a plug friction "
+                "or a gauge's gain fitted per test), or a third set-up, says which set-up is off" if flagged else ""))
     head = "with two set-ups a pressure term and a difference between the set-ups are told apart only by the pressures "
     if flagged:
         return (head + f"within each: {lead}, so set-up {alt['setup']} is flagged and the laws compared with its level "

@@ -57,7 +57,7 @@ class LawCoordinates:
         self._amps: list[tuple[int, int, float, float]] = []
         if {"d", "s", "log_vc"} <= set(names) and v_range:
             self._pairs.append((names.index("d"), names.index("s"), names.index("log_vc"), *v_range))
-        elif {"d", "s", "log_pc"} <= set(names) and p_range:
+        elif {"d", "s", "log_pc"} <= set(names) and "log_vc" not in names and p_range:  # the pressure law
             self._pairs.append((names.index("d"), names.index("s"), names.index("log_pc"), *p_range))
         if {"amp_p", "log_pc"} <= set(names) and p_range:
             self._amps.append((names.index("amp_p"), names.index("log_pc"), *p_range))

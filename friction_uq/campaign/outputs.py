@@ -2,7 +2,8 @@
 
 ``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 3``; version 1 had no weights, and its
 set-up offsets were free; version 2 pooled the stationary f whatever the records carried, and had no ``basis``
-nor ``pooled_stationary``): ``records`` (each
+nor ``pooled_stationary``; version 3's pressure law was a straight line in p, its parameters ``f_ref`` and
+``c_per_p_ref``): ``records`` (each
 record's path, set-up, test id, ``status`` done | skipped | failed, the refusal ``message``,
 seconds, the ``causes`` its diagnosis named or null), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
 scatter ``sigma`` with 90 % intervals, each test's effective sample size, the Monte Carlo variance
@@ -42,18 +43,18 @@ from .analysis import CampaignAnalysis, f_law_draws, supported_laws
 from .job import RecordResult
 
 SCHEMA = "friction-uq/campaign"
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 
 
 #: The law parameters' meanings and units, as the JSON's ``friction_law.meanings`` and the sentences give them.
 MEANINGS = {
     "f": "f (-)",
-    "f_s": "f at rest, V -> 0 (-)",
-    "f_d": "f at high sliding speed (-)",
-    "v_c": "speed over which f falls from f_s toward f_d (m/s)",
-    "f_low_p": "f as the wall pressure tends to 0 (-)",
-    "f_high_p": "f at high wall pressure (-)",
-    "p_c_MPa": "wall pressure over which f changes from its low-pressure toward its high-pressure value (MPa)",
+    "f_s": "f at rest, V -> 0 (-; pressure+velocity: at the campaign's mean wall pressure)",
+    "f_d": "f at high sliding speed (-; pressure+velocity: at the campaign's mean wall pressure)",
+    "v_c": "sliding speed over which f changes by 63 % of its way from its value at rest to its value at high speed (m/s)",
+    "f_at_lowest_p": "f at the lowest wall pressure tested (-)",
+    "f_at_highest_p": "f at the highest wall pressure tested (-)",
+    "p_c_MPa": "wall pressure over which the pressure term changes f by 63 % of its whole change (MPa)",
     "df_dp_per_MPa": "change of f per MPa of wall pressure, at the campaign's mean pressure (1/MPa)",
     "scatter_rel": "test-to-test scatter of f beyond each test's own uncertainty (relative)",
 }

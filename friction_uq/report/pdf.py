@@ -102,9 +102,9 @@ def page_summary(r: ReportInputs) -> Figure:
     if named is not None and r.diagnosis.named_causes:
         stationary = f"The stationary analysis without the named causes (page {whole_record_page(r) + 2} for them): "
     elif named is not None:  # nothing named: a mixture of the candidates (and, from run, of this analysis)
-        half = "half of the f to quote, " if STATIONARY in r.diagnosis.mixture_weights else ""
-        stationary = (f"The stationary analysis ({half}page {whole_record_page(r) + 2} for the candidates diagnose "
-                      "could not tell apart): ")
+        half = "half the draws of the f to quote; " if STATIONARY in r.diagnosis.mixture_weights else ""
+        stationary = (f"The stationary analysis ({half}page {whole_record_page(r) + 2} for the candidates that "
+                      "diagnose could not tell apart): ")
     lines = [f"WARNING: {w}" for w in r.warnings] + [
         stationary + f"f = {f.q50:.4f}, 90 % credible interval [{f.q05:.4f}, {f.q95:.4f}] "
         f"(posterior mean {f.mean:.4f}, sd {f.sd:.4f}; given the output bars' header values, whose calibration "

@@ -67,8 +67,8 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`, with the output bars'
     calibration: :mod:`friction_uq.quoted`), the model it comes from, the calibration's sd (the budget, and what was
     folded in beyond what the model's likelihood carries) and the same f given
-    the bars' header values (``given_bar_headers``, the posterior's own); under named causes, how its posterior
-    was approximated and the Pareto k that judges it. ``f_stationary``: the stationary f to quote,
+    the bars' header values (``given_bar_headers``, the posterior's own); where it comes from a fitted model or a
+    stacking mixture, how its draws were obtained and the Pareto k of the final model's importance step. ``f_stationary``: the stationary f to quote,
     ``f_stationary_posterior`` its posterior summary."""
     from ..discrepancy.diagnosis_words import f_draws_to_quote, folded_of, headline
     from ..physics.bars import FORCE_RATIO_CALIBRATION_SD
