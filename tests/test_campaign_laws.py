@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from friction_uq.campaign import RecordResult
-from friction_uq.campaign.analysis import WEIGHT_RULE, RecordPosterior, analyse_tests, verdict
+from friction_uq.campaign.analysis import WEIGHT_RULE, RecordPosterior, analyse_tests, supported_laws, verdict
 from friction_uq.campaign.flags import causes_sentence, setup_flags, tally_causes
 from friction_uq.campaign.laws import Elpd, Model
 from friction_uq.campaign.outputs import campaign_doc, summary_text, write_netcdf
@@ -52,8 +52,13 @@ def three_setups():
 def test_the_velocity_law_is_found_and_the_odd_setup_flagged(three_setups):
     ca = three_setups
     # B's 20 % is far beyond a calibration (3 %): B is flagged (alone: A and C are not taken for off because B
-    # pulled the law), its level left out of the laws, and velocity carries the weight
-    assert ca.best == "velocity" and ca.chosen == "velocity + offset B" and ca.weights["velocity"] >= 0.9
+    # pulled the law), its level left out of the laws, and velocity is named alone: the weight is on it and on
+    # pressure+velocity, which holds it and predicts these tests alike (0.14 +- 0.65 ahead, weights 0.54 and 0.46 with
+    # the pressure term of the nineteenth session; 1.4 behind, 0.05 and 0.95, with the straight line before): stacking
+    # splits its weight between nested laws that predict alike, the named set does not (docs/campaigns.md)
+    assert ca.best == "velocity" and ca.chosen == "velocity + offset B"
+    assert ca.weights["velocity"] + ca.weights["pressure+velocity"] >= 0.9
+    assert supported_laws(ca.weights, ca.ranking) == ["velocity"]
     assert any("level of set-up B left out" in s for s in ca.sentences)
     flagged = [f for f in ca.flagged if "setup" in f]
     assert [f["setup"] for f in flagged] == ["B"]
@@ -79,7 +84,8 @@ def test_campaign_outputs_from_the_analysis(three_setups, tmp_path):
     assert "m/s" in law["meanings"]["v_c"] and "scatter" in law["meanings"]["scatter_rel"]
     assert set(doc["pooled"]) == {"f", "kappa"} and doc["flagged"][0]["setup"] == "B"
     text = summary_text(doc)
-    assert "friction law: velocity (weight " in text and "the law that carries the weight" in text
+    assert "friction law: velocity (weight " in text and ("the law that carries the weight" in text or (
+        "the laws that contain it (pressure+velocity) predict the tests no better, the others are ruled out" in text))
     internal = {k for m in law["models"].values() for k in m if "_" in k}  # f_s, scatter_rel, p_c_MPa, ...
     assert "scatter_rel" in internal and not [k for k in internal if k in text], text
     assert "flagged: set-up B does not follow the shared law: kappa offset +" in text

@@ -92,8 +92,9 @@ def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np
         P = np.array([np.min(fit.data.p), np.max(fit.data.p)]) / fit.p_ref
         at = col["d"][:, None] + (col["s"] - col["d"])[:, None] * np.exp(-P[None, :] / np.exp(col["log_pc"])[:, None])
         out["f_at_lowest_p"], out["f_at_highest_p"] = at[:, 0] * g, at[:, 1] * g
-    else:
-        out["f_s"], out["f_d"], out["v_c"] = col["s"] * g, col["d"] * g, np.exp(col["log_vc"])
+    else:  # pressure+velocity: the velocity law's values at the mean pressure, where its pressure term is 0
+        at = "" if law == "velocity" else "_at_mean_p"
+        out["f_s" + at], out["f_d" + at], out["v_c"] = col["s"] * g, col["d"] * g, np.exp(col["log_vc"])
     if "log_pc" in col:
         pc = np.exp(col["log_pc"])
         amp = col["s"] - col["d"] if law == "pressure" else col["amp_p"]

@@ -49,8 +49,10 @@ SCHEMA_VERSION = 4
 #: The law parameters' meanings and units, as the JSON's ``friction_law.meanings`` and the sentences give them.
 MEANINGS = {
     "f": "f (-)",
-    "f_s": "f at rest, V -> 0 (-; pressure+velocity: at the campaign's mean wall pressure)",
-    "f_d": "f at high sliding speed (-; pressure+velocity: at the campaign's mean wall pressure)",
+    "f_s": "f at rest, V -> 0 (-)",
+    "f_d": "f at high sliding speed (-)",
+    "f_s_at_mean_p": "f at rest, V -> 0, at the campaign's mean wall pressure (-)",
+    "f_d_at_mean_p": "f at high sliding speed, at the campaign's mean wall pressure (-)",
     "v_c": "sliding speed over which f changes by 63 % of its way from its value at rest to its value at high speed (m/s)",
     "f_at_lowest_p": "f at the lowest wall pressure tested (-)",
     "f_at_highest_p": "f at the highest wall pressure tested (-)",
