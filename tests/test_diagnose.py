@@ -216,9 +216,13 @@ def test_plug_friction_is_named_and_f_recovered(tmp_path):
     steps = diagnosis_words.f_steps(dg)
     assert [v.mechanism.name for v, _, _ in steps] == ["plug_friction"] and steps[0][2] < steps[0][1]
     assert "the plug rubbing on the tube (plug_friction), f " in doc["sentence"]
-    # the sentence quotes the f to quote: the posterior's with the output bars' calibration folded in (wider)
+    # the sentence quotes the f to quote: the posterior's with the output bars' calibration folded in. Wider in sd
+    # (Var(XG) >= E[G]^2 Var(X) >= Var(X) for an independent factor G of median 1), not in each quantile: the exact
+    # quantiles of XG smooth the draws' empirical ones, and on a draw set with a sparse lower tail (this record with
+    # the packages of 2026-11-27) q05 moved up by 0.3e-3 and the 90 % interval narrowed by 0.4e-3 with a 2 % factor
     fq = diagnosis_words.headline(dg)[1]
-    assert fq["q05"] < fx["q05"] and fq["q95"] > fx["q95"] and fq["q05"] <= 0.05 <= fq["q95"], (fq, fx)
+    assert fq["sd"] > fx["sd"], (fq, fx)
+    assert fq["q05"] <= 0.05 <= fq["q95"], (fq, fx)
     assert f"f = {fq['q50']:.3f} [{fq['q05']:.3f}, {fq['q95']:.3f}] with them (the f to quote)" in doc["sentence"]
 
 
