@@ -23,7 +23,7 @@ from .conclusions import CampaignAnalysis
 from .job import RecordResult
 from .law_comparison import (WEIGHT_RULE, LawComparison, draw_summary, fits_with_loo, offset_sentence,
                              simplest_supported, supported_laws, verdict)
-from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model
+from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model, law_mean
 from .next_test import advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
 from .pooling import implied_kappa_log_prior, strata
@@ -89,8 +89,8 @@ def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np
     if law == "constant":
         out["f"] = col["a"] * g
     elif law == "pressure":  # at the lowest and highest tested pressures: what the tests fix, not the law's limits
-        P = np.array([np.min(fit.data.p), np.max(fit.data.p)]) / fit.p_ref
-        at = col["d"][:, None] + (col["s"] - col["d"])[:, None] * np.exp(-P[None, :] / np.exp(col["log_pc"])[:, None])
+        p_rel = np.array([np.min(fit.data.p), np.max(fit.data.p)]) / fit.p_ref - 1.0
+        at = law_mean(law, {k: v[:, None] for k, v in col.items()}, np.zeros(2), p_rel)
         out["f_at_lowest_p"], out["f_at_highest_p"] = at[:, 0] * g, at[:, 1] * g
     else:  # pressure+velocity: the velocity law's values at the mean pressure, where its pressure term is 0
         at = "" if law == "velocity" else "_at_mean_p"
