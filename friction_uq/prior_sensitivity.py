@@ -188,9 +188,13 @@ def prior_data_conflict(dt, samples: PosteriorSamples, priors: Priors, *, thresh
     ll_vars = list(dt["log_likelihood"].data_vars)
     prior_s, like_s, diag = {}, {}, {}
     for n in samples.names:
-        ps = arviz_stats.psense(tree, var_names=[n], group="prior", group_var_names=[n])
         ls = arviz_stats.psense(tree, var_names=[n], group="likelihood", group_var_names=ll_vars)
-        prior_s[n], like_s[n] = float(ps[n].values), float(ls[n].values)
+        like_s[n] = float(ls[n].values)
+        if np.ptp(lp[n][1]) == 0.0:  # a flat prior over the draws (uniform): a power of it is the same prior,
+            prior_s[n] = 0.0         # so the posterior does not move (and PSIS has no tail to fit)
+        else:
+            ps = arviz_stats.psense(tree, var_names=[n], group="prior", group_var_names=[n])
+            prior_s[n] = float(ps[n].values)
         if prior_s[n] >= threshold and like_s[n] >= threshold:
             diag[n] = "prior-data conflict"
         elif prior_s[n] >= threshold:

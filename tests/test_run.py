@@ -220,6 +220,23 @@ def test_a_prior_that_overwhelms_the_data_is_said_everywhere(paper_run, tmp_path
     assert any(line.startswith("WARNING: the priors, not the data, drive the result - f:") for line in lines)
 
 
+def test_a_uniform_prior_is_run_and_its_power_scaling_is_zero(paper_run, tmp_path):
+    """The shipped sensitivity file puts a uniform prior on nu: a power of a flat prior is the same prior, so the
+    posterior cannot move with it (prior sensitivity 0); before, the power-scaling check ended the run with an
+    internal error after sampling, and left a checkpoint behind."""
+    from friction_uq.priors import PRIORS_DIR
+
+    _, _, rec = paper_run
+    out = tmp_path / "wide"
+    code = main(["run", str(rec), "--out", str(out), "--seed", "7", "--quiet", "--no-pdf",
+                 "--priors", str(PRIORS_DIR / "I1-nu-wide.toml")])
+    assert code == 0
+    assert sorted(p.name for p in out.iterdir()) == ["paper_P-01.json", "paper_P-01.nc"]
+    js = json.loads((out / "paper_P-01.json").read_text())
+    assert js["prior_data_conflict"]["prior_sensitivity"]["nu"] == 0.0
+    assert js["prior_data_conflict"]["prior_sensitivity"]["f"] > 0.0  # the half-normal f prior is scaled as before
+
+
 def test_run_file_can_run_silently(paper_run, tmp_path, capsys):
     from friction_uq.run import run_file
 
