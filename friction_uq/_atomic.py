@@ -203,6 +203,37 @@ def output_lock(folder: Path, stem: str, *, busy: str | None = None) -> Iterator
         os.close(fd)
 
 
+@contextmanager
+def output_folder(folder: Path) -> Iterator[Path]:
+    """Create ``folder`` (and its parents) for a run's outputs; if the run then fails, remove the folders this
+    call created that are still empty, so that a refused run leaves nothing behind.
+
+    Raises
+    ------
+    OutputError
+        If ``folder`` is a file or cannot be created.
+    """
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"{folder}: --out must be a directory, and this is a file")
+    made = []
+    for p in reversed([folder, *folder.parents]):
+        if not p.exists():
+            made.append(p)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"{folder}: cannot create the output directory ({os_error_text(exc)})") from None
+    try:
+        yield folder
+    except BaseException:
+        for p in reversed(made):  # the deepest first; a folder something was written into stays
+            try:
+                p.rmdir()
+            except OSError:
+                break
+        raise
+
+
 def check_unlocked(folder: Path, stem: str, *, busy: str | None = None) -> None:
     """Refuse at once, as :func:`output_lock` would, when another process holds ``folder/.<stem>.lock``: a
     busy folder is said before any work. Takes nothing and creates nothing (the lock itself is taken later)."""

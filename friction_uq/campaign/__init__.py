@@ -25,6 +25,7 @@ from typing import Any
 
 from .._atomic import check_unlocked, output_lock
 from ..errors import FrictionUQError, check_seed
+from ..priors import load_priors
 from .analysis import CampaignAnalysis, analyse
 from .compare import Comparison, TestResult, TrendFit, compare, comparison_table, fit_trend, load_result
 from .job import RecordResult, RecordTask, read_result, run_record
@@ -72,6 +73,8 @@ def run_campaign(
     busy = (f"{out}: another friction-uq campaign is writing into this folder (lock .{CAMPAIGN_LOCK}.lock); "
             "wait for it to end or choose another --out")
     check_unlocked(out, CAMPAIGN_LOCK, busy=busy)  # said at once; the lock itself is taken below
+    if priors_path is not None:  # one prior file for every record: refused at once, not once per record
+        load_priors(priors_path)
     headers = [read_header(p) for p in find_records(inputs)]
     check_headers(headers)
     made = not out.exists()
@@ -85,8 +88,9 @@ def run_campaign(
                                priors_path=priors_path, dispersion=dispersion, hoop=hoop, pdf=pdf, diagnose=diagnose,
                                progress=progress)
     finally:
-        if made and out.is_dir() and not any(out.iterdir()):
-            out.rmdir()  # a refused campaign leaves no empty folder behind
+        for folder in (out / RECORDS_SUBDIR, out):  # a refused campaign leaves no empty folder behind
+            if made and folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
 
 
 def _run_locked(headers, out: Path, *, workers: int, scheduler: str | None, seed: int, priors_path, dispersion: bool,

@@ -52,8 +52,10 @@ def find_records(inputs: Sequence[str | os.PathLike[str]]) -> list[Path]:
             if not inside:
                 raise FrictionUQError(f"{p}: a folder with no records in it (no *.h5 or *.hdf5 file)")
             found.extend(inside)
+        elif p.exists():
+            found.append(p)  # a file that is no record is a failed record of the campaign, said in its table
         else:
-            found.append(p)
+            raise FrictionUQError(f"{p}: no such file or folder")
     return found
 
 

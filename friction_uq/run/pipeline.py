@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from .._atomic import check_unlocked, output_lock, remove_orphans, write_together
+from .._atomic import check_unlocked, output_folder, output_lock, remove_orphans, write_together
 from .._parallel import Background
 from ..analysis import Identification, Prepared, identify, prepare
 from ..discrepancy.check import WholeRecordCheck
@@ -39,13 +39,13 @@ from ..diagnostics import (
     ratio_ppc,
     summarize,
 )
-from ..errors import OutputError, SamplingError, check_seed, os_error_text
+from ..errors import OutputError, SamplingError, check_seed
 from ..likelihood import Likelihood, LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import default_prior_path, load_priors
 from ..quoted import quoted_summary
 from ..record import read_record
-from ..sampler import PosteriorSamples, sample_posterior, stderr_progress
+from ..sampler import PosteriorSamples, likelihood_priors, sample_posterior, stderr_progress
 from ..settings import AnalysisSettings
 from .alongside import alongside, whole_record_start
 from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
@@ -127,13 +127,8 @@ def run_file(
     likelihood = Likelihood(prep.data, hoop=use_hoop, axial_poisson=settings.axial_poisson,
                             hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy,
                             force_mode=settings.force_mode, ratio_model_form=settings.ratio_model_form)
+    likelihood_priors(likelihood, priors)  # the prior file holds every parameter the likelihood needs
     out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"{out}: --out must be a directory, and this is a file")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"{out}: cannot create the output directory ({os_error_text(exc)})") from None
     stem = safe_stem(record.campaign, record.test_id)
     names = {"netcdf": out / f"{stem}.nc", "pdf": out / f"{stem}.pdf", "json": out / f"{stem}.json"}
     for p in names.values():
@@ -148,7 +143,8 @@ def run_file(
         import matplotlib.figure  # noqa: F401
     # on the other core while this one samples: forked before the output lock is taken (the child holds
     # no lock), stopped on the way out
-    with (Background(alongside if check else None, prep, priors, whole_record_start(lab, priors),
+    with (output_folder(out),  # created here; removed again if the run fails and leaves it empty
+          Background(alongside if check else None, prep, priors, whole_record_start(lab, priors),
                      hoop=use_hoop, seed=seed, check=check, pages=pdf) as side_job,
           output_lock(out, stem)):
         backend = out / f".{stem}.checkpoint.npz"
@@ -245,7 +241,7 @@ def run_file(
 
         seconds = time.perf_counter() - t_start
         doc: dict[str, object] = {"schema": RUN_SCHEMA, "schema_version": RUN_SCHEMA_VERSION, "warnings": warns,
-                                  "f": quoted_f(f_quoted, summary["f"].to_json(), diag)}
+                                  "f": quoted_f(f_quoted, summary["f"].to_json(), diag, hoop=samples.hoop)}
         allv = dict(summary) | {"V": V}
         for name in JSON_VARIABLES:
             v = allv[name]
@@ -293,7 +289,7 @@ def run_file(
     if table:
         from ..report.quote import quote_line
 
-        print(quote_line(f_quoted, diag, len(warns)))
+        print(quote_line(f_quoted, diag, len(warns), hoop=samples.hoop))
         for w in warns:
             print(f"WARNING: {w}")
         lines = []

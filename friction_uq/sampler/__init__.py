@@ -44,12 +44,12 @@ Design
   posteriori in z, every walker inside the prior support.
 """
 
-from .ensemble import integrated_time, sample_posterior
+from .ensemble import integrated_time, likelihood_priors, sample_posterior
 from .model import LogPosterior, _initial_guess, start_ball
 from .moves import BlockDEMove
 from .results import ConvergenceWarning, PosteriorSamples, Progress, SamplerSettings, stderr_progress
 
 __all__ = [
     "BlockDEMove", "ConvergenceWarning", "LogPosterior", "PosteriorSamples", "Progress", "SamplerSettings",
-    "_initial_guess", "integrated_time", "sample_posterior", "start_ball", "stderr_progress",
+    "_initial_guess", "integrated_time", "likelihood_priors", "sample_posterior", "start_ball", "stderr_progress",
 ]

@@ -89,6 +89,16 @@ def _memory_backend(ck: checkpoint.Checkpoint, nwalkers: int, ndim: int) -> emce
     return b
 
 
+def likelihood_priors(likelihood: Likelihood, priors: Priors) -> Priors:
+    """The priors of the likelihood's parameters, in its order; :class:`PriorError` (naming the file and the missing
+    parameter) if the prior file lacks one: checked before any work."""
+    try:
+        return priors.subset(likelihood.names)
+    except PriorError as exc:
+        raise PriorError(f"{exc} (the {'hoop' if likelihood.has_hoop else 'force'} likelihood needs "
+                         f"{', '.join(likelihood.names)})") from exc
+
+
 def sample_posterior(
     data: StationaryData,
     priors: Priors,
@@ -168,10 +178,7 @@ def sample_posterior(
         raise SamplingError(f"the likelihood given is over other data or has the hoop term "
                             f"{'on' if likelihood.has_hoop else 'off'} against hoop={hoop}")
     names = likelihood.names
-    try:
-        prior = priors.subset(names)
-    except PriorError as exc:
-        raise PriorError(f"{exc} (the {'hoop' if likelihood.has_hoop else 'force'} likelihood needs {', '.join(names)})") from exc
+    prior = likelihood_priors(likelihood, priors)
     log_post = LogPosterior(likelihood, prior)
     ndim = len(names)
     if nwalkers < 2 * ndim:
