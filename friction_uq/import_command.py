@@ -45,10 +45,11 @@ def run(args: argparse.Namespace, parser: argparse.ArgumentParser, output_check)
         from .acquisition.binary import BINARY_SUFFIXES, describe_binary
         from .acquisition.delimited import describe_text
         from .errors import ScopeFileError
+        from .plausible import not_regular
 
         for f in args.files:
             if not f.is_file():
-                raise ScopeFileError(f"{f}: {'is a directory' if f.is_dir() else 'file not found'}")
+                raise ScopeFileError(f"{f}: {not_regular(f) or 'file not found'}")
             lines = describe_binary(f) if f.suffix.lower() in BINARY_SUFFIXES else describe_text(f)
             print("\n".join(lines))
         return 0

@@ -12,8 +12,11 @@ decompresses to.
 from __future__ import annotations
 
 import math
+import os
 import re
+import stat
 import unicodedata
+from pathlib import Path
 
 #: (low, high, unit, what spans it) per quantity; bounds are inclusive.
 RANGES: dict[str, tuple[float, float, str, str]] = {
@@ -46,6 +49,9 @@ MAX_SAMPLES = 1_000_000
 MAX_RECORD_BYTES = 256 * 2**20
 #: Bytes of one attribute of a record, as stored.
 MAX_ATTRIBUTE_BYTES = 64 * 2**10
+#: Longest test id or campaign name (characters): the two name every output file, whose name the file system
+#: limits to 255 bytes.
+MAX_ID_CHARS = 100
 #: Bytes of a text input (simulation configuration, prior file, result JSON).
 MAX_TEXT_BYTES = 1 * 2**20
 #: Parts of one dotted key or table name of a TOML file (``a.b.c`` has 3), and levels of nesting.
@@ -65,6 +71,18 @@ def out_of_range(key: str, value: float) -> str | None:
         return None
     u = f" {unit}" if unit else ""
     return f"is {value!r}{u}, outside the plausible range [{low:g}, {high:g}]{u} ({what})"
+
+
+def not_regular(path: Path) -> str | None:
+    """None if ``path`` is a regular file (or does not exist: its reader says so), else a few words: a pipe would
+    block the reader, a device never end."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return None
+    if stat.S_ISREG(mode):
+        return None
+    return "is a folder" if stat.S_ISDIR(mode) else "is not a regular file (a device or a pipe)"
 
 
 def unprintable(text: str) -> str | None:

@@ -15,6 +15,10 @@ Each is commented for the lab to edit; docs/priors.md describes the format.
 
 from __future__ import annotations
 
+import json
+
+from .plausible import unprintable
+
 NU_MIN, NU_MAX = 0.01, 0.49
 
 _COMMON_F = """\
@@ -46,17 +50,26 @@ def _check(nu: float, sd: float) -> None:
         raise ValueError(f"--nu-sd must lie in (0, 0.25], got {sd:g}")
 
 
+def _check_source(source: str) -> None:
+    bad = unprintable(source)
+    if bad:
+        raise ValueError(f"--source {bad}: it is written on one line of the prior files")
+
+
 def _head(material: str, description: str, source: str) -> str:
+    """The files' head; ``description`` as a TOML basic string (a JSON string is one: quotes and backslashes
+    escaped)."""
     return (f"# Priors for the sample material {material} (written by friction-uq priors; edit to suit).\n"
             f"# {source}\n"
             "# Read by friction-uq run --priors THIS_FILE; every key is checked (a typo is refused). docs/priors.md.\n"
             f'material = "{material}"\n'
-            f'description = "{description}"\n\n')
+            f"description = {json.dumps(description)}\n\n")
 
 
 def default_text(material: str, nu: float, sd: float, source: str = "") -> str:
     """The text of ``MATERIAL.toml``."""
     _check(nu, sd)
+    _check_source(source)
     src = source or "nu estimated by the lab"
     return (_head(material, f"{material} default: nu {nu:g} +- {sd:g} ({src}), f weakly informative, hoop gauge 5 %",
                   f"nu: {src}.")

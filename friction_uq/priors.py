@@ -58,7 +58,7 @@ import numpy as np
 from scipy import special, stats
 
 from .errors import PriorError
-from .plausible import is_name, toml_shape_problem
+from .plausible import is_name, not_regular, toml_shape_problem
 
 #: Physical support (lower, upper) of each parameter the analysis knows.
 PARAMETERS: Mapping[str, tuple[float, float]] = {
@@ -376,6 +376,9 @@ def load_priors(path: str | Path) -> Priors:
         names the file, the key and the problem.
     """
     path = Path(path)
+    odd = not_regular(path)
+    if odd:
+        raise _fail(path, "file", f"{odd}, not a prior file")
     try:
         with open(path, "rb") as fh:
             raw = fh.read(MAX_PRIOR_BYTES + 1)

@@ -6,7 +6,6 @@ The parser and the command's body; :mod:`friction_uq.cli` registers them.
 from __future__ import annotations
 
 import argparse
-import re
 from pathlib import Path
 
 HELP = "list the materials with prior files, or write starting prior files for a new sample material"
@@ -19,8 +18,12 @@ DESCRIPTION = (
 
 
 def _material(text: str) -> str:
-    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.+-]*", text) or "-nu-" in text:
-        raise argparse.ArgumentTypeError(f"material {text!r} must be a name of letters, digits, '_', '.', '+', '-' "
+    """The rule ``run`` looks a record's material up by (:func:`~friction_uq.plausible.is_name`), so that every file
+    written here can be found."""
+    from .plausible import is_name
+
+    if not is_name(text) or "-nu-" in text:
+        raise argparse.ArgumentTypeError(f"material {text!r} must be a name of letters, digits, '_' and '-' "
                                          "(as in the record's /apparatus/sample@material), without '-nu-'")
     return text
 

@@ -402,14 +402,22 @@ def test_an_absurd_prior_scale_is_refused(tmp_path):
 
 def _result_json(**change) -> str:
     s = {"mean": 0.05, "sd": 0.003, "q05": 0.045, "q50": 0.05, "q95": 0.055}
-    doc = {"campaign": "A", "test_id": "A-01", "f": s, "kappa": s, "nu": s, "V": s, "p_mean": s} | change
+    doc = {"schema": "friction-uq/run-result", "schema_version": 4, "campaign": "A", "test_id": "A-01", "f": s,
+           "kappa": s, "nu": s, "V": s, "p_mean": s} | change
     return json.dumps(doc)
 
 
 @pytest.mark.parametrize("text, words", [
     ("[]", "a JSON list, not an object"),
     ('"x"', "a JSON str, not an object"),
-    ("{}", "key(s) f, kappa, nu, V, p_mean, test_id, campaign missing"),
+    ("{}", "key 'schema' is None, not 'friction-uq/run-result'"),
+    (_result_json(schema="other"), "key 'schema' is 'other'"),
+    (_result_json(schema_version=99), "key 'schema_version' is 99; this friction-uq reads run results of versions 1"),
+    (_result_json(schema_version="4"), "key 'schema_version' is '4'"),
+    (_result_json(f="0.05", f_stationary={"mean": 0.05, "sd": 0.003, "q05": 0.045, "q50": 0.05, "q95": 0.055}),
+     "key 'f' must hold finite numbers"),
+    (json.dumps({"schema": "friction-uq/run-result", "schema_version": 4}),
+     "key(s) f, kappa, nu, V, p_mean, test_id, campaign missing"),
     ("{", "not JSON"),
     ("[" * 100_000, "not JSON"),
     (_result_json(f=[1, 2]), "key 'f' must hold finite numbers"),
@@ -571,3 +579,91 @@ def test_ctrl_c_stops_a_campaigns_dask_workers_quietly(tmp_path):
             break
         time.sleep(0.1)
     assert not alive, [Path(f"/proc/{w}/cmdline").read_bytes()[:200] for w in alive]
+
+
+# ---------------------------------------------------------------- 6. found by a fault-injection pass (session 20)
+
+
+def test_a_prior_file_without_the_hoop_prior_is_refused_before_any_folder(good_record, tmp_path, capsys):
+    text = (PRIORS_DIR / "I1.toml").read_text()
+    cut = text[:text.index("[hoop_gain]")]
+    (tmp_path / "p.toml").write_text(cut)
+    assert _code(["run", good_record, "--priors", tmp_path / "p.toml", "--out", tmp_path / "o", "--quiet",
+                  "--no-pdf"]) == 2
+    assert "p.toml: [hoop_gain]: no prior for this parameter" in _one_sentence(capsys)
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_run_that_fails_after_making_its_folder_leaves_none(good_record, tmp_path, capsys):
+    """A prior of sd 1e-300 passes the file's checks; the sampler then cannot place its walkers, after the folder
+    was made: the folders the run made are removed again, a folder that was there stays."""
+    text = (PRIORS_DIR / "I1.toml").read_text()
+    (tmp_path / "p.toml").write_text(text.replace("sd = 0.03", "sd = 1e-300"))
+    assert "sd = 1e-300" in (tmp_path / "p.toml").read_text()
+    assert _code(["run", good_record, "--priors", tmp_path / "p.toml", "--out", tmp_path / "a" / "b", "--quiet",
+                  "--no-pdf"]) == 2
+    assert "could not place the walkers" in _one_sentence(capsys)
+    assert not (tmp_path / "a").exists()
+    (tmp_path / "kept").mkdir()
+    assert _code(["run", good_record, "--priors", tmp_path / "p.toml", "--out", tmp_path / "kept", "--quiet",
+                  "--no-pdf"]) == 2
+    assert (tmp_path / "kept").is_dir() and not any((tmp_path / "kept").iterdir())
+
+
+def test_long_ids_and_long_text_attributes_are_refused(record_copy):
+    with pytest.raises(RecordError, match=r"/@test_id: is 101 characters long, more than the 100 an id may be"):
+        read_record(_edit(record_copy(), _set("/", test_id="A" * 101)))
+    with pytest.raises(RecordError, match=r"/@description: holds 70000 bytes of text, more than the 65536"):
+        read_record(_edit(record_copy(), _set("/", description="x" * 70_000)))  # a variable-length string
+
+
+def test_a_material_that_is_no_name_is_refused_by_the_reader(record_copy):
+    with pytest.raises(RecordError, match=r"/apparatus/sample@material: '../evil' is not a material name"):
+        read_record(_edit(record_copy(), _set("/apparatus/sample", material="../evil")))
+
+
+def test_a_pipe_or_a_folder_as_prior_file_is_refused_without_reading(good_record, tmp_path, capsys):
+    fifo = tmp_path / "fifo.toml"
+    os.mkfifo(fifo)
+    with pytest.raises(PriorError, match="fifo.toml: file: is not a regular file"):  # would block on open
+        load_priors(fifo)
+    with pytest.raises(PriorError, match=": file: is a folder, not a prior file"):
+        load_priors(tmp_path)
+
+
+@pytest.mark.parametrize("source, ok", [('a "quoted" \\ citation', True), ("two\nlines", False)])
+def test_priors_source_text_is_written_as_toml_or_refused(tmp_path, capsys, source, ok):
+    out = tmp_path / "p"
+    code = _code(["priors", "PMMA", "--nu", "0.35", "--nu-sd", "0.03", "--source", source, "--out", out])
+    if ok:
+        assert code == 0
+        assert source in load_priors(out / "PMMA.toml").description
+    else:
+        assert code == 2 and "--source holds the control character" in _one_sentence(capsys)
+        assert not out.exists()
+
+
+def test_priors_names_a_material_as_run_looks_it_up(tmp_path, capsys):
+    assert _code(["priors", "PE.HD", "--nu", "0.4", "--nu-sd", "0.03", "--out", tmp_path / "p"]) == 2
+    assert not (tmp_path / "p").exists()
+
+
+def test_campaign_inputs_are_refused_before_any_work(good_record, tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text((PRIORS_DIR / "I1.toml").read_text().replace("sd = 0.03", "sd = -0.03"))
+    assert _code(["campaign", good_record, "--priors", bad, "--out", tmp_path / "c1", "--quiet"]) == 2
+    assert "bad.toml: [nu] sd: must be > 0" in _one_sentence(capsys)
+    assert _code(["campaign", tmp_path / "nope", "--out", tmp_path / "c2", "--quiet"]) == 2
+    assert "nope: no such file or folder" in _one_sentence(capsys)
+    assert not (tmp_path / "c1").exists() and not (tmp_path / "c2").exists()
+
+
+def test_a_simulation_the_reader_would_refuse_is_refused(tmp_path, capsys):
+    cfg = tmp_path / "s.toml"
+    cfg.write_text("[measurement]\nsample_rate = 5e4\nduration = 1e-3\n")
+    assert _code(["simulate", cfg, "-o", tmp_path / "s.h5"]) == 2
+    assert "key 'measurement.sample_rate' must lie in [100000" in _one_sentence(capsys)
+    cfg.write_text("[loading]\nstriker_velocity = 0.05\n")
+    assert _code(["simulate", cfg, "-o", tmp_path / "s.h5"]) == 2
+    assert "key 'loading.striker_velocity' must lie in [0.1" in _one_sentence(capsys)
+    assert not (tmp_path / "s.h5").exists()

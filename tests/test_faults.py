@@ -216,7 +216,7 @@ def test_a_real_full_disk_is_one_sentence_and_leaves_nothing(record, tmp_path):
     (["run", "{rec}", "--priors", "{u16}"], "is not UTF-8 text"),
     (["run", "{rec}", "--priors", "{binary}"], "is not UTF-8 text"),
     (["run", "{rec}", "--priors", "{deep}"], "nested too deeply"),
-    (["run", "{rec}", "--priors", "{tmp}"], "cannot be read"),
+    (["run", "{rec}", "--priors", "{tmp}"], "is a folder, not a prior file"),
     (["inspect", "{u16}"], "is not an HDF5 file"),
     (["analyze", "{tmp}"], "is a directory"),
 ])

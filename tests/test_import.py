@@ -227,6 +227,31 @@ def test_missing_column_is_named(tmp_path, scope_csv, capsys):
     assert "scope.csv: column 'CH7' not found; the header line 6 has: Time, CH1, CH2, CH3, CH4" in err
 
 
+def test_rows_over_the_sample_limit_are_counted_before_parsing(tmp_path, scope_csv, capsys, monkeypatch):
+    import friction_uq.acquisition.delimited as delimited
+
+    def no_parse(*args, **kwargs):
+        raise AssertionError("the numbers were parsed before the rows were counted")
+
+    monkeypatch.setattr(delimited, "MAX_SAMPLES", 1000)  # the export holds a few thousand rows
+    monkeypatch.setattr(delimited.np, "loadtxt", no_parse)
+    err = _refused(tmp_path, [scope_csv], setup_doc(), capsys)
+    assert "scope.csv: more than 1000 data rows from line" in err
+
+
+def test_a_material_that_is_no_name_is_refused_in_the_setup(tmp_path, scope_csv, capsys):
+    doc = setup_doc()
+    doc["apparatus"]["sample"]["material"] = "../evil"
+    err = _refused(tmp_path, [scope_csv], doc, capsys)
+    assert "SETUP.toml: [apparatus.sample] material: '../evil' is not a material name" in err
+
+
+def test_a_device_is_not_an_export(tmp_path, capsys):
+    setup = write_setup(tmp_path / "SETUP.toml", setup_doc())
+    assert main(["import", "/dev/zero", "--setup", str(setup), "-o", str(tmp_path / "o.h5")]) == 2
+    assert "/dev/zero: is not a regular file (a device or a pipe)" in capsys.readouterr().err
+
+
 def test_non_numeric_cell_names_line_and_column(tmp_path, scope_csv, capsys):
     lines = scope_csv.read_text().splitlines()
     cells = lines[3000].split(",")

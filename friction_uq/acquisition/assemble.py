@@ -22,6 +22,7 @@ import numpy as np
 from ..record.writer import write_apparatus
 from .._atomic import atomic_path
 from ..errors import RecordError, ScopeFileError, SetupError
+from ..plausible import not_regular
 from ..record.contract import FORMAT, FORMAT_VERSION
 from .binary import BINARY_SUFFIXES, Trace, read_binary
 from .delimited import read_delimited
@@ -226,7 +227,7 @@ def import_scope_files(files: Sequence[str | os.PathLike[str]], setup: Setup | s
         raise ScopeFileError("no oscilloscope file given")
     for p in paths:
         if not p.is_file():
-            raise ScopeFileError(f"{p}: {'is a directory' if p.is_dir() else 'file not found'}")
+            raise ScopeFileError(f"{p}: {not_regular(p) or 'file not found'}")
     by_file: dict[Path, list[ChannelSetup]] = {}
     for ch in st.channels.values():
         by_file.setdefault(_file_of(st, ch, paths), []).append(ch)

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ScopeFileError
+from ..plausible import MAX_SAMPLES
 
 #: Largest text export read (bytes): 1 M samples x 8 columns of 16-character numbers is 140 MB.
 MAX_TEXT_BYTES = 2_000_000_000
@@ -197,6 +198,10 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
     for _ in range(start):
         offset = text.index("\n", offset) + 1
     body = text[offset:]
+    rows = body.count("\n") + 1
+    if rows > MAX_SAMPLES and sum(1 for ln in body.split("\n") if ln.strip()) > MAX_SAMPLES:  # before parsing
+        raise ScopeFileError(f"{p}: more than {MAX_SAMPLES} data rows from line {start + 1}, more samples than a "
+                             "record may hold (docs/limits.md); export a shorter or decimated record")
     if dec == ",":
         body = body.replace(",", ".")
     uniq = sorted(set(idx))

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SetupError
+from ..plausible import escaped, is_name, not_regular
 from ..record.contract import CHANNELS, REQUIRED_CHANNELS
 
 #: Largest set-up file read (bytes).
@@ -215,6 +216,9 @@ def _apparatus(path: Path, doc: dict) -> dict[str, dict[str, Any]]:
                 raise _fail(path, f"{where} {name}", "missing (SI units: Pa, m/s, m, kg/m^3)")
             if name == "material":
                 vals[name] = _string(path, f"{where} {name}", g[name])
+                if not is_name(vals[name]):  # as the record reader: it names the prior file, never a path
+                    raise _fail(path, f"{where} {name}", f"{escaped(vals[name])!r} is not a material name (letters, "
+                                "digits, '-' and '_' only)")
             else:
                 vals[name] = _number(path, f"{where} {name}", g[name], positive=name != "gauge_offset")
         for name in OPTIONAL_ATTRS.get(part, ()):
@@ -304,6 +308,9 @@ def parse_setup(doc: dict, *, path: str | Path = "<setup>") -> Setup:
 def load_setup(path: str | Path) -> Setup:
     """Read and check a SETUP.toml; :class:`SetupError` names the file, the key and the problem."""
     p = Path(path)
+    odd = not_regular(p)
+    if odd:
+        raise _fail(p, "file", f"{odd}, not a set-up file")
     try:
         with open(p, "rb") as fh:
             raw = fh.read(MAX_SETUP_BYTES + 1)

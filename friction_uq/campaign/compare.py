@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionUQError
+from ..run.outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION
 
 REQUIRED = ("f", "kappa", "nu", "V", "p_mean", "test_id", "campaign")
 SUMMARIES = ("f", "kappa", "nu", "V", "p_mean")
@@ -55,13 +56,26 @@ class TrendFit:
         return float(self.coef[j] / self.se[j])
 
 
+def _check_summary(p: Path, key: str, v: object, *, positive_sd: bool = False) -> None:
+    """Refuse, naming the file and the key, a summary that is not finite numbers ``STATISTICS`` with sd >= 0 (> 0
+    with ``positive_sd``)."""
+    import math
+
+    bad = [s for s in STATISTICS if not isinstance(v, dict) or isinstance(v.get(s), bool)
+           or not isinstance(v.get(s), (int, float)) or not math.isfinite(v[s])]
+    if bad:
+        raise FrictionUQError(f"{p}: key {key!r} must hold finite numbers {', '.join(STATISTICS)}; "
+                              f"{', '.join(bad)} {'is' if len(bad) == 1 else 'are'} not")
+    assert isinstance(v, dict)
+    if v["sd"] < 0 or (positive_sd and v["sd"] == 0):
+        raise FrictionUQError(f"{p}: key '{key}': sd is {v['sd']!r}, it must be > 0")
+
+
 def load_result(path: str | os.PathLike[str]) -> TestResult:
     """Read one ``<campaign>_<test_id>.json`` written by ``friction-uq run``; refuse, in one sentence naming the
     file and the key, one that is not a JSON object with the ids as text and each summary as finite numbers. Its
     f is the stationary analysis' (``f_stationary``, given the bars' header values, as its kappa; ``f`` in a
     file of schema 1)."""
-    import math
-
     from ..plausible import MAX_TEXT_BYTES, escaped, unprintable
 
     p = Path(path)
@@ -75,25 +89,28 @@ def load_result(path: str | os.PathLike[str]) -> TestResult:
         raise FrictionUQError(f"{p}: not a friction-uq result file ({exc})") from None
     if not isinstance(doc, dict):
         raise FrictionUQError(f"{p}: not a friction-uq run result (a JSON {type(doc).__name__}, not an object)")
+    if doc.get("schema") != RUN_SCHEMA:
+        raise FrictionUQError(f"{p}: key 'schema' is {doc.get('schema')!r}, not {RUN_SCHEMA!r}: not a friction-uq run "
+                              "result")
+    version = doc.get("schema_version")
+    if isinstance(version, bool) or not isinstance(version, int) or not 1 <= version <= RUN_SCHEMA_VERSION:
+        raise FrictionUQError(f"{p}: key 'schema_version' is {version!r}; this friction-uq reads run results of "
+                              f"versions 1 to {RUN_SCHEMA_VERSION}")
     missing = [k for k in REQUIRED if k not in doc]
     if missing:
         raise FrictionUQError(f"{p}: not a friction-uq run result: key(s) {', '.join(missing)} missing")
-    # schema >= 2: f_stationary is the stationary f, given the bars' header values as kappa is (f: the f to quote)
+    # schema >= 2: f_stationary is the stationary f, given the bars' header values as kappa is (f: the f to quote,
+    # checked as the others are, though the comparison reads f_stationary)
     field = {"f": "f_stationary"} if "f_stationary" in doc else {}
+    if field:
+        _check_summary(p, "f", doc["f"])
     doc = doc | {k: doc[v] for k, v in field.items()}
     for key in ("campaign", "test_id"):
         if not isinstance(doc[key], str) or not doc[key].strip() or unprintable(doc[key]):
             shown = escaped(doc[key]) if isinstance(doc[key], str) else repr(doc[key])
             raise FrictionUQError(f"{p}: key {key!r} is {shown!r}, not an id (non-empty text, no control characters)")
     for key in SUMMARIES:
-        v = doc[key]
-        bad = [s for s in STATISTICS if not isinstance(v, dict) or isinstance(v.get(s), bool)
-               or not isinstance(v.get(s), (int, float)) or not math.isfinite(v[s])]
-        if bad:
-            raise FrictionUQError(f"{p}: key {field.get(key, key)!r} must hold finite numbers {', '.join(STATISTICS)}; "
-                                  f"{', '.join(bad)} {'is' if len(bad) == 1 else 'are'} not")
-        if v["sd"] < 0 or (key == "kappa" and v["sd"] == 0):
-            raise FrictionUQError(f"{p}: key '{field.get(key, key)}': sd is {v['sd']!r}, it must be > 0")
+        _check_summary(p, field.get(key, key), doc[key], positive_sd=key == "kappa")
     return TestResult(doc["campaign"], doc["test_id"], doc["f"], doc["kappa"], doc["nu"], doc["V"], doc["p_mean"],
                       str(p))
 

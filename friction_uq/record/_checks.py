@@ -48,6 +48,10 @@ class Reader:
             value = value.item()
         if isinstance(value, bytes):
             value = value.decode("utf-8", "replace")
+        if isinstance(value, str) and len(value.encode("utf-8", "surrogatepass")) > MAX_ATTRIBUTE_BYTES:
+            # a variable-length string is stored apart from its attribute, whose storage size does not count it
+            raise self.fail(loc, f"holds {len(value.encode('utf-8', 'surrogatepass'))} bytes of text, more than the "
+                            f"{MAX_ATTRIBUTE_BYTES} an attribute may")
         if kind == "str":
             if not isinstance(value, str):
                 raise self.fail(loc, f"must be a string, got {type(value).__name__} {value!r}")

@@ -25,6 +25,7 @@ from ..errors import RecordError
 from ._apparatus_reader import read_apparatus
 from ..plausible import (
     MAX_ATTRIBUTE_BYTES,
+    MAX_ID_CHARS,
     MAX_RECORD_BYTES,
     MAX_SAMPLES,
     apparatus_problem,
@@ -114,6 +115,9 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
     for key, value in (("test_id", test_id), ("campaign", campaign)):
         if not value.strip():
             raise r.fail(f"/@{key}", "is empty")
+        if len(value) > MAX_ID_CHARS:
+            raise r.fail(f"/@{key}", f"is {len(value)} characters long, more than the {MAX_ID_CHARS} an id may be "
+                         "(it names the output files)")
         bad = unprintable(value)
         if bad:
             raise r.fail(f"/@{key}", f"{bad} ('{escaped(value)}'): an id is printed on terminals and names files")

@@ -17,7 +17,7 @@ file and the key.
     seed = 101                  # optional integer >= 0; simulate(..., seed=N) overrides it
 
     [loading]
-    striker_velocity = 10.0     # m/s, (0, 100]
+    striker_velocity = 10.0     # m/s, [0.1, 100]
     rise_time = 20e-6           # s, rise (and fall) of the trapezoidal incident wave, (0, 1e-4]
 
     [sample]
@@ -42,7 +42,7 @@ file and the key.
     dispersion = false          # Pochhammer-Chree dispersion on every bar leg
 
     [measurement]
-    sample_rate = 5e6           # Hz
+    sample_rate = 5e6           # Hz, [1e5, 1e9]
     duration = 1.3e-3           # s, record length
     pretrigger = 80e-6          # s, from the record start to the incident wave's foot at the input gauge
 
@@ -88,7 +88,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..physics.tube import BETA_EFF_PAPER_TUBE
-from ..plausible import MAX_SIMULATED_SAMPLES, apparatus_problem
+from ..plausible import MAX_SIMULATED_SAMPLES, RANGES, apparatus_problem
 from ..record import CHANNELS, UNITS, Apparatus, Plug, paper_apparatus
 from ._checks import Section
 from .apparatus import check_consistency, parse_apparatus
@@ -206,7 +206,9 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
     kw["seed"] = s.integer("seed", None, low=0, high=2**63 - 1)
 
     s = Section(source, "loading", data.get("loading", {}), ("striker_velocity", "rise_time"))
-    kw["striker_velocity"] = s.number("striker_velocity", d.striker_velocity, low=0.0, high=100.0, low_open=True)
+    # the lower bounds are the record reader's (friction_uq.plausible): what is simulated can be read back
+    kw["striker_velocity"] = s.number("striker_velocity", d.striker_velocity, low=RANGES["striker_velocity"][0],
+                                      high=100.0)
     kw["rise_time"] = s.number("rise_time", d.rise_time, low=0.0, high=1e-4, low_open=True)
 
     s = Section(source, "sample", data.get("sample", {}), ("poisson_ratio",))
@@ -231,7 +233,7 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
     kw["dispersion"] = s.boolean("dispersion", d.dispersion)
 
     s = Section(source, "measurement", data.get("measurement", {}), ("sample_rate", "duration", "pretrigger"))
-    kw["sample_rate"] = s.number("sample_rate", d.sample_rate, low=1e4, high=1e9)
+    kw["sample_rate"] = s.number("sample_rate", d.sample_rate, low=RANGES["signals.sample_rate"][0], high=1e9)
     kw["duration"] = s.number("duration", d.duration, low=0.0, high=0.1, low_open=True)
     kw["pretrigger"] = s.number("pretrigger", d.pretrigger, low=0.0, high=0.1)
 
