@@ -133,7 +133,7 @@ def page_summary(r: ReportInputs) -> Figure:
         lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, stationary_quoted(r)))
     # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
     # together where they would run into the table below them
-    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings)), 100))
+    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings), hoop=r.samples.hoop), 100))
     ax.text(0.0, 1.0, first, fontsize=13, va="top", transform=ax.transAxes, weight="bold",
             color="firebrick" if r.warnings else "black")
     point = 1.0 / (ax.get_position().height * fig.get_figheight() * 72.0)  # one point, in axes fraction

@@ -12,6 +12,7 @@ from scipy import stats
 
 from ..analysis import Prepared
 from ..diagnostics import VariableSummary
+from ..gauge_check import hoop_findings
 from ..priors import PRIORS_DIR, Priors, load_priors
 
 
@@ -60,6 +61,7 @@ def alternative_nu_priors(default_path: Path, priors: Priors) -> dict[str, Prior
 def hoop_unusable(p: Prepared) -> str | None:
     """Why the hoop gauge cannot enter the likelihood for this record, or None if it can.
 
+    * the gauge reads the tube contracting through the loading (reversed: :func:`~friction_uq.gauge_check.hoop_findings`);
     * the channel shows no pulse above its noise (a dead or disconnected gauge);
     * its window mean is not a swelling beyond 3 standard errors (noise of the mean and offset);
     * the tube differs from the one the influence function was fitted to (bore 10 mm, outer
@@ -71,6 +73,9 @@ def hoop_unusable(p: Prepared) -> str | None:
         return (f"the tube influence function is fitted to a 10/24 mm tube with nu_t = 0.29, this record's tube is "
                 f"{t.inner_diameter * 1e3:g}/{t.outer_diameter * 1e3:g} mm with nu_t = {t.poisson_ratio:g}")
     info = p.forces.channels["tube_hoop"]
+    for finding in hoop_findings(p.forces, p.record.apparatus, info.noise.sd):
+        if finding.kind == "reversed":  # a reversed gauge's pulse is not "no pulse": say what it is
+            return finding.sentence
     if not info.detected:
         return "tube_hoop shows no pulse above its noise (a dead or disconnected gauge?)"
     se = info.noise.window_mean_sd(p.data.n)

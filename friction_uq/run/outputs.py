@@ -63,7 +63,7 @@ RUN_SCHEMA_VERSION = 4
 
 
 def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],
-             diagnosis=None) -> dict[str, object]:
+             diagnosis=None, *, hoop: bool = True) -> dict[str, object]:
     """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`, with the output bars'
     calibration: :mod:`friction_uq.quoted`), the model it comes from, the calibration's sd (the budget, and what was
     folded in beyond what the model's likelihood carries) and the same f given
@@ -75,7 +75,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     from ..quoted import folded_sd
     from ..report.quote import f_to_quote
 
-    source, fx = f_to_quote(f_stationary, diagnosis)
+    source, fx = f_to_quote(f_stationary, diagnosis, hoop=hoop)
     named = None if diagnosis is None else headline(diagnosis)
     model = "stationary" if named is None else named[0]
     given = f_stationary_posterior if named is None else summarize_draws(f_draws_to_quote(diagnosis))
