@@ -33,11 +33,11 @@ def test_the_bundled_campaign_gives_one_verdict_over_five_seeds(tmp_path):
     """The laws' fits are sampled in coordinates where their autocorrelation time is tens of steps
     (friction_uq/campaign/law_coordinates.py); before, it was 200-250 steps against 700 kept, the fits' tails
     followed the seed, and so did the verdict (seed 4 read pressure+velocity with no set-up flagged, the others
-    pressure and velocity with B flagged). Converged, pressure+velocity predicts the tests best among the laws
-    without B's offset, and B's offset under it is short of decisive (3.3-3.5 nats, SE 0.8: the pressure term
-    takes most of B's departure, B's bars putting it at higher pressures); compared with every law with B's
-    offset, those carry all the stacking weight (velocity + offset B leads by 4.1-4.7), so B is flagged and the
-    laws compared with its level left out. B hides a plug friction (data/README.md)."""
+    named laws and flagged B). The verdict asserted is what every seed reads: f not constant, constant not among
+    the laws named, and set-up B flagged (it departs from the shared law by more than its calibration allows;
+    B hides a plug friction, data/README.md). Which of the non-constant laws are named is compared across the
+    seeds, not fixed here; the measured ELPDs and weights, which move with the law's form, are in
+    docs/validation.md ("Campaigns on the bundled data")."""
     records = sorted(DATA.glob("[AB]/*.h5"))
     verdicts = [_verdict(run_campaign(records, tmp_path / f"s{seed}", seed=seed, pdf=False, progress=False).analysis)
                 for seed in range(1, 6)]

@@ -48,9 +48,10 @@ def _summary_page(ca: CampaignAnalysis, doc: dict[str, Any]):
                        colWidths=[0.07, 0.1, 0.08, 0.1, 0.2, 0.45], bbox=[0.0, 0.0, 1.0, min(0.55, 0.03 * (len(rows) + 1))])
         tab.auto_set_font_size(False)
         tab.set_fontsize(8)
-    fig.text(0.01, 0.01, "f: under each test's diagnosed model where diagnose ran, else the stationary analysis "
-             "(eq. 17 with the hoop gauge), given the bars' header values (the laws carry each set-up's calibration "
-             "offset); each test's f to quote, with its bars' calibration, is in its own JSON.", fontsize=8)
+    fig.text(0.01, 0.01, _wrapped(["f: under each test's diagnosed model where diagnose ran, else the stationary "
+                                   "analysis (eq. 17 with the hoop gauge), given the bars' header values (the laws "
+                                   "carry each set-up's calibration offset); each test's f to quote, with its bars' "
+                                   "calibration, is in its own JSON."], width=170), fontsize=8, va="bottom")
     return fig
 
 
