@@ -215,22 +215,25 @@ def output_folder(folder: Path) -> Iterator[Path]:
     """
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"{folder}: --out must be a directory, and this is a file")
-    made = []
-    for p in reversed([folder, *folder.parents]):
-        if not p.exists():
-            made.append(p)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"{folder}: cannot create the output directory ({os_error_text(exc)})") from None
-    try:
-        yield folder
-    except BaseException:
+    full = Path(os.path.abspath(folder))  # 'a/../b' made 'b' only
+    made = [p for p in reversed([full, *full.parents]) if not p.exists()]
+
+    def remove_made() -> None:
         for p in reversed(made):  # the deepest first; a folder something was written into stays
             try:
                 p.rmdir()
             except OSError:
                 break
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        remove_made()  # the parents made before the failure
+        raise OutputError(f"{folder}: cannot create the output directory ({os_error_text(exc)})") from None
+    try:
+        yield folder
+    except BaseException:
+        remove_made()
         raise
 
 

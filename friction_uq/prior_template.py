@@ -51,6 +51,10 @@ def _check(nu: float, sd: float) -> None:
 
 
 def _check_source(source: str) -> None:
+    try:
+        source.encode("utf-8")
+    except UnicodeEncodeError:  # bytes of another encoding, passed through as lone surrogates
+        raise ValueError("--source holds bytes that are not UTF-8 text") from None
     bad = unprintable(source)
     if bad:
         raise ValueError(f"--source {bad}: it is written on one line of the prior files")

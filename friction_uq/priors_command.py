@@ -70,6 +70,8 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise FrictionUQError(f"priors {args.material}: {exc}") from None
     paths = {args.out / name: text for name, text in texts.items()}
+    if args.out.exists() and not args.out.is_dir():
+        raise OutputError(f"{args.out}: --out must be a folder, and this is a file")
     if not args.force:
         for p in paths:
             if p.exists():

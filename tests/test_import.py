@@ -239,13 +239,6 @@ def test_rows_over_the_sample_limit_are_counted_before_parsing(tmp_path, scope_c
     assert "scope.csv: more than 1000 data rows from line" in err
 
 
-def test_a_material_that_is_no_name_is_refused_in_the_setup(tmp_path, scope_csv, capsys):
-    doc = setup_doc()
-    doc["apparatus"]["sample"]["material"] = "../evil"
-    err = _refused(tmp_path, [scope_csv], doc, capsys)
-    assert "SETUP.toml: [apparatus.sample] material: '../evil' is not a material name" in err
-
-
 def test_a_device_is_not_an_export(tmp_path, capsys):
     setup = write_setup(tmp_path / "SETUP.toml", setup_doc())
     assert main(["import", "/dev/zero", "--setup", str(setup), "-o", str(tmp_path / "o.h5")]) == 2

@@ -154,9 +154,23 @@ def test_a_dead_hoop_gauge_is_left_out_with_a_note(tmp_path, capsys):
     doc = json.loads((out / "dead_D-01.json").read_text())
     assert doc["hoop_term"] is False and doc["hoop_left_out"]
     assert doc["f"]["q05"] <= 0.05 <= doc["f"]["q95"]
+    assert doc["f"]["source"] == "the stationary analysis (eq. 17; the hoop gauge left out)"  # not "and the hoop"
     # nor the whole-record check, where its calibration prior would make a flat gauge pull nu
     channels = {fig["channel"] for fig in doc["misfit"]["figures"]}
     assert "tube_hoop" not in channels and "external_output_bar" in channels
+
+
+def test_a_reversed_hoop_gauge_is_said_as_reversed(tmp_path, capsys):
+    test = ClosedFormTest(f=0.05, nu=0.4)
+    rec = write_closed_form_record(tmp_path / "rev.h5", test, seed=8, test_id="R-01", campaign="rev")
+    import h5py
+
+    with h5py.File(rec, "r+") as fh:
+        fh["signals/tube_hoop"][...] = -fh["signals/tube_hoop"][...]
+    assert main(["run", str(rec), "--out", str(tmp_path / "o"), "--quiet", "--no-pdf"]) == 0
+    err = capsys.readouterr().err
+    assert "hoop gauge is left out of the likelihood: /signals/tube_hoop reads the tube contracting" in err
+    assert "looks reversed" in err and "no pulse above its noise" not in err
 
 
 def test_out_that_is_a_file_is_refused(paper_run, tmp_path, capsys):

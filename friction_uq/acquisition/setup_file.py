@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SetupError
-from ..plausible import escaped, is_name, not_regular
+from ..plausible import not_regular
 from ..record.contract import CHANNELS, REQUIRED_CHANNELS
 
 #: Largest set-up file read (bytes).
@@ -216,9 +216,6 @@ def _apparatus(path: Path, doc: dict) -> dict[str, dict[str, Any]]:
                 raise _fail(path, f"{where} {name}", "missing (SI units: Pa, m/s, m, kg/m^3)")
             if name == "material":
                 vals[name] = _string(path, f"{where} {name}", g[name])
-                if not is_name(vals[name]):  # as the record reader: it names the prior file, never a path
-                    raise _fail(path, f"{where} {name}", f"{escaped(vals[name])!r} is not a material name (letters, "
-                                "digits, '-' and '_' only)")
             else:
                 vals[name] = _number(path, f"{where} {name}", g[name], positive=name != "gauge_offset")
         for name in OPTIONAL_ATTRS.get(part, ()):

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._atomic import check_unlocked, output_lock
+from .._atomic import check_unlocked, output_folder, output_lock
 from ..errors import FrictionUQError, check_seed
 from ..priors import load_priors
 from .analysis import CampaignAnalysis, analyse
@@ -77,34 +77,23 @@ def run_campaign(
         load_priors(priors_path)
     headers = [read_header(p) for p in find_records(inputs)]
     check_headers(headers)
-    made = not out.exists()
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise FrictionUQError(f"{out}: cannot create the output directory ({exc.strerror or exc})") from None
-    try:
-        with output_lock(out, CAMPAIGN_LOCK, busy=busy):
-            return _run_locked(headers, out, workers=workers, scheduler=scheduler, seed=seed,
-                               priors_path=priors_path, dispersion=dispersion, hoop=hoop, pdf=pdf, diagnose=diagnose,
-                               progress=progress)
-    finally:
-        for folder in (out / RECORDS_SUBDIR, out):  # a refused campaign leaves no empty folder behind
-            if made and folder.is_dir() and not any(folder.iterdir()):
-                folder.rmdir()
+    # a refused campaign leaves no empty folder behind (output_folder removes those it made, while empty)
+    with output_folder(out), output_lock(out, CAMPAIGN_LOCK, busy=busy):
+        return _run_locked(headers, out, workers=workers, scheduler=scheduler, seed=seed,
+                           priors_path=priors_path, dispersion=dispersion, hoop=hoop, pdf=pdf, diagnose=diagnose,
+                           progress=progress)
 
 
 def _run_locked(headers, out: Path, *, workers: int, scheduler: str | None, seed: int, priors_path, dispersion: bool,
                 hoop: bool, pdf: bool, diagnose: bool, progress: bool) -> CampaignOutcome:
     """:func:`run_campaign` once its inputs are checked and it holds the folder's campaign lock."""
     records_dir = out / RECORDS_SUBDIR
-    try:
-        records_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise FrictionUQError(f"{records_dir}: cannot create the output directory ({exc.strerror or exc})") from None
-    tasks = make_tasks(headers, out_dir=records_dir, seed=seed, priors_path=str(priors_path) if priors_path else None,
-                       dispersion=dispersion, hoop=hoop, pdf=pdf, diagnose=diagnose)
-    t0 = time.perf_counter()
-    results = run_tasks(tasks, workers=workers, scheduler=scheduler, progress=progress)
+    with output_folder(records_dir):  # removed again while empty if the tasks are refused (no scheduler answers)
+        tasks = make_tasks(headers, out_dir=records_dir, seed=seed,
+                           priors_path=str(priors_path) if priors_path else None, dispersion=dispersion, hoop=hoop,
+                           pdf=pdf, diagnose=diagnose)
+        t0 = time.perf_counter()
+        results = run_tasks(tasks, workers=workers, scheduler=scheduler, progress=progress)
     t1 = time.perf_counter()
     say = (lambda line: print(f"campaign: {line}", file=sys.stderr, flush=True)) if progress else None
     ca = analyse(results, records_dir, seed=seed, say=say) if any(r.ok for r in results) else None

@@ -19,7 +19,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionUQError
-from ..run.outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION
 
 REQUIRED = ("f", "kappa", "nu", "V", "p_mean", "test_id", "campaign")
 SUMMARIES = ("f", "kappa", "nu", "V", "p_mean")
@@ -89,13 +88,20 @@ def load_result(path: str | os.PathLike[str]) -> TestResult:
         raise FrictionUQError(f"{p}: not a friction-uq result file ({exc})") from None
     if not isinstance(doc, dict):
         raise FrictionUQError(f"{p}: not a friction-uq run result (a JSON {type(doc).__name__}, not an object)")
-    if doc.get("schema") != RUN_SCHEMA:
-        raise FrictionUQError(f"{p}: key 'schema' is {doc.get('schema')!r}, not {RUN_SCHEMA!r}: not a friction-uq run "
-                              "result")
-    version = doc.get("schema_version")
-    if isinstance(version, bool) or not isinstance(version, int) or not 1 <= version <= RUN_SCHEMA_VERSION:
-        raise FrictionUQError(f"{p}: key 'schema_version' is {version!r}; this friction-uq reads run results of "
-                              f"versions 1 to {RUN_SCHEMA_VERSION}")
+    from ..run.outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION
+
+    # schema 1 files carry neither key; every later one carries both
+    if "schema" in doc or "schema_version" in doc:
+        if doc.get("schema") != RUN_SCHEMA:
+            raise FrictionUQError(f"{p}: key 'schema' is {doc.get('schema')!r}, not {RUN_SCHEMA!r}: not a friction-uq "
+                                  "run result")
+        version = doc.get("schema_version")
+        if isinstance(version, bool) or not isinstance(version, int) or not 2 <= version <= RUN_SCHEMA_VERSION:
+            raise FrictionUQError(f"{p}: key 'schema_version' is {version!r}; this friction-uq reads run results of "
+                                  f"versions 1 to {RUN_SCHEMA_VERSION}")
+        if "f_stationary" not in doc:
+            raise FrictionUQError(f"{p}: key 'f_stationary' is missing, which a result of schema version {version} "
+                                  "holds")
     missing = [k for k in REQUIRED if k not in doc]
     if missing:
         raise FrictionUQError(f"{p}: not a friction-uq run result: key(s) {', '.join(missing)} missing")

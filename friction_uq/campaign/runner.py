@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionUQError
+from ..plausible import not_regular
 from .job import RecordResult, RecordTask, file_sha256, run_record
 
 RECORD_SUFFIXES = (".h5", ".hdf5")
@@ -52,10 +53,12 @@ def find_records(inputs: Sequence[str | os.PathLike[str]]) -> list[Path]:
             if not inside:
                 raise FrictionUQError(f"{p}: a folder with no records in it (no *.h5 or *.hdf5 file)")
             found.extend(inside)
-        elif p.exists():
-            found.append(p)  # a file that is no record is a failed record of the campaign, said in its table
-        else:
+        elif not p.exists():
             raise FrictionUQError(f"{p}: no such file or folder")
+        elif odd := not_regular(p):  # a pipe would block the checksum, a device never end it
+            raise FrictionUQError(f"{p}: {odd}, not a record")
+        else:
+            found.append(p)  # a file that is no record is a failed record of the campaign, said in its table
     return found
 
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 from typing import Any
 
 from ..apparatus import DEFAULT_BAR_POISSON_RATIO, Apparatus, Bar, Plug, Sample, Tube
-from ..plausible import escaped, is_name
 from ._checks import Reader
 
 _BAR_ATTRS = ("young_modulus", "wave_speed", "diameter", "length")
@@ -43,9 +42,6 @@ def read_apparatus(app: Any, r: Reader) -> Apparatus:
         for name in names:
             if name == "material":
                 vals[name] = r.attr(g, where, name, "str")
-                if not is_name(vals[name]):  # looked up among the prior files: a name, never a path
-                    raise r.fail(f"{where}@material", f"{escaped(vals[name])!r} is not a material name (letters, "
-                                 "digits, '-' and '_' only): it names the prior file, never a path")
             elif name in _SIGNED:
                 vals[name] = r.attr(g, where, name, "float")
             else:

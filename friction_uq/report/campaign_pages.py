@@ -49,9 +49,10 @@ def _summary_page(ca: CampaignAnalysis, doc: dict[str, Any]):
         tab.auto_set_font_size(False)
         tab.set_fontsize(8)
     fig.text(0.01, 0.01, _wrapped(["f: under each test's diagnosed model where diagnose ran, else the stationary "
-                                   "analysis (eq. 17 with the hoop gauge), given the bars' header values (the laws "
-                                   "carry each set-up's calibration offset); each test's f to quote, with its bars' "
-                                   "calibration, is in its own JSON."], width=170), fontsize=8, va="bottom")
+                                   "analysis (eq. 17, with the hoop gauge where it was used), given the bars' header "
+                                   "values (the laws carry each set-up's calibration offset); each test's f to "
+                                   "quote, with its bars' calibration, is in its own JSON."], width=170),
+             fontsize=8, va="bottom")
     return fig
 
 

@@ -39,7 +39,7 @@ from ..diagnostics import (
     ratio_ppc,
     summarize,
 )
-from ..errors import OutputError, SamplingError, check_seed
+from ..errors import OutputError, PriorError, SamplingError, check_seed
 from ..likelihood import Likelihood, LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import default_prior_path, load_priors
@@ -115,7 +115,10 @@ def run_file(
             print(f"friction-uq: note: {msg}", file=sys.stderr, flush=True)
 
     record = read_record(path)
-    p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
+    try:
+        p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
+    except PriorError as exc:  # the record's material names no prior file: say which record and field
+        raise PriorError(f"{record.path}: /apparatus/sample@material: {exc}") from None
     priors = load_priors(p_path)  # every input is checked before the signals' work, the busy folder too
     check_unlocked(Path(out_dir), safe_stem(record.campaign, record.test_id))
     prep = prepare(record, window=window, dispersion=dispersion)
