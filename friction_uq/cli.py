@@ -63,13 +63,12 @@ def _output_file(path: Path, suffixes: Sequence[str], what: str) -> None:
 
 def _check_text_file(path: Path, what: str, error: type[FrictionUQError]) -> str:
     """The UTF-8 text of an input file, or one sentence saying why it is not one."""
-    import stat
-
-    from .plausible import MAX_TEXT_BYTES
+    from .plausible import MAX_TEXT_BYTES, not_regular
 
     try:
-        if not stat.S_ISREG(path.stat().st_mode):
-            raise error(f"{path}: is not a regular file (a device, a pipe or a folder), not a {what}")
+        path.stat()  # a missing file: said below, as for any file that cannot be read
+        if odd := not_regular(path):
+            raise error(f"{path}: {odd}, not a {what}")
         with open(path, "rb") as fh:
             raw = fh.read(MAX_TEXT_BYTES + 1)
     except OSError as exc:

@@ -616,6 +616,12 @@ def test_long_ids_and_long_text_attributes_are_refused(record_copy):
     with pytest.raises(RecordError, match=r"/@description: holds 70000 bytes of text, more than the 65536"):
         read_record(_edit(record_copy(), _set("/", description="x" * 70_000)))  # a variable-length string
 
+    def provenance(fh):
+        fh.require_group("provenance").attrs["note"] = "x" * 70_000
+
+    with pytest.raises(RecordError, match=r"/provenance@note: is larger than the 65536 bytes"):
+        read_record(_edit(record_copy(), provenance))
+
 
 def test_a_pipe_or_a_folder_as_prior_file_is_refused_without_reading(good_record, tmp_path, capsys):
     fifo = tmp_path / "fifo.toml"
@@ -661,6 +667,9 @@ def test_a_simulation_the_reader_would_refuse_is_refused(tmp_path, capsys):
     cfg.write_text("[loading]\nstriker_velocity = 0.05\n")
     assert _code(["simulate", cfg, "-o", tmp_path / "s.h5"]) == 2
     assert "key 'loading.striker_velocity' must lie in [0.1" in _one_sentence(capsys)
+    cfg.write_text(f'[record]\ntest_id = "{"A" * 101}"\n')
+    assert _code(["simulate", cfg, "-o", tmp_path / "s.h5"]) == 2
+    assert "key 'record.test_id' is 101 characters long, more than the 100 a record takes" in _one_sentence(capsys)
     assert not (tmp_path / "s.h5").exists()
 
 

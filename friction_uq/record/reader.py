@@ -236,6 +236,9 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
             if prov.attrs.get_id(k).get_storage_size() > MAX_ATTRIBUTE_BYTES:
                 raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
         provenance = {k: plain(v) for k, v in prov.attrs.items()}
+        for k, v in provenance.items():  # a variable-length string is stored apart: its storage size does not count it
+            if isinstance(v, str) and len(v.encode("utf-8", "surrogatepass")) > MAX_ATTRIBUTE_BYTES:
+                raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
 
     return Record(
         path=str(p),

@@ -71,12 +71,18 @@ class Section:
             raise self.fail(key, f"must be true or false, got {_show(value)}")
         return value
 
-    def string(self, key: str, default: str | None, *, choices: Sequence[str] | None = None) -> str | None:
+    def string(self, key: str, default: str | None, *, choices: Sequence[str] | None = None,
+               max_chars: int | None = None, max_bytes: int | None = None) -> str | None:
+        """``key``'s text; ``max_chars`` and ``max_bytes`` (UTF-8): the longest the record reader takes."""
         if key not in self.table:
             return default
         value = self.table[key]
         if not isinstance(value, str):
             raise self.fail(key, f"must be a string, got {_show(value)}")
+        if max_chars is not None and len(value) > max_chars:
+            raise self.fail(key, f"is {len(value)} characters long, more than the {max_chars} a record takes")
+        if max_bytes is not None and len(value.encode("utf-8", "surrogatepass")) > max_bytes:
+            raise self.fail(key, f"holds more than the {max_bytes} bytes of text a record's attribute may")
         if choices is not None and value not in choices:
             raise self.fail(key, f"is {value!r}, allowed values: {', '.join(choices)}")
         if choices is None and not value.strip():

@@ -88,7 +88,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..physics.tube import BETA_EFF_PAPER_TUBE
-from ..plausible import MAX_SIMULATED_SAMPLES, RANGES, apparatus_problem
+from ..plausible import MAX_ATTRIBUTE_BYTES, MAX_ID_CHARS, MAX_SIMULATED_SAMPLES, RANGES, apparatus_problem
 from ..record import CHANNELS, UNITS, Apparatus, Plug, paper_apparatus
 from ._checks import Section
 from .apparatus import check_consistency, parse_apparatus
@@ -193,9 +193,9 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
 
     s = Section(source, "record", data.get("record", {}),
                 ("test_id", "campaign", "description", "date", "dtype", "seed"))
-    kw["test_id"] = s.string("test_id", d.test_id)
-    kw["campaign"] = s.string("campaign", d.campaign)
-    kw["description"] = s.string("description", None)
+    kw["test_id"] = s.string("test_id", d.test_id, max_chars=MAX_ID_CHARS)  # what the reader takes back
+    kw["campaign"] = s.string("campaign", d.campaign, max_chars=MAX_ID_CHARS)
+    kw["description"] = s.string("description", None, max_bytes=MAX_ATTRIBUTE_BYTES)
     kw["date"] = s.string("date", None)
     if kw["date"] is not None:
         try:
