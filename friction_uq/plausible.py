@@ -73,6 +73,11 @@ def out_of_range(key: str, value: float) -> str | None:
     return f"is {value!r}{u}, outside the plausible range [{low:g}, {high:g}]{u} ({what})"
 
 
+def text_bytes(text: str) -> int:
+    """Bytes ``text`` takes as UTF-8 (lone surrogates counted, not refused): what an attribute's limit counts."""
+    return len(text.encode("utf-8", "surrogatepass"))
+
+
 def not_regular(path: Path) -> str | None:
     """None if ``path`` is a regular file (or does not exist: its reader says so), else a few words: a pipe would
     block the reader, a device never end."""

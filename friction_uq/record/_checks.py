@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import RecordError
-from ..plausible import MAX_ATTRIBUTE_BYTES
+from ..plausible import MAX_ATTRIBUTE_BYTES, text_bytes
 from .contract import CLIP_RUN
 
 
@@ -48,10 +48,10 @@ class Reader:
             value = value.item()
         if isinstance(value, bytes):
             value = value.decode("utf-8", "replace")
-        if isinstance(value, str) and len(value.encode("utf-8", "surrogatepass")) > MAX_ATTRIBUTE_BYTES:
+        if isinstance(value, str) and text_bytes(value) > MAX_ATTRIBUTE_BYTES:
             # a variable-length string is stored apart from its attribute, whose storage size does not count it
-            raise self.fail(loc, f"holds {len(value.encode('utf-8', 'surrogatepass'))} bytes of text, more than the "
-                            f"{MAX_ATTRIBUTE_BYTES} an attribute may")
+            raise self.fail(loc, f"holds {text_bytes(value)} bytes of text, more than the {MAX_ATTRIBUTE_BYTES} an "
+                            "attribute may")
         if kind == "str":
             if not isinstance(value, str):
                 raise self.fail(loc, f"must be a string, got {type(value).__name__} {value!r}")

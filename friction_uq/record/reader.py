@@ -31,6 +31,7 @@ from ..plausible import (
     apparatus_problem,
     escaped,
     out_of_range,
+    text_bytes,
     unprintable,
 )
 from ._checks import Reader, check_distinct, check_samples, check_strain, plain, sha256_of
@@ -237,7 +238,7 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
                 raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
         provenance = {k: plain(v) for k, v in prov.attrs.items()}
         for k, v in provenance.items():  # a variable-length string is stored apart: its storage size does not count it
-            if isinstance(v, str) and len(v.encode("utf-8", "surrogatepass")) > MAX_ATTRIBUTE_BYTES:
+            if isinstance(v, str) and text_bytes(v) > MAX_ATTRIBUTE_BYTES:
                 raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
 
     return Record(

@@ -8,6 +8,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ..errors import ConfigError
+from ..plausible import text_bytes
 
 
 class Section:
@@ -81,7 +82,7 @@ class Section:
             raise self.fail(key, f"must be a string, got {_show(value)}")
         if max_chars is not None and len(value) > max_chars:
             raise self.fail(key, f"is {len(value)} characters long, more than the {max_chars} a record takes")
-        if max_bytes is not None and len(value.encode("utf-8", "surrogatepass")) > max_bytes:
+        if max_bytes is not None and text_bytes(value) > max_bytes:
             raise self.fail(key, f"holds more than the {max_bytes} bytes of text a record's attribute may")
         if choices is not None and value not in choices:
             raise self.fail(key, f"is {value!r}, allowed values: {', '.join(choices)}")
