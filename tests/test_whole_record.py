@@ -121,3 +121,21 @@ def test_the_check_uses_a_cells_own_tolerance_where_one_is_set(tmp_path, monkeyp
     after = {(c.channel, c.phase): c.statistic for c in misfit.decide(chk.comparison).cells}
     assert after[worst] < before[worst]
     assert {k: v for k, v in after.items() if k != worst} == {k: v for k, v in before.items() if k != worst}
+
+
+def test_a_cells_own_threshold_decides_that_cell_only(tmp_path, monkeypatch):
+    """CELL_THRESHOLD gives one channel and phase its own threshold: the record's decision is then that of the cell
+    furthest over its own threshold, named with it; every other cell keeps the record threshold."""
+    from friction_uq.discrepancy import misfit
+
+    path = tmp_path / "clean.h5"
+    simulate_to_file(noisy_config(friction_params=MappingProxyType({"f": 0.06})), path, seed=1)
+    chk = _check(path)
+    assert not chk.decision.detected
+    cell = max(chk.decision.cells, key=lambda c: c.statistic)
+    monkeypatch.setitem(misfit.CELL_THRESHOLD, (cell.channel, cell.phase), 0.5 * cell.statistic)
+    d = misfit.decide(chk.comparison)
+    assert d.detected and [(c.channel, c.phase) for c in d.flagged()] == [(cell.channel, cell.phase)]
+    assert d.statistic == pytest.approx(cell.statistic) and d.threshold == pytest.approx(0.5 * cell.statistic)
+    assert f"threshold {0.5 * cell.statistic:g}" in d.sentence()
+    assert all(c.threshold == THRESHOLD for c in d.cells if (c.channel, c.phase) != (cell.channel, cell.phase))

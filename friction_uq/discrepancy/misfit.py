@@ -16,14 +16,23 @@ records of the axisymmetric simulation (plug, sample and tube in r-z): the input
 unloading (the plug's impact and rebound, which the 1-D model's rigid plug makes sharper) and the
 internal output bar's rise (the wave through an elastic sample in r-z arrives with another front).
 A timing tolerance of up to 0.5 us on those fronts, the timing a gauge's position or a trigger's
-skew may carry, brings it to 2 of 40 (the grid search ``benchmarks/bench_check_tolerance.py``,
-seed 11: 0.3 us on the input bar's rise, 0.5 us on its unloading and on the internal bar's rise),
-and to 2 of 16 on the trust study's records it was not set on. It is not applied: on the 1-D
-study's records (``benchmarks/bench_misfit.py --clean 40 --effect 6``) the same table took the
-detection of a 300 N + 2 % plug friction from 81 % to 0 of 6, and a plug friction the check does
-not see leaves f 15-40 % high with no warning, which a false alarm on a clean record does not.
-:data:`CHECK_TOLERANCE` holds a per-cell table once one is set on both kinds of records at once
-(docs/trust.md). On e' two standardised figures are formed:
+skew may carry, brings it to 2 of 40 (:data:`CHECK_TOLERANCE`, the grid search
+``benchmarks/bench_check_tolerance.py``, seed 11: 0.3 us on the input bar's rise, 0.5 us on its
+unloading and on the internal bar's rise).
+
+Threshold per cell. The statistic of a record is the largest over its cells, tested at
+:data:`THRESHOLD`; one cell has its own, lower, threshold (:data:`CELL_THRESHOLD`): the external
+output bar's rise. A force that reaches the tube without passing through the sample (a plug rubbing
+on the tube) adds to F_eo in the stationary phase exactly as wall friction does, so eq. 17 reads it as
+a higher f and nothing in that phase can tell; it shows as an external force that leads the sample's
+during the rise, and there only. Tested at 5 with the other cells, the 1-D simulation's plug friction
+was seen mostly through the input bar's unloading, the very front the tolerance table forgives; tested
+on its own at 2.5 (about the 1-2 % point of a single cell's statistic under the noise model), the cell
+sees it instead. On clean records it stayed under 1.6 on 40 of the 1-D simulation and 40 of it
+perturbed (mesh, hoop kernel, pulse, coloured noise, a channel's timing) and under 1.8 on 39 of 40 of the
+axisymmetric one (the fortieth, at 14.7, is flagged on other cells too): ``benchmarks/bench_check_cells.py``,
+seed 41; the table and this threshold together flag 2 of those 40 axisymmetric records where the
+channels' tolerances at one threshold flagged 4 (docs/trust.md gives the held-out checks). (docs/trust.md). On e' two standardised figures are formed:
 
 * the level z = mean(e') / se, se^2 the variance of an AR(1) mean (long-run variance), of the
   offset error of the pre-pulse mean and of the phase mean of the prediction over the posterior
@@ -47,7 +56,7 @@ rate of each hidden effect.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -57,9 +66,20 @@ from .whole_record import CHANNEL_LABELS, PHASES, WholeRecord, tolerance_sd, whi
 #: Decision threshold on the statistic (standard-normal units).
 THRESHOLD = 5.0
 #: The check's model tolerance where a channel's over a phase differs from its own: (channel, phase) ->
-#: (relative tolerance, timing tolerance in s) (module docstring).
-#: Empty: the table set on axisymmetric records (module docstring) cost the detection of plug friction.
-CHECK_TOLERANCE: dict[tuple[str, str], tuple[float, float]] = {}
+#: (relative tolerance, timing tolerance in s), set on clean records of the axisymmetric simulation (module docstring).
+CHECK_TOLERANCE: dict[tuple[str, str], tuple[float, float]] = {
+    ("input_bar", "rise"): (0.01, 0.5e-6),
+    ("input_bar", "unloading"): (0.01, 0.5e-6),
+    ("internal_output_bar", "rise"): (0.01, 0.5e-6),
+}
+#: The threshold of a cell where it differs from :data:`THRESHOLD`: the one place a force that bypasses the
+#: sample shows (module docstring).
+CELL_THRESHOLD: dict[tuple[str, str], float] = {("external_output_bar", "rise"): 2.5}
+
+
+def cell_threshold(channel: str, phase: str) -> float:
+    """The threshold of one channel over one phase: :data:`CELL_THRESHOLD`'s, else :data:`THRESHOLD`."""
+    return CELL_THRESHOLD.get((channel, phase), THRESHOLD)
 
 
 @dataclass(frozen=True)
@@ -72,14 +92,21 @@ class CellTest:
     shape_z: float
     relative_level: float
     chi2_dof: float = float("nan")
+    threshold: float = THRESHOLD
 
     @property
     def statistic(self) -> float:
         return max(abs(self.level_z), self.shape_z)
 
+    @property
+    def over(self) -> bool:
+        """The cell's statistic exceeds its threshold."""
+        return self.statistic > self.threshold
+
     def to_json(self) -> dict[str, float | str]:
         return {"channel": self.channel, "phase": self.phase, "level_z": self.level_z, "shape_z": self.shape_z,
-                "statistic": self.statistic, "relative_level": self.relative_level, "chi2_dof": self.chi2_dof}
+                "statistic": self.statistic, "threshold": self.threshold, "relative_level": self.relative_level,
+                "chi2_dof": self.chi2_dof}
 
 
 @dataclass(frozen=True)
@@ -96,11 +123,12 @@ class MisfitDecision:
 
     @property
     def worst(self) -> CellTest | None:
-        return max(self.cells, key=lambda c: c.statistic) if self.cells else None
+        """The cell furthest over (or nearest to) its threshold."""
+        return max(self.cells, key=lambda c: c.statistic / c.threshold) if self.cells else None
 
     def flagged(self) -> list[CellTest]:
-        """Cells over the threshold, worst first."""
-        return sorted((c for c in self.cells if c.statistic > self.threshold), key=lambda c: -c.statistic)
+        """Cells over their threshold, furthest over first."""
+        return sorted((c for c in self.cells if c.over), key=lambda c: -c.statistic / c.threshold)
 
     def sentence(self, *, page: int | None = None) -> str:
         """One line for the summary page and the terminal."""
@@ -120,7 +148,7 @@ class MisfitDecision:
         else:
             what = (f"departs from the model's shape over the {w.phase} phase (chi2/dof {w.chi2_dof:.1f}, "
                     f"shape z {w.shape_z:.0f}")
-        return f"The {CHANNEL_LABELS[w.channel]} gauge {what}; threshold {self.threshold:g}){also}{where}."
+        return f"The {CHANNEL_LABELS[w.channel]} gauge {what}; threshold {w.threshold:g}){also}{where}."
 
     def to_json(self) -> dict[str, object]:
         return {"detected": self.detected, "statistic": self.statistic, "threshold": self.threshold,
@@ -178,7 +206,8 @@ def cell_test(wr: WholeRecord, channel: str, phase: str, a: int, b: int, *, rela
     m_meas = float(np.mean(wr.measured[channel][a:b]))
     rel = float(np.mean(resid)) / m_meas if abs(m_meas) > 0 else 0.0
     w_plain = whiten(resid, sd=nz.sd, rho=nz.rho)
-    return CellTest(channel, phase, float(np.mean(e)) / se, shape, rel, float(np.mean(w_plain**2)))
+    return CellTest(channel, phase, float(np.mean(e)) / se, shape, rel, float(np.mean(w_plain**2)),
+                    cell_threshold(channel, phase))
 
 
 def phase_spans(wr: WholeRecord, channel: str) -> list[tuple[str, int, int]]:
@@ -197,5 +226,8 @@ def decide(wr: WholeRecord, *, threshold: float = THRESHOLD) -> MisfitDecision:
             if (rel, tim) not in tols:
                 tols[(rel, tim)] = channel_tolerance(wr, ch, relative=rel, timing=tim)
             cells.append(cell_test(wr, ch, phase, a, b, tolerance=tols[(rel, tim)]))
-    stat = max((c.statistic for c in cells), default=0.0)
-    return MisfitDecision(statistic=stat, threshold=threshold, cells=tuple(cells))
+    if threshold != THRESHOLD:  # a threshold given for the whole record replaces every cell's
+        cells = [replace(c, threshold=threshold) for c in cells]
+    worst = max(cells, key=lambda c: c.statistic / c.threshold, default=None)
+    return MisfitDecision(statistic=worst.statistic if worst else 0.0,
+                          threshold=worst.threshold if worst else threshold, cells=tuple(cells))

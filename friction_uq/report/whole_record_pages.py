@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..discrepancy.check import WholeRecordCheck
+from ..discrepancy.misfit import THRESHOLD
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from .style import figure
 
@@ -38,8 +39,9 @@ def _channel(ax_sig, ax_res, chk: WholeRecordCheck, ch: str) -> None:
     ax_res.axhline(2, color="tab:blue", lw=0.8, ls="--")
     ax_res.axhline(-2, color="tab:blue", lw=0.8, ls="--")
     worst = [c for c in chk.decision.cells if c.channel == ch]
-    text = ", ".join(f"{c.phase} {c.statistic:.1f}" for c in worst)
-    ax_res.set_title(f"residual / noise sd; misfit statistic {text}", fontsize=8)
+    text = ", ".join(f"{c.phase} {c.statistic:.1f}" + ("" if c.threshold == THRESHOLD else f" (threshold {c.threshold:g})")
+                     for c in worst)
+    ax_res.set_title(f"residual / noise sd; misfit statistic {text} (threshold {THRESHOLD:g})", fontsize=8)
     ax_res.set_ylabel("standardised")
     ax_res.set_xlabel("time on the record (us)")
     lim = max(4.0, float(np.nanpercentile(np.abs(z), 99.5)) * 1.1)

@@ -109,7 +109,7 @@ def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary, diagnosis
     if not cells:
         w = d.flagged()[0]
         return (f"The simulated test misses the {CHANNEL_LABELS[w.channel]} gauge over the {w.phase} phase (statistic "
-                f"{w.statistic:.0f} > {d.threshold:g}): something in this test is not in the model (a plug friction, "
+                f"{w.statistic:.0f} > {w.threshold:g}): something in this test is not in the model (a plug friction, "
                 f"a clearance, a gauge's calibration, ...) and may bias {_f_text(f)} although the stationary phase "
                 f"looks right; {_next_step(diagnosis, f)}")
     w = cells[0]
@@ -117,7 +117,7 @@ def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary, diagnosis
            "test" if abs(w.level_z) >= w.shape_z else
            f"departs from the simulated test's shape (chi2/dof {w.chi2_dof:.1f})")
     return (f"The {CHANNEL_LABELS[w.channel]} gauge {how} over the stationary phase "
-            f"(statistic {w.statistic:.0f} > {d.threshold:g}): the model behind eq. 17 misses something there, "
+            f"(statistic {w.statistic:.0f} > {w.threshold:g}): the model behind eq. 17 misses something there, "
             f"so {_f_text(f)} may be biased by about as much; {_next_step(diagnosis, f)}")
 
 
