@@ -41,7 +41,7 @@ def _channel(ax_sig, ax_res, chk: WholeRecordCheck, ch: str) -> None:
     worst = [c for c in chk.decision.cells if c.channel == ch]
     text = ", ".join(f"{c.phase} {c.statistic:.1f}" + ("" if c.threshold == THRESHOLD else f" (threshold {c.threshold:g})")
                      for c in worst)
-    ax_res.set_title(f"residual / noise sd; misfit statistic {text} (threshold {THRESHOLD:g})", fontsize=8)
+    ax_res.set_title(f"residual / noise sd; misfit statistic, threshold {THRESHOLD:g}: {text}", fontsize=8)
     ax_res.set_ylabel("standardised")
     ax_res.set_xlabel("time on the record (us)")
     lim = max(4.0, float(np.nanpercentile(np.abs(z), 99.5)) * 1.1)
