@@ -17,8 +17,9 @@ can be set and judged without fitting again. Groups (f, nu, striker speed, rise 
     python benchmarks/bench_check_cells.py --load FILE [FILE ...]
 
 ``--load`` prints, per group, the records flagged before (the channels' own tolerances, one threshold for
-every cell) and as the package applies the check (``CHECK_TOLERANCE``, ``CELL_THRESHOLD``), the cells over
-and the largest statistic of each cell as applied.
+every cell) and as the package applies the check (``CHECK_TOLERANCE``, ``CELL_THRESHOLD``), the cells over,
+and the largest statistic of the cells with a threshold of their own and of the three other largest cells, as
+applied.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from bench_check_tolerance import GRID, cell_statistics, own  # noqa: E402
 from bench_misfit import clean_config  # noqa: E402
 from verdict_records import make, write  # noqa: E402
 
-from friction_uq.discrepancy.misfit import CHECK_TOLERANCE, THRESHOLD, cell_threshold  # noqa: E402
+from friction_uq.discrepancy.misfit import CELL_THRESHOLD, CHECK_TOLERANCE, THRESHOLD, cell_threshold  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 
 
@@ -89,7 +90,8 @@ def summary(rows: list[dict]) -> str:
         for r in rs:
             for c, s in applied(r["cells"], CHECK_TOLERANCE).items():
                 top[c] = max(top.get(c, -np.inf), s)
-        big = sorted(top.items(), key=lambda kv: -kv[1])[:4]
+        big = [(c, top[c]) for c in CELL_THRESHOLD if c in top]  # the cells of their own threshold, then the largest
+        big += [kv for kv in sorted(top.items(), key=lambda kv: -kv[1]) if kv[0] not in CELL_THRESHOLD][:3]
         lines.append(f"{g:<32} {len(rs):>3} {n_own:>7} {n_app:>8}  "
                      f"{', '.join(f'{k} {v}' for k, v in over.items()) or '-'}  "
                      f"{', '.join(f'{c[0]}/{c[1]} {s:.1f}' for c, s in big)}")
@@ -117,14 +119,12 @@ def main(argv: list[str]) -> int:
             with open(a.save, "wb") as fh:
                 pickle.dump(rows, fh)
     print(f"threshold {THRESHOLD:g} (cells of their own: "
-          f"{', '.join(f'{c[0]}/{c[1]} {cell_threshold(*c):g}' for c in CELL_NOTE) or 'none'}); "
+          f"{', '.join(f'{c[0]}/{c[1]} {t:g}' for c, t in CELL_THRESHOLD.items()) or 'none'}); "
           f"CHECK_TOLERANCE {CHECK_TOLERANCE!r}")
     print(summary(rows))
     print(f"{len(rows)} records, {time.perf_counter() - t0:.0f} s")
     return 0
 
-
-CELL_NOTE = (("external_output_bar", "rise"),)
 
 if __name__ == "__main__":
     sys.exit(main(sys.argv[1:]))

@@ -165,7 +165,7 @@ def analyse_one(group: str, k: int, rng: np.random.Generator, tmp: str, seed: in
                   "kappa_covered": bool(k.q05 <= kappa_truth <= k.q95), "kappa_z": (k.q50 - kappa_truth) / k.sd,
                   "misfit": bool(res.whole_record is not None and res.whole_record.decision.detected),
                   "flagged": [] if res.whole_record is None else
-                  [f"{c.channel}/{c.phase} {c.statistic:.1f}" for c in res.whole_record.decision.flagged()],
+                  [f"{c.channel}/{c.phase} {c.statistic:.1f} > {c.threshold:g}" for c in res.whole_record.decision.flagged()],
                   "warnings": list(res.warnings)}
 
 

@@ -189,7 +189,7 @@ def dump(out: str, name: str, group: str, note: str, cfg, prep, dg) -> None:
                        "calibration_names": list(e.calibration_names), "delpd": rk.delpd, "se": rk.se})
     m = dg.misfits[0]
     meta = {"group": group, "note": note, "truth_f": true_f(cfg, prep), "misfit": bool(m.detected),
-            "flagged": [[c.channel, c.phase, c.statistic] for c in m.flagged()],
+            "flagged": [[c.channel, c.phase, c.statistic, c.threshold] for c in m.flagged()],
             "base_calibration_names": list(base.elpd.calibration_names), "models": models,
             "named_now": dg.cause.mechanism.name if dg.cause else None}
     np.savez_compressed(os.path.join(out, f"{name}.npz"), meta=json.dumps(meta), **arrays)

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from friction_uq.analysis import prepare
 from friction_uq.discrepancy.check import check_whole_record
-from friction_uq.discrepancy.misfit import THRESHOLD, predictive_quadratic, tolerated
+from friction_uq.discrepancy.misfit import predictive_quadratic, tolerated
 from friction_uq.discrepancy.whole_record import longest_sign_run, whiten
 from friction_uq.likelihood import ar1_noise
 from friction_uq.priors import default_prior_path, load_priors
@@ -82,7 +82,7 @@ def test_plug_friction_is_a_misfit(tmp_path):
     simulate_to_file(noisy_config(plug_friction_force=400.0, plug_friction_coefficient=0.02), path, seed=4)
     chk = _check(path)
     assert chk.decision.detected
-    assert chk.decision.statistic > THRESHOLD
+    assert chk.decision.statistic > chk.decision.threshold
     sentence = chk.decision.sentence()
     assert ("above" in sentence or "below" in sentence or "shape" in sentence), sentence
 
@@ -104,7 +104,8 @@ def test_the_check_of_a_dispersion_corrected_analysis_has_dispersive_bars(tmp_pa
     simulate_to_file(noisy_config(dispersion=True), path, seed=3)
     plain, disp = _check(path), _check(path, dispersion=True)
     assert plain.decision.detected
-    assert disp.decision.statistic < 0.5 * plain.decision.statistic
+    assert (disp.decision.statistic / disp.decision.threshold
+            < 0.5 * plain.decision.statistic / plain.decision.threshold)
 
 
 def test_the_check_uses_a_cells_own_tolerance_where_one_is_set(tmp_path, monkeypatch):
@@ -132,10 +133,13 @@ def test_a_cells_own_threshold_decides_that_cell_only(tmp_path, monkeypatch):
     simulate_to_file(noisy_config(friction_params=MappingProxyType({"f": 0.06})), path, seed=1)
     chk = _check(path)
     assert not chk.decision.detected
-    cell = max(chk.decision.cells, key=lambda c: c.statistic)
+    cell = max(chk.decision.cells, key=lambda c: c.statistic / c.threshold)
     monkeypatch.setitem(misfit.CELL_THRESHOLD, (cell.channel, cell.phase), 0.5 * cell.statistic)
     d = misfit.decide(chk.comparison)
     assert d.detected and [(c.channel, c.phase) for c in d.flagged()] == [(cell.channel, cell.phase)]
     assert d.statistic == pytest.approx(cell.statistic) and d.threshold == pytest.approx(0.5 * cell.statistic)
     assert f"threshold {0.5 * cell.statistic:g}" in d.sentence()
-    assert all(c.threshold == THRESHOLD for c in d.cells if (c.channel, c.phase) != (cell.channel, cell.phase))
+    with pytest.raises(ValueError, match="threshold"):
+        misfit.decide(chk.comparison, threshold=0.0)
+    assert all(c.threshold == misfit.cell_threshold(c.channel, c.phase) for c in d.cells
+               if (c.channel, c.phase) != (cell.channel, cell.phase))

@@ -43,6 +43,11 @@ EQUILIBRIUM_TOL = 0.05
 F_CHANNELS = ("internal_output_bar", "external_output_bar", "tube_hoop")
 
 
+def _stat(x: float) -> str:
+    """A misfit statistic as printed: whole numbers from 10 up, one decimal below (a cell tested at 2.5 reads 2.7)."""
+    return f"{x:.0f}" if x >= 10 else f"{x:.1f}"
+
+
 def _f_text(f: VariableSummary) -> str:
     return f"f = {f.q50:.4g} [{f.q05:.4g}, {f.q95:.4g}]"
 
@@ -109,15 +114,15 @@ def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary, diagnosis
     if not cells:
         w = d.flagged()[0]
         return (f"The simulated test misses the {CHANNEL_LABELS[w.channel]} gauge over the {w.phase} phase (statistic "
-                f"{w.statistic:.0f} > {w.threshold:g}): something in this test is not in the model (a plug friction, "
-                f"a clearance, a gauge's calibration, ...) and may bias {_f_text(f)} although the stationary phase "
-                f"looks right; {_next_step(diagnosis, f)}")
+                f"{_stat(w.statistic)} > {w.threshold:g}): something in this test is not in the model (a plug "
+                f"friction, a clearance, a gauge's calibration, ...) and may bias {_f_text(f)} although the stationary "
+                f"phase looks right; {_next_step(diagnosis, f)}")
     w = cells[0]
     how = (f"reads {abs(w.relative_level) * 100:.1f} % {'above' if w.relative_level > 0 else 'below'} the simulated "
            "test" if abs(w.level_z) >= w.shape_z else
            f"departs from the simulated test's shape (chi2/dof {w.chi2_dof:.1f})")
     return (f"The {CHANNEL_LABELS[w.channel]} gauge {how} over the stationary phase "
-            f"(statistic {w.statistic:.0f} > {w.threshold:g}): the model behind eq. 17 misses something there, "
+            f"(statistic {_stat(w.statistic)} > {w.threshold:g}): the model behind eq. 17 misses something there, "
             f"so {_f_text(f)} may be biased by about as much; {_next_step(diagnosis, f)}")
 
 
