@@ -83,6 +83,8 @@ def test_plug_friction_is_a_misfit(tmp_path):
     chk = _check(path)
     assert chk.decision.detected
     assert chk.decision.statistic > chk.decision.threshold
+    # the plug's force leads the wall friction: it is seen where it leads, in the first half of the external rise
+    assert ("external_output_bar", "early rise") in [(c.channel, c.phase) for c in chk.decision.flagged()]
     sentence = chk.decision.sentence()
     assert ("above" in sentence or "below" in sentence or "shape" in sentence), sentence
 
@@ -143,3 +145,20 @@ def test_a_cells_own_threshold_decides_that_cell_only(tmp_path, monkeypatch):
         misfit.decide(chk.comparison, threshold=0.0)
     assert all(c.threshold == misfit.cell_threshold(c.channel, c.phase) for c in d.cells
                if (c.channel, c.phase) != (cell.channel, cell.phase))
+
+
+def test_the_external_bars_rise_is_tested_as_two_halves(tmp_path):
+    """SPLIT_RISE: the external output bar's rise is two cells, its halves in time, and every other channel's one."""
+    from friction_uq.discrepancy import misfit
+
+    path = tmp_path / "clean.h5"
+    simulate_to_file(noisy_config(friction_params=MappingProxyType({"f": 0.06})), path, seed=2)
+    wr = _check(path).comparison
+    spans = {ch: misfit.phase_spans(wr, ch) for ch in wr.phase_bounds}
+    ext = spans["external_output_bar"]
+    assert [p for p, _, _ in ext][:2] == ["early rise", "late rise"]
+    i0, iw0, _, _ = wr.phase_bounds["external_output_bar"]
+    assert ext[0][1] == i0 and ext[0][2] == ext[1][1] and ext[1][2] == iw0 and abs(ext[0][2] - (i0 + iw0) / 2) <= 1
+    assert all(p[0] == "rise" for ch, sp in spans.items() if ch != "external_output_bar" for p in sp[:1])
+    assert misfit.cell_threshold("external_output_bar", "early rise") < misfit.THRESHOLD
+    assert misfit.cell_threshold("external_output_bar", "late rise") == misfit.THRESHOLD

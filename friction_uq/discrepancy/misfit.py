@@ -20,19 +20,23 @@ skew may carry, is :data:`CHECK_TOLERANCE` (the grid search ``benchmarks/bench_c
 on 40 records, seed 11, and 40 more, seed 43, which moved the input bar's rise from 0.3 to 0.5 us).
 
 Threshold per cell. Every cell is tested at :data:`THRESHOLD` except one, which has its own, lower,
-threshold (:data:`CELL_THRESHOLD`): the external output bar's rise. A force that reaches the tube
-without passing through the sample (a plug rubbing on the tube) adds to F_eo in the stationary phase
-exactly as wall friction does, so eq. 17 reads it as a higher f and nothing in that phase can tell; it
-shows as an external force that leads the sample's during the rise, and there only. Tested at 5 with
-the other cells, the 1-D simulation's plug friction was seen mostly through the input bar's
-unloading, the very front the tolerance table forgives; tested on its own at 2.5 (about the 1-2 %
-point of a single cell's statistic under the noise model, chosen before the records below), the cell
-sees it instead. On clean records it stayed under 1.6 on 40 of the 1-D simulation and 40 of it
-perturbed (mesh, hoop kernel, pulse, coloured noise, a channel's timing), and under 2.5 on 118 of 120
-of the axisymmetric one (the other two, at 7.9 and 14.7, would be flagged at 5 too):
-``benchmarks/bench_check_cells.py``, seeds 41, 43 and 47. With the table and this threshold the check
-flags 5 of those 120 axisymmetric records (2 of the 40 of seed 47, on which nothing was set), where
-the channels' tolerances at one threshold flagged 28; docs/trust.md gives the tables.
+threshold (:data:`CELL_THRESHOLD`): the first half of the external output bar's rise. A force that
+reaches the tube without passing through the sample (a plug rubbing on the tube) adds to F_eo in the
+stationary phase exactly as wall friction does, so eq. 17 reads it as a higher f and nothing in that
+phase can tell; it shows as an external force that leads the sample's, early in the rise, before the
+wall friction builds. So the external bar's rise is tested as two halves in time (:data:`SPLIT_RISE`:
+"early rise" and "late rise"; over the whole rise the lead is diluted by the half where the fitted,
+too high, f over-predicts), and the early half at 2.5 (about the 1-2 % point of a single cell's
+statistic under the noise model, chosen before the records below); the late half keeps 5 (at 2.5 it
+flagged 2 of 80 clean axisymmetric records and no plug friction the early half missed). Tested at 5
+with the other cells over the whole rise, the 1-D simulation's plug friction was seen mostly through
+the input bar's unloading, the very front the tolerance table forgives. ``benchmarks/bench_check_cells.py``
+(seeds 41, 43, 47): the early half stayed under 1.6 on 40 clean records of the 1-D simulation and 40 of
+it perturbed (mesh, hoop kernel, pulse, coloured noise, a channel's timing), and went over 2.5 on 3 of
+80 of the axisymmetric one; plug friction of 200-400 N + 1-2 % of F_i went over it on 40 of 40 records
+of the 1-D simulation and 35 of 40 of the axisymmetric one. With the table and this threshold the check
+flags 6 of those 80 clean axisymmetric records (7.5 %), where the channels' tolerances at one threshold
+flagged 24, and plug friction on 40 and 36 of 40 (27 and 28 before); docs/trust.md gives the tables.
 
 On e' two standardised figures are formed:
 
@@ -50,8 +54,8 @@ On e' two standardised figures are formed:
 A cell's statistic is the larger of |level z| and shape z; "misfit" when a cell's exceeds its threshold
 (:func:`cell_threshold`), and the cells over theirs are named, the furthest over (statistic over
 threshold) first. The record's statistic and threshold are that cell's, so that a record reads
-"statistic 2.7 > 2.5" when only the external bar's rise is over, while another cell may stand at 4.9
-under its 5. The threshold 5 was set on simulated clean records (Coulomb friction, no hidden effect,
+"statistic 2.7 > 2.5" when only the external bar's early rise is over, while another cell may stand at
+4.9 under its 5. The threshold 5 was set on simulated clean records (Coulomb friction, no hidden effect,
 f, nu, striker speed and noise levels drawn over their ranges, both bundled set-ups) for a false
 alarm rate of at most 5 %; ``benchmarks/bench_misfit.py`` measures the rate and the detection
 rate of each hidden effect.
@@ -78,7 +82,10 @@ CHECK_TOLERANCE: dict[tuple[str, str], tuple[float, float]] = {
 }
 #: The threshold of a cell where it differs from :data:`THRESHOLD`: the one place a force that bypasses the
 #: sample shows (module docstring).
-CELL_THRESHOLD: dict[tuple[str, str], float] = {("external_output_bar", "rise"): 2.5}
+CELL_THRESHOLD: dict[tuple[str, str], float] = {("external_output_bar", "early rise"): 2.5}
+#: Channels whose rise is tested as two halves in time, "early rise" and "late rise": a force that bypasses the
+#: sample leads the wall friction, so it sits in the first half, where a test over the whole rise dilutes it.
+SPLIT_RISE = ("external_output_bar",)
 
 
 def cell_threshold(channel: str, phase: str) -> float:
@@ -215,9 +222,14 @@ def cell_test(wr: WholeRecord, channel: str, phase: str, a: int, b: int, *, rela
 
 
 def phase_spans(wr: WholeRecord, channel: str) -> list[tuple[str, int, int]]:
-    """(phase, first sample, end) of each phase of ``channel`` long enough to test (>= 10 samples)."""
+    """(phase, first sample, end) of each phase of ``channel`` long enough to test (>= 10 samples); the rise of a
+    channel of :data:`SPLIT_RISE` as its two halves in time, "early rise" and "late rise"."""
     i0, iw0, iw1, i3 = wr.phase_bounds[channel]
-    return [(p, a, b) for p, (a, b) in zip(PHASES, ((i0, iw0), (iw0, iw1), (iw1, i3))) if b - a >= 10]
+    spans = [(p, a, b) for p, (a, b) in zip(PHASES, ((i0, iw0), (iw0, iw1), (iw1, i3))) if b - a >= 10]
+    if channel in SPLIT_RISE and iw0 - i0 >= 20:
+        mid = (i0 + iw0) // 2
+        spans = [("early rise", i0, mid), ("late rise", mid, iw0)] + [s for s in spans if s[0] != "rise"]
+    return spans
 
 
 def decide(wr: WholeRecord, *, threshold: float | None = None) -> MisfitDecision:
