@@ -14,7 +14,6 @@ from test_sbc import closed_form_data
 from friction_uq.likelihood import Likelihood
 from friction_uq.likelihood.force_level import RATIO_MODEL_FORM, LevelForceTerm, batch_count, batch_means
 from friction_uq.physics import cell
-from friction_uq.stats.ar1 import ar1_mean_sd
 
 
 def _posterior_of_r(term, lo=1e-3, hi=1.0, n=200_001):
@@ -35,7 +34,6 @@ def test_level_term_is_the_student_t_density_of_the_window_mean():
     for r in (0.05, 0.15, 0.3):
         u = a - r * x
         se_b = math.sqrt(np.sum((u - u.mean()) ** 2) / (8 * 7))
-        se_n = math.hypot(ar1_mean_sd(d.sd_eo, d.rho_eo, d.n), r * ar1_mean_sd(d.sd_io, d.rho_io, d.n))
         s = math.sqrt(se_b**2 + d.sd_offset_eo**2 + r**2 * d.sd_offset_io**2)
         ubar = d.F_eo.mean() - r * d.F_io.mean()
         assert term.loglike(np.array(r)) == pytest.approx(stats.t(7, scale=s).logpdf(ubar), rel=1e-10)
