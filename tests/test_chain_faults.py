@@ -69,12 +69,16 @@ def test_a_clean_axisymmetric_record_gets_no_cause_named(tmp_path):
     assert dg.cause is None, [(r.fit.label, round(r.delpd, 1), round(r.se, 1)) for r in dg.ranking]
 
 
-def test_candidates_a_record_does_not_tell_apart_are_said_as_candidates_not_causes(tmp_path):
-    """Record 7 of the calibration study's clean axisymmetric group (benchmarks/verdict_records.py, seed 17):
-    the check flags the reflected gauge's unloading, several mechanisms pass and none beats the others. The first
-    candidate is fitted in turn, but the record's verdict stays "candidates", the sentence says so (not "causes
-    found"), and f is the mixture, which holds the truth."""
+def test_candidates_a_record_does_not_tell_apart_are_said_as_candidates_not_causes(tmp_path, monkeypatch):
+    """Record 7 of the calibration study's clean axisymmetric group (benchmarks/verdict_records.py, seed 17).
+    Under the check's tolerance table (0.5 us on the reflected gauge's unloading, set on clean axisymmetric
+    records) its check passes and nothing is named ("unconfirmed"). With the channel's own 0.2 us there, the
+    check flags that unloading, several mechanisms pass and none beats the others: the first candidate is fitted
+    in turn, but the record's verdict stays "candidates", the sentence says so (not "causes found"), and f is the
+    mixture, which holds the truth."""
     import verdict_records
+
+    from friction_uq.discrepancy import misfit
 
     rng = np.random.default_rng(17)
     for group, k in [(g, k) for g in verdict_records.groups() for k in range(16 if g.startswith("clean") else 8)]:
@@ -92,8 +96,13 @@ def test_candidates_a_record_does_not_tell_apart_are_said_as_candidates_not_caus
         return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
 
     lab = identify(prep, nu=0.4)
+    stationary = {"mean": 0.114, "sd": 0.005, "q05": 0.106, "q50": 0.114, "q95": 0.122}
     dg = diagnose(prep, log_prior, {"f": lab.f, "nu": 0.4}, hoop=True, seed=7)
-    doc = outcome.to_json(dg, {"mean": 0.114, "sd": 0.005, "q05": 0.106, "q50": 0.114, "q95": 0.122})
+    doc = outcome.to_json(dg, stationary)
+    assert doc["round_verdicts"] == ["unconfirmed"] and doc["causes"] == [], doc["round_verdicts"]
+    monkeypatch.delitem(misfit.CHECK_TOLERANCE, ("input_bar", "unloading"))
+    dg = diagnose(prep, log_prior, {"f": lab.f, "nu": 0.4}, hoop=True, seed=7)
+    doc = outcome.to_json(dg, stationary)
     assert doc["round_verdicts"][0] == "candidates" and doc["fitted_in_turn"], doc["round_verdicts"]
     assert doc["causes"] == [] and doc["cause"] is None and doc["open_candidates"][0] == doc["fitted_in_turn"][0]
     assert doc["verdict"] == "candidates" and doc["mixture"] is not None
