@@ -34,12 +34,10 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_check_tolerance import GRID, cell_statistics, own  # noqa: E402
-from bench_misfit import clean_config  # noqa: E402
+from bench_check_tolerance import GRID, own, record_statistics  # noqa: E402
 from verdict_records import make, write  # noqa: E402
 
 from friction_uq.discrepancy.misfit import CELL_THRESHOLD, CHECK_TOLERANCE, THRESHOLD, cell_threshold  # noqa: E402
-from friction_uq.errors import FrictionUQError  # noqa: E402
 
 
 def collect(group: str, n: int, seed: int) -> list[dict]:
@@ -49,19 +47,11 @@ def collect(group: str, n: int, seed: int) -> list[dict]:
     with tempfile.TemporaryDirectory() as tmp:
         for k in range(n):
             t = time.perf_counter()
-            if group == "clean":
-                cfg, edit, note, header = clean_config(rng, "A" if k % 2 == 0 else "B"), None, "1-D", None
-            else:
-                cfg, edit, note, header = make(group, k, rng)
+            cfg, edit, note, header = make(group, k, rng)
             path = os.path.join(tmp, f"{group}-{k}.h5")
             write(cfg, path, int(rng.integers(2**31)), edit, header)
-            try:
-                stats = cell_statistics(path, seed)
-            except FrictionUQError as exc:
-                print(f"{group} {k}: refused: {exc}", flush=True)
-                continue
-            rows.append({"group": group, "k": k, "note": note, "cells": stats})
-            print(f"{group} {k} ({note}): {time.perf_counter() - t:.1f} s", flush=True)
+            if (stats := record_statistics(path, seed, f"{group} {k} ({note})", t)) is not None:
+                rows.append({"group": group, "k": k, "note": note, "cells": stats})
     return rows
 
 

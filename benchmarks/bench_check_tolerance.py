@@ -73,6 +73,18 @@ def cell_statistics(path: str, seed: int) -> dict[tuple[str, str], np.ndarray]:
     return out
 
 
+def record_statistics(path: str, seed: int, label: str, t0: float) -> dict[tuple[str, str], np.ndarray] | None:
+    """:func:`cell_statistics` of one record, said with ``label`` and the seconds since ``t0``; None (said) where
+    the record is refused."""
+    try:
+        stats = cell_statistics(path, seed)
+    except FrictionUQError as exc:
+        print(f"{label} refused: {exc}", flush=True)
+        return None
+    print(f"{label}: {time.perf_counter() - t0:.1f} s", flush=True)
+    return stats
+
+
 def own(cell: tuple[str, str]) -> tuple[float, float]:
     return (TOLERANCE.get(cell[0], 0.0), TIMING_TOLERANCE)
 
@@ -86,16 +98,8 @@ def study(n: int, seed: int) -> list[dict[tuple[str, str], np.ndarray]]:
             path = os.path.join(tmp, f"r{k}.h5")
             t = time.perf_counter()
             make_record(cfg, path, int(rng.integers(2**31)), None, rng)
-            try:
-                stats = cell_statistics(path, seed)
-            except FrictionUQError as exc:
-                print(f"{k:3d} refused: {exc}", flush=True)
-                continue
-            rows.append(stats)
-            base = {c: v[GRID.index(own(c))] for c, v in stats.items()}
-            worst = max(base, key=base.get)
-            print(f"{k:3d} set-up {'AB'[k % 2]}: statistic {base[worst]:6.1f} ({worst[0]}/{worst[1]}), "
-                  f"{time.perf_counter() - t:.1f} s", flush=True)
+            if (stats := record_statistics(path, seed, f"{k:3d} set-up {'AB'[k % 2]}", t)) is not None:
+                rows.append(stats)
     return rows
 
 

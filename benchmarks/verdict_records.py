@@ -141,7 +141,9 @@ def make(group: str, k: int, r: np.random.Generator):
     or None), a note and the apparatus its header carries (None: the configuration's)."""
     cfg = clean_config(r, "A" if k % 2 == 0 else "B")
     edit, note, header = None, "", None
-    if group == "clean_axisymmetric":
+    if group == "clean":  # the 1-D simulation as drawn: the likelihood's own family
+        note = "1-D"
+    elif group == "clean_axisymmetric":
         cfg, note = _axisymmetric(cfg), "axisymmetric"
     elif group == "clean_perturbed":
         cfg, ch, note = _perturbation(cfg, r)

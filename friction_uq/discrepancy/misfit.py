@@ -110,6 +110,11 @@ class CellTest:
         return max(abs(self.level_z), self.shape_z)
 
     @property
+    def excess(self) -> float:
+        """The statistic over the cell's threshold: a misfit above 1."""
+        return self.statistic / self.threshold
+
+    @property
     def over(self) -> bool:
         """The cell's statistic exceeds its threshold."""
         return self.statistic > self.threshold
@@ -135,11 +140,11 @@ class MisfitDecision:
     @property
     def worst(self) -> CellTest | None:
         """The cell furthest over (or nearest to) its threshold."""
-        return max(self.cells, key=lambda c: c.statistic / c.threshold) if self.cells else None
+        return max(self.cells, key=lambda c: c.excess) if self.cells else None
 
     def flagged(self) -> list[CellTest]:
         """Cells over their threshold, furthest over first."""
-        return sorted((c for c in self.cells if c.over), key=lambda c: -c.statistic / c.threshold)
+        return sorted((c for c in self.cells if c.over), key=lambda c: -c.excess)
 
     def sentence(self, *, page: int | None = None) -> str:
         """One line for the summary page and the terminal."""
@@ -247,6 +252,6 @@ def decide(wr: WholeRecord, *, threshold: float | None = None) -> MisfitDecision
             cells.append(cell_test(wr, ch, phase, a, b, tolerance=tols[(rel, tim)]))
     if threshold is not None:  # one threshold for the whole record replaces every cell's
         cells = [replace(c, threshold=threshold) for c in cells]
-    worst = max(cells, key=lambda c: c.statistic / c.threshold, default=None)
+    worst = max(cells, key=lambda c: c.excess, default=None)
     return MisfitDecision(statistic=worst.statistic if worst else 0.0,
                           threshold=worst.threshold if worst else (threshold or THRESHOLD), cells=tuple(cells))
