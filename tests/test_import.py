@@ -255,6 +255,21 @@ def test_non_numeric_cell_names_line_and_column(tmp_path, scope_csv, capsys):
     assert "scope.csv: line 3001, column 'CH2' (number 3): 'overload' is not a number" in err
 
 
+@pytest.mark.parametrize("edit, words", [
+    (lambda cells: cells[:2], "has 2 fields"),  # a row cut short
+    (lambda cells: cells[:2] + ["overload"] + cells[3:], "is not a row of numbers ('"),
+])
+def test_a_damaged_row_near_the_end_is_named_by_its_line(tmp_path, scope_csv, capsys, edit, words):
+    lines = scope_csv.read_text().splitlines()
+    k = len(lines) - 5  # among the last lines, where the layout is read from
+    ncols = len(lines[k].split(","))
+    lines[k] = ",".join(edit(lines[k].split(",")))
+    scope_csv.write_text("\n".join(lines) + "\n")
+    err = _refused(tmp_path, [scope_csv], setup_doc(), capsys)
+    assert f"scope.csv: line {k + 1} {words}" in err, err
+    assert f"where the rows around it are {ncols} numbers each" in err, err
+
+
 def test_unequal_lengths_are_named(tmp_path, capsys):
     files = export_record(RECORD, tmp_path, strain_per_volt=SPV, names=COLUMNS, per_channel=True)
     files[2].write_text("\n".join(files[2].read_text().splitlines()[:-100]) + "\n")

@@ -73,17 +73,45 @@ def _numeric_row(line: str, delim: str | None, decimal: str) -> int:
     return len(f) if f and all(_number(c, decimal) for c in f) else 0
 
 
-def _dialect(path: Path, tail: list[str]) -> tuple[str | None, str, int]:
+def _dialect(path: Path, tail: list[str], text: str = "") -> tuple[str | None, str, int]:
+    """(delimiter, decimal mark, fields per row) under which every line of ``tail`` is a row of numbers; else
+    one sentence naming the line that breaks the layout most of them share (its number found in ``text``)."""
     best: tuple[str | None, str, int] | None = None
     for delim, dec in DIALECTS:
         counts = {_numeric_row(line, delim, dec) for line in tail}
         if len(counts) == 1 and (n := counts.pop()) > 0 and (best is None or n > best[2]):
             best = (delim, dec, n)
     if best is None:
+        odd = _odd_line(tail, text)
+        if odd is not None:
+            raise ScopeFileError(f"{path}: {odd[0]}, where the rows around it are {odd[1]} numbers each (a truncated "
+                                 "or damaged row near the end of the export)")
         raise ScopeFileError(f"{path}: its last lines are not rows of numbers in any of the usual layouts (comma, "
                              "semicolon, tab or space separated; decimal point or comma): is it an oscilloscope "
                              "export?")
     return best
+
+
+def _odd_line(tail: list[str], text: str) -> tuple[str, int] | None:
+    """The first line of ``tail`` that breaks the layout most of them share (the layout with the most numbers per
+    row among those), located in ``text`` ('line N has k fields'), and the rows' count of numbers; None when no
+    layout is shared by more than half of them."""
+    shared: tuple[int, int, str | None, str] | None = None  # (rows, fields, delimiter, decimal mark)
+    for delim, dec in DIALECTS:
+        counts = [_numeric_row(line, delim, dec) for line in tail]
+        top = max(set(counts) - {0}, key=lambda n: (counts.count(n), n), default=0)
+        if top and 2 * counts.count(top) > len(tail) and (shared is None or (counts.count(top), top) > shared[:2]):
+            shared = (counts.count(top), top, delim, dec)
+    if shared is None:
+        return None
+    _, ncols, delim, dec = shared
+    line = next(ln for ln in tail if _numeric_row(ln, delim, dec) != ncols)
+    n = len(_fields(line, delim))
+    what = (f"has {n} field{'s' if n != 1 else ''}" if _numeric_row(line, delim, dec)
+            else f"is not a row of numbers ({line.strip()[:40]!r})")
+    pos = text.rfind(line)
+    where = f"line {text.count(chr(10), 0, pos) + 1}" if text and pos >= 0 else "a line near the end"
+    return f"{where} {what}", ncols
 
 
 def _data_start(path: Path, head: list[str], delim: str | None, dec: str, ncols: int) -> int:
@@ -195,7 +223,7 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
         tail = [ln for ln in head if ln.strip()][-_TAIL_LINES:]
     if not tail:
         raise ScopeFileError(f"{p}: is empty")
-    delim, dec, ncols = _dialect(p, tail)
+    delim, dec, ncols = _dialect(p, tail, text)
     start = _data_start(p, head, delim, dec, ncols)
     names = [w for w in wanted if isinstance(w, str)]
     hline, header = _header(p, head, start, delim, names)
@@ -234,7 +262,7 @@ def describe_text(path: str | Path) -> list[str]:
         [ln for ln in head if ln.strip()][-_TAIL_LINES:]
     if not tail:
         raise ScopeFileError(f"{p}: is empty")
-    delim, dec, ncols = _dialect(p, tail)
+    delim, dec, ncols = _dialect(p, tail, text)
     start = _data_start(p, head, delim, dec, ncols)
     above = [i for i in range(start - 1, max(-1, start - 60), -1) if head[i].strip()][:3]
     named = [i for i in above if len(f := _fields(head[i], delim)) >= ncols and len(set(f)) == len(f)]
