@@ -9,8 +9,12 @@ are the same for every seed. Issue 24 point 6 asks the same named causes with 5 
 and every study group.
 
     python benchmarks/bench_stability.py [RECORD ...] [--seeds 1,2,3,4,5]
+    python benchmarks/bench_stability.py --groups all|GROUP,... [--per 1] [--seed 23] [--seeds 1,2,3,4,5]
 
-Without records: the bundled ones (data/A, data/B).
+Without records: the bundled ones (data/A, data/B). With ``--groups``: ``--per`` records of each study group of
+``verdict_records.py`` (a clean record of the axisymmetric simulation or of the 1-D one perturbed, a hidden
+mechanism in either simulation, a fault of the measurement chain), simulated with ``--seed`` and written to a
+temporary folder first; the record's seed is not one of the sampler's.
 """
 
 from __future__ import annotations
@@ -22,8 +26,11 @@ import io
 import json
 import os
 import statistics
+import sys
 import tempfile
 import time
+
+import numpy as np
 
 from friction_uq import cli
 
@@ -50,13 +57,45 @@ def verdict_of(doc: dict) -> tuple[str, tuple[str, ...]]:
     return str(d.get("verdict")), causes
 
 
+def study_records(names: str, per: int, seed: int, folder: str) -> list[str]:
+    """``per`` records of each group in ``names`` (comma-separated, or "all") written in ``folder``."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from verdict_records import groups, make, write
+
+    chosen = groups() if names == "all" else names.split(",")
+    unknown = sorted(set(chosen) - set(groups()) - {"clean"})
+    if unknown:
+        raise SystemExit(f"unknown group(s) {', '.join(unknown)}; known: clean, {', '.join(groups())}")
+    paths = []
+    for group in chosen:
+        rng = np.random.default_rng([seed, sum(map(ord, group))])
+        for k in range(per):
+            cfg, edit, note, header = make(group, k, rng)
+            path = os.path.join(folder, f"{group}-{k}.h5")
+            write(cfg, path, int(rng.integers(2**31)), edit, header)
+            print(f"{os.path.basename(path)}: {note}", flush=True)
+            paths.append(path)
+    return paths
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("records", nargs="*")
     ap.add_argument("--seeds", default="1,2,3,4,5")
+    ap.add_argument("--groups", help='study groups of verdict_records.py (comma-separated, or "all")')
+    ap.add_argument("--per", type=int, default=1, help="records of each group")
+    ap.add_argument("--seed", type=int, default=23, help="the seed the groups' records are simulated with")
     a = ap.parse_args()
-    records = a.records or sorted(glob.glob(os.path.join(ROOT, "data", "[AB]", "*.h5")))
-    seeds = [int(s) for s in a.seeds.split(",")]
+    with tempfile.TemporaryDirectory() as folder:
+        if a.groups:
+            records = a.records + study_records(a.groups, a.per, a.seed, folder)
+        else:
+            records = a.records or sorted(glob.glob(os.path.join(ROOT, "data", "[AB]", "*.h5")))
+        check(records, [int(s) for s in a.seeds.split(",")], a.seeds)
+
+
+def check(records: list[str], seeds: list[int], label: str) -> None:
+    """Each record diagnosed with every seed: its verdicts and causes, and whether they agree."""
     stable = 0
     secs = []
     for path in records:
@@ -76,7 +115,7 @@ def main() -> None:
         stable += same
         print(f"{os.path.basename(path)}: {'the same verdict and causes' if same else 'NOT the same'} with "
               f"{len(seeds)} seeds", flush=True)
-    print(f"\n{stable} of {len(records)} records give the same verdict and causes with seeds {a.seeds}; "
+    print(f"\n{stable} of {len(records)} records give the same verdict and causes with seeds {label}; "
           f"diagnose's time per run: median {statistics.median(secs):.0f} s")
 
 
