@@ -87,6 +87,11 @@ def test_plug_friction_is_a_misfit(tmp_path):
     assert ("external_output_bar", "early rise") in [(c.channel, c.phase) for c in chk.decision.flagged()]
     sentence = chk.decision.sentence()
     assert ("above" in sentence or "below" in sentence or "shape" in sentence), sentence
+    # the report draws two channels a page (reflected and internal, then external and hoop): the sentence sends the
+    # reader to the page of the channel it names
+    worst = chk.decision.worst.channel
+    page = {"input_bar": 9, "internal_output_bar": 9, "external_output_bar": 10, "tube_hoop": 10}[worst]
+    assert f"see page {page}." in chk.decision.sentence(page=9), (worst, chk.decision.sentence(page=9))
 
 
 def test_clearance_is_a_misfit_on_the_hoop_gauge(tmp_path):
@@ -96,7 +101,7 @@ def test_clearance_is_a_misfit_on_the_hoop_gauge(tmp_path):
     chk = _check(path)
     assert chk.decision.detected
     assert any(c.channel == "tube_hoop" for c in chk.decision.flagged())
-    assert "see page 9" in chk.decision.sentence(page=9)
+    assert "see page 9." in chk.decision.sentence(page=9)  # the worst is the internal gauge's rise, on that page
 
 
 def test_the_check_of_a_dispersion_corrected_analysis_has_dispersive_bars(tmp_path):

@@ -147,14 +147,16 @@ class MisfitDecision:
         return sorted((c for c in self.cells if c.over), key=lambda c: -c.excess)
 
     def sentence(self, *, page: int | None = None) -> str:
-        """One line for the summary page and the terminal."""
+        """One line for the summary page and the terminal; ``page``: the report's first whole-record page (two
+        channels a page, in :data:`CHANNEL_LABELS`' order), from which the worst channel's page is said."""
         if not self.detected:
             n = len({c.channel for c in self.cells})
             return (f"The model reproduces all {n} gauges within their noise over the whole loading "
                     f"(misfit statistic {self.statistic:.1f} <= {self.threshold:g}).")
         w = self.worst
         assert w is not None
-        where = f": see page {page}" if page is not None else ""
+        drawn = [c for c in CHANNEL_LABELS if any(x.channel == c for x in self.cells)]
+        where = f": see page {page + drawn.index(w.channel) // 2}" if page is not None else ""
         more = len(self.flagged()) - 1
         also = f"; {more} more channel/phase pairs over their thresholds" if more > 0 else ""
         if abs(w.level_z) >= w.shape_z:

@@ -25,6 +25,7 @@ from ..sampler import PosteriorSamples
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
 from .style import CORE_FONTS, figure
+from .whole_record_pages import page_count
 
 UNITS = {"f": ("-", 1.0), "nu": ("-", 1.0), "kappa": ("-", 1.0), "hoop_gain": ("-", 1.0), "ratio": ("-", 1.0),
          "p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
@@ -166,7 +167,8 @@ def page_summary(r: ReportInputs) -> Figure:
     ax.text(0.875, SUMMARY_TABLE_TOP - 0.02, "Pages\n 2 raw gauges\n 3 waves, forces, equilibrium\n 4 window and noise\n"
             " 5 posterior vs prior\n 6 nu -> f\n 7 convergence\n 8 predictive check"
             + ("\n 9 hoop gauge vs model" if r.samples.hoop else "")
-            + (f"\n{whole_record_page(r):2d} whole test vs gauges" if r.whole_record is not None else "")
+            + (f"\n{_span(whole_record_page(r), page_count(r.whole_record))} whole test vs gauges"
+               if r.whole_record is not None else "")
             + (f"\n{whole_record_page(r) + 2:2d} mechanisms ranked\n{whole_record_page(r) + 3:2d} extended fit"
                if r.diagnosis is not None else ""),
             fontsize=8, va="top", transform=ax.transAxes, family="monospace")
@@ -241,6 +243,11 @@ def render_report(r: ReportInputs, record_part: bytes | None = None, posterior_p
     buf = io.BytesIO()
     out.write(buf)
     return buf.getvalue()
+
+
+def _span(first: int, n: int) -> str:
+    """' 9', '10', or '10-11': the pages a part of the report takes, for the page list."""
+    return f"{first:2d}" if n <= 1 else f"{first}-{first + n - 1}"
 
 
 def whole_record_page(r: ReportInputs) -> int:

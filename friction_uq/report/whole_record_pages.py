@@ -48,6 +48,11 @@ def _channel(ax_sig, ax_res, chk: WholeRecordCheck, ch: str) -> None:
     ax_res.set_ylim(-lim, lim)
 
 
+def page_count(chk: WholeRecordCheck) -> int:
+    """How many pages :func:`pages_whole_record` draws: two channels a page."""
+    return (sum(c in chk.comparison.spans for c in CHANNEL_LABELS) + 1) // 2
+
+
 def pages_whole_record(chk: WholeRecordCheck, *, test: str, first_page: int | None = None) -> list[Figure]:
     """Two pages, two channels each (reflected and internal; external and hoop); ``first_page``: the PDF page
     number of the first, written before the titles."""
