@@ -58,7 +58,7 @@ import numpy as np
 from scipy import special, stats
 
 from .errors import PriorError
-from .plausible import is_name, not_regular, toml_shape_problem
+from .plausible import MAX_TEXT_BYTES, is_name, not_regular, toml_shape_problem
 
 #: Physical support (lower, upper) of each parameter the analysis knows.
 PARAMETERS: Mapping[str, tuple[float, float]] = {
@@ -100,8 +100,9 @@ def _priors_dir() -> Path:
 
 #: Folder of the prior files that come with friction-uq (found from any folder).
 PRIORS_DIR = _priors_dir()
-#: Largest prior file read (bytes): a prior file is a few dozen lines.
-MAX_PRIOR_BYTES = 1_000_000
+#: Largest prior file read (bytes): a prior file is a few dozen lines; the limit of every text input
+#: (docs/limits.md: 1 MiB).
+MAX_PRIOR_BYTES = MAX_TEXT_BYTES
 
 _LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
 
