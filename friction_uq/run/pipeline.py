@@ -17,39 +17,23 @@ import json
 import os
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from .. import __version__
-from .._atomic import check_unlocked, output_folder, output_lock, remove_orphans, write_together
+from .._atomic import output_folder, output_lock, remove_orphans, write_together
 from .._parallel import Background
-from ..analysis import Identification, Prepared, identify, prepare
+from ..analysis import Identification, Prepared
+from ..diagnostics import Convergence, VariableSummary
 from ..discrepancy.check import WholeRecordCheck
-from ..diagnostics import (
-    Convergence,
-    VariableSummary,
-    build_datatree,
-    convergence,
-    f_given_nu,
-    nu_sensitivity,
-    nu_variance_share,
-    prior_data_conflict,
-    ratio_ppc,
-    summarize,
-)
-from ..errors import OutputError, PriorError, SamplingError, check_seed
-from ..likelihood import Likelihood, LevelForceTerm
+from ..errors import check_seed
+from ..likelihood import LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
-from ..priors import default_prior_path, load_priors
-from ..quoted import quoted_summary
-from ..record import read_record
-from ..sampler import PosteriorSamples, likelihood_priors, sample_posterior, stderr_progress
-from ..settings import AnalysisSettings
+from ..sampler import PosteriorSamples
 from .alongside import alongside, whole_record_start
-from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
-from .outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION, netcdf_bytes, quoted_f, safe_stem, sha256_hex, summary_table
+from .outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION, netcdf_bytes, quoted_f, sha256_hex, summary_table
+from .steps import RunSetup, StationaryPosterior, set_up, stationary_posterior
 from .warnings import run_warnings
 
 JSON_VARIABLES = ("f", "nu", "kappa", "p_mean", "tau_mean", "V", "ratio")
@@ -114,32 +98,9 @@ def run_file(
         if notes:
             print(f"friction-uq: note: {msg}", file=sys.stderr, flush=True)
 
-    record = read_record(path)
-    try:
-        p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
-    except PriorError as exc:  # the record's material names no prior file: say which record and field
-        raise PriorError(f"{record.path}: /apparatus/sample@material: {exc}") from None
-    priors = load_priors(p_path)  # every input is checked before the signals' work, the busy folder too
-    check_unlocked(Path(out_dir), safe_stem(record.campaign, record.test_id))
-    prep = prepare(record, window=window, dispersion=dispersion)
-    settings = AnalysisSettings(window=window, dispersion=dispersion, hoop=hoop)
-    alternatives = alternative_nu_priors(p_path, priors)
-    left_out = hoop_unusable(prep) if settings.hoop and prep.data.hoop is not None else None
-    use_hoop = bool(settings.hoop and prep.data.hoop is not None and left_out is None)
-    # the likelihood of this analysis, built once and passed to every stage that needs it
-    likelihood = Likelihood(prep.data, hoop=use_hoop, axial_poisson=settings.axial_poisson,
-                            hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy,
-                            force_mode=settings.force_mode, ratio_model_form=settings.ratio_model_form)
-    likelihood_priors(likelihood, priors)  # the prior file holds every parameter the likelihood needs
     out = Path(out_dir)
-    stem = safe_stem(record.campaign, record.test_id)
-    names = {"netcdf": out / f"{stem}.nc", "pdf": out / f"{stem}.pdf", "json": out / f"{stem}.json"}
-    for p in names.values():
-        if p.is_dir():
-            raise OutputError(f"{p}: cannot write the output, a directory has that name")
+    s = set_up(path, priors_path, out, window=window, dispersion=dispersion, hoop=hoop)
     stages["signals"] = time.perf_counter() - t_start
-    # the lab's analysis: eq. 17 at the nominal nu (the prior's median, 0.4 for I1)
-    lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
     check = bool(whole_record or diagnose)
     if pdf:  # imported once, before the fork, for both processes
         import matplotlib.backends.backend_pdf  # noqa: F401
@@ -147,160 +108,174 @@ def run_file(
     # on the other core while this one samples: forked before the output lock is taken (the child holds
     # no lock), stopped on the way out
     with (output_folder(out),  # created here; removed again if the run fails and leaves it empty
-          Background(alongside if check else None, prep, priors, whole_record_start(lab, priors),
-                     hoop=use_hoop, seed=seed, check=check, pages=pdf) as side_job,
-          output_lock(out, stem)):
-        backend = out / f".{stem}.checkpoint.npz"
-        remove_orphans(out, [p.name for p in names.values()] + [backend.name])
-        old_backend = out / f".{stem}.chains.h5"  # an earlier version's emcee backend
+          Background(alongside if check else None, s.prepared, s.priors, whole_record_start(s.lab, s.priors),
+                     hoop=s.use_hoop, seed=seed, check=check, pages=pdf) as side_job,
+          output_lock(out, s.stem)):
+        backend = out / f".{s.stem}.checkpoint.npz"
+        remove_orphans(out, [p.name for p in s.names.values()] + [backend.name])
+        old_backend = out / f".{s.stem}.chains.h5"  # an earlier version's emcee backend
         if old_backend.exists():
             old_backend.unlink()
-        say(f"{record.campaign} {record.test_id}: window {prep.window.t0 * 1e6:.1f}-"
-            f"{prep.window.t1 * 1e6:.1f} us, hoop term {'on' if use_hoop else 'off'}, priors {p_path}")
-        if left_out:
-            note(f"the hoop gauge is left out of the likelihood: {left_out}")
+        say(f"{s.record.campaign} {s.record.test_id}: window {s.prepared.window.t0 * 1e6:.1f}-"
+            f"{s.prepared.window.t1 * 1e6:.1f} us, hoop term {'on' if s.use_hoop else 'off'}, priors {s.prior_path}")
+        if s.hoop_left_out:
+            note(f"the hoop gauge is left out of the likelihood: {s.hoop_left_out}")
         if check:
             say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if side_job.forked
                                                                          else "(after the sampling)"))
-
+        post = stationary_posterior(s, seed=seed, backend=backend, progress=progress, say=say, note=note,
+                                    stages=stages)
         t = time.perf_counter()
-        try:
-            samples = sample_posterior(prep.data, priors, seed=seed, hoop=use_hoop, backend_path=backend,
-                                       progress=stderr_progress if progress else None, notify=note,
-                                       likelihood=likelihood)
-        except SamplingError as exc:  # the sampler knows the priors, not the record: name it
-            raise SamplingError(f"{record.path}: {exc}") from None
-        stages["sampling"] = time.perf_counter() - t
-        t = time.perf_counter()
-        dt = build_datatree(samples, prep.data, priors, seed=seed, likelihood=likelihood)
-        dt.attrs["analysis_settings"] = settings.to_attr()  # provenance: how the likelihood was built
-        conv = convergence(dt, samples)
-        summary = summarize(dt)
-        stages["datatree"] = time.perf_counter() - t
-        t = time.perf_counter()
-        sens = nu_sensitivity(prep.data, alternatives, seed=seed, hoop=use_hoop, done={"default": samples},
-                              likelihood=likelihood)
-        n_rerun = sum(s.method == "sampled" for k, s in sens.items() if k != "default")
-        say(f"sensitivity to the nu prior: {len(alternatives) - 1} alternatives, {len(alternatives) - 1 - n_rerun} "
-            f"by importance reweighting, {n_rerun} sampled afresh")
-        conflict = prior_data_conflict(dt, samples, priors)
-        if conflict.flagged:
-            note(conflict.sentence())
-        stages["sensitivity"] = time.perf_counter() - t
-        t = time.perf_counter()
-        band = f_given_nu(samples, np.linspace(0.15, 0.49, 69))
-        share = nu_variance_share(samples)
-        ppc = ratio_ppc(samples, prep.data, seed=seed, likelihood=likelihood)
-        V = sliding_velocity_summary(prep)
-        f_quoted = quoted_summary(samples.flat("f"))  # the stationary f to quote: with the bars' calibration
-        stages["analysis"] = time.perf_counter() - t
-        t = time.perf_counter()
-        posterior_part = None
-        if pdf:  # the posterior's pages, while the other core finishes
-            from ..report.pdf import ReportInputs, render_posterior_part, render_report
-
-            inputs = ReportInputs(prep, samples, dt, summary, conv, band, sens, share, ppc, lab, V, __version__,
-                                  conflict, likelihood=likelihood)
-            posterior_part = render_posterior_part(inputs)
+        inputs, posterior_part = _posterior_pages(s, post) if pdf else (None, None)  # while the other core finishes
         stages["pdf"] = time.perf_counter() - t
         t = time.perf_counter()  # whole_record: what is left of the check when this process gets to it, and diagnose
         wrc, record_part = side_job.result() if check else (None, None)
-        diag = None
-        if wrc is not None:
-            from ..discrepancy import pipeline
-
-            pipeline.add_whole_record(dt, wrc)
-            if diagnose:
-                from ..discrepancy import outcome
-
-                say("diagnose: fitting each mechanism of the catalogue to the whole record")
-                start = {"f": summary["f"].q50, "nu": summary["nu"].q50}
-                diag = pipeline.run_diagnose(prep, priors, start, hoop=use_hoop, seed=seed, say=say, check=wrc,
-                                             stationary_f=samples.flat("f"))
-                outcome.add_to_datatree(dt, diag, priors["f"])
+        diag = _record_check(s, post, wrc, diagnose=diagnose, seed=seed, say=say) if wrc is not None else None
         stages["whole_record"] = time.perf_counter() - t
-        levels = likelihood.force if isinstance(likelihood.force, LevelForceTerm) else LevelForceTerm(prep.data)
-        warns = run_warnings(ppc=ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=summary["f"], lab=lab,
-                             conv=conv, conflict=conflict, check=wrc, gauge_notes=prep.gauge_notes,
-                             diagnosis=diag)
-        dt.attrs.update({
-            "friction_uq_version": __version__, "record": str(record.path), "record_sha256": record.sha256,
-            "test_id": record.test_id, "campaign": record.campaign, "window_s": [prep.window.t0, prep.window.t1],
-            "dispersion_correction": int(dispersion), "hoop_term": int(use_hoop),
-            "seed": seed if seed < 2**63 else str(seed),  # netCDF attributes hold int64
-            "prior_file": str(p_path), "prior_data_conflict": int(bool(conflict.flagged)),
-        })  # the DataTree is complete: nothing below changes it
+        warns = _warnings(s, post, wrc, diag)
+        _complete_datatree(post, s, seed)  # the DataTree is complete: nothing below changes it
         # the netCDF on the other core (its writer loads dask and xarray's backends, ~0.6 s) while this one
         # draws the report's last pages; in line where this process may not fork
-        with Background(netcdf_bytes, dt) as nc_job:
+        with Background(netcdf_bytes, post.datatree) as nc_job:
             t = time.perf_counter()
             pdf_bytes = None
-            if pdf:
+            if inputs is not None:
+                from ..report.pdf import render_report
+
                 inputs = dataclasses.replace(inputs, whole_record=wrc, diagnosis=diag, warnings=tuple(warns))
                 pdf_bytes = render_report(inputs, record_part=record_part, posterior_part=posterior_part)
             stages["pdf"] += time.perf_counter() - t
             t = time.perf_counter()
             nc_bytes = nc_job.result()
-
         seconds = time.perf_counter() - t_start
-        doc: dict[str, object] = {"schema": RUN_SCHEMA, "schema_version": RUN_SCHEMA_VERSION, "warnings": warns,
-                                  "f": quoted_f(f_quoted, summary["f"].to_json(), diag, hoop=samples.hoop)}
-        allv = dict(summary) | {"V": V}
-        for name in JSON_VARIABLES:
-            v = allv[name]
-            doc["f_stationary" if name == "f" else name] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50,
-                                                            "q95": v.q95}
-        if "hoop_gain" in summary:
-            v = summary["hoop_gain"]
-            doc["hoop_gain"] = {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50, "q95": v.q95}
-        doc |= {
-            "window": [prep.window.t0, prep.window.t1],
-            "rhat_max": conv.r_hat_max,
-            "ess_min": min(conv.ess_bulk_min, conv.ess_tail_min),
-            "seed": seed,
-            "seconds": seconds,
-            "converged": conv.ok,
-            "test_id": record.test_id,
-            "campaign": record.campaign,
-            "record_sha256": record.sha256,
-            "prior_file": str(p_path),
-            "hoop_term": use_hoop,
-            "hoop_left_out": left_out,
-            "dispersion_correction": dispersion,
-            "analysis_settings": settings.to_json(),
-            "nu_variance_share_of_f": share,
-            "f_under_nu_priors": {k: s.to_json() for k, s in sens.items()},
-            "prior_data_conflict": conflict.to_json(),
-            "ppc_ratio_coverage_90": ppc.coverage,
-            "lab_point_estimate_nominal_nu": {"nu": lab.nu, "f": lab.f, "ratio": lab.ratio},
-            "ess_per_second": conv.ess_per_second,
-            "notes": said,
-            "outputs": {"netcdf": {"file": names["netcdf"].name, "sha256": sha256_hex(nc_bytes)},
-                        "pdf": None if pdf_bytes is None else {"file": names["pdf"].name, "sha256": sha256_hex(pdf_bytes)}},
-            "friction_uq_version": __version__,
-        }
-        if wrc is not None:
-            doc["misfit"] = wrc.to_json()
-        if diag is not None:
-            doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json(), f_quoted)
+        doc = run_document(s, post, seed=seed, seconds=seconds, warns=warns, notes=said, wrc=wrc, diag=diag,
+                           dispersion=dispersion, nc_bytes=nc_bytes, pdf_bytes=pdf_bytes)
         js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
-        write_together({names["netcdf"]: nc_bytes, names["pdf"]: pdf_bytes, names["json"]: js_bytes},
-                       last=names["json"])
+        write_together({s.names["netcdf"]: nc_bytes, s.names["pdf"]: pdf_bytes, s.names["json"]: js_bytes},
+                       last=s.names["json"])
         backend.unlink(missing_ok=True)
         stages["outputs"] = time.perf_counter() - t  # the netCDF's wait, the JSON and the writes
-    outputs = {k: p for k, p in names.items() if k != "pdf" or pdf_bytes is not None}
+    outputs = {k: p for k, p in s.names.items() if k != "pdf" or pdf_bytes is not None}
     if table:
-        from ..report.quote import quote_line
+        _print_summary(s, post, wrc, diag, doc, warns, outputs, seconds, page=pdf_bytes is not None)
+    return RunResult(s.prepared, post.samples, post.summary, post.convergence, s.lab, outputs, seconds, post.conflict,
+                     tuple(said), stages, post.sensitivity, wrc, diag, tuple(warns))
 
-        print(quote_line(f_quoted, diag, len(warns), hoop=samples.hoop))
-        for w in warns:
-            print(f"WARNING: {w}")
-        lines = []
-        if wrc is not None:
-            lines.append(wrc.decision.sentence(page=(10 if use_hoop else 9) if pdf_bytes is not None else None))
-        if diag is not None:
-            lines.append(doc["discrepancy"]["sentence"])
-        print(summary_table(record.campaign, record.test_id, allv, conv, outputs, seconds, conflict, lines))
-    return RunResult(prep, samples, summary, conv, lab, outputs, seconds, conflict, tuple(said), stages, sens,
-                     wrc, diag, tuple(warns))
 
+def _posterior_pages(s: RunSetup, post: StationaryPosterior) -> tuple[object, bytes]:
+    """The report's inputs so far and its posterior pages (2-8, 9 with the hoop term)."""
+    from ..report.pdf import ReportInputs, render_posterior_part
+
+    inputs = ReportInputs(s.prepared, post.samples, post.datatree, post.summary, post.convergence, post.band,
+                          post.sensitivity, post.nu_share, post.ppc, s.lab, post.V, __version__, post.conflict,
+                          likelihood=s.likelihood)
+    return inputs, render_posterior_part(inputs)
+
+
+def _warnings(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck | None, diag: object | None) -> list[str]:
+    """The checks that failed, one sentence each (:mod:`.warnings`)."""
+    lik = s.likelihood
+    levels = lik.force if isinstance(lik.force, LevelForceTerm) else LevelForceTerm(s.prepared.data)
+    return run_warnings(ppc=post.ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=post.summary["f"],
+                        lab=s.lab, conv=post.convergence, conflict=post.conflict, check=wrc,
+                        gauge_notes=s.prepared.gauge_notes, diagnosis=diag)
+
+
+def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck, *, diagnose: bool, seed: int,
+                  say: Callable[[str], None]) -> object | None:
+    """The whole-record check written into the DataTree; with ``diagnose``, every mechanism of the catalogue
+    fitted to the whole record and the cause named (written there too), else None."""
+    from ..discrepancy import outcome, pipeline
+
+    pipeline.add_whole_record(post.datatree, wrc)
+    if not diagnose:
+        return None
+    say("diagnose: fitting each mechanism of the catalogue to the whole record")
+    start = {"f": post.summary["f"].q50, "nu": post.summary["nu"].q50}
+    diag = pipeline.run_diagnose(s.prepared, s.priors, start, hoop=s.use_hoop, seed=seed, say=say, check=wrc,
+                                 stationary_f=post.samples.flat("f"))
+    outcome.add_to_datatree(post.datatree, diag, s.priors["f"])
+    return diag
+
+
+def _complete_datatree(post: StationaryPosterior, s: RunSetup, seed: int) -> None:
+    """The run's provenance in the DataTree's attributes."""
+    post.datatree.attrs.update({
+        "friction_uq_version": __version__, "record": str(s.record.path), "record_sha256": s.record.sha256,
+        "test_id": s.record.test_id, "campaign": s.record.campaign,
+        "window_s": [s.prepared.window.t0, s.prepared.window.t1],
+        "dispersion_correction": int(s.settings.dispersion), "hoop_term": int(s.use_hoop),
+        "seed": seed if seed < 2**63 else str(seed),  # netCDF attributes hold int64
+        "prior_file": str(s.prior_path), "prior_data_conflict": int(bool(post.conflict.flagged)),
+    })
+
+
+def _summary_json(v: VariableSummary) -> dict[str, float]:
+    return {"mean": v.mean, "sd": v.sd, "q05": v.q05, "q50": v.q50, "q95": v.q95}
+
+
+def run_document(s: RunSetup, post: StationaryPosterior, *, seed: int, seconds: float, warns: list[str],
+                 notes: list[str], wrc: WholeRecordCheck | None, diag: object | None, dispersion: bool,
+                 nc_bytes: bytes, pdf_bytes: bytes | None) -> dict[str, object]:
+    """The run's JSON (docs/outputs.md)."""
+    summary, conv = post.summary, post.convergence
+    doc: dict[str, object] = {"schema": RUN_SCHEMA, "schema_version": RUN_SCHEMA_VERSION, "warnings": warns,
+                              "f": quoted_f(post.f_quoted, summary["f"].to_json(), diag, hoop=post.samples.hoop)}
+    allv = dict(summary) | {"V": post.V}
+    for name in JSON_VARIABLES:
+        doc["f_stationary" if name == "f" else name] = _summary_json(allv[name])
+    if "hoop_gain" in summary:
+        doc["hoop_gain"] = _summary_json(summary["hoop_gain"])
+    lab = s.lab
+    doc |= {
+        "window": [s.prepared.window.t0, s.prepared.window.t1],
+        "rhat_max": conv.r_hat_max,
+        "ess_min": min(conv.ess_bulk_min, conv.ess_tail_min),
+        "seed": seed,
+        "seconds": seconds,
+        "converged": conv.ok,
+        "test_id": s.record.test_id,
+        "campaign": s.record.campaign,
+        "record_sha256": s.record.sha256,
+        "prior_file": str(s.prior_path),
+        "hoop_term": s.use_hoop,
+        "hoop_left_out": s.hoop_left_out,
+        "dispersion_correction": dispersion,
+        "analysis_settings": s.settings.to_json(),
+        "nu_variance_share_of_f": post.nu_share,
+        "f_under_nu_priors": {k: x.to_json() for k, x in post.sensitivity.items()},
+        "prior_data_conflict": post.conflict.to_json(),
+        "ppc_ratio_coverage_90": post.ppc.coverage,
+        "lab_point_estimate_nominal_nu": {"nu": lab.nu, "f": lab.f, "ratio": lab.ratio},
+        "ess_per_second": conv.ess_per_second,
+        "notes": notes,
+        "outputs": {"netcdf": {"file": s.names["netcdf"].name, "sha256": sha256_hex(nc_bytes)},
+                    "pdf": None if pdf_bytes is None else {"file": s.names["pdf"].name,
+                                                           "sha256": sha256_hex(pdf_bytes)}},
+        "friction_uq_version": __version__,
+    }
+    if wrc is not None:
+        doc["misfit"] = wrc.to_json()
+    if diag is not None:
+        from ..discrepancy import outcome
+
+        doc["discrepancy"] = outcome.to_json(diag, summary["f"].to_json(), post.f_quoted)
+    return doc
+
+
+def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck | None, diag: object | None,
+                   doc: dict[str, object], warns: list[str], outputs: dict[str, Path], seconds: float, *,
+                   page: bool) -> None:
+    """The terminal's headline, warnings and summary table (``page``: a report was written to point at)."""
+    from ..report.quote import quote_line
+
+    print(quote_line(post.f_quoted, diag, len(warns), hoop=post.samples.hoop))
+    for w in warns:
+        print(f"WARNING: {w}")
+    lines = []
+    if wrc is not None:
+        lines.append(wrc.decision.sentence(page=(10 if s.use_hoop else 9) if page else None))
+    if diag is not None:
+        lines.append(doc["discrepancy"]["sentence"])
+    print(summary_table(s.record.campaign, s.record.test_id, dict(post.summary) | {"V": post.V}, post.convergence,
+                        outputs, seconds, post.conflict, lines))
