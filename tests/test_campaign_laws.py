@@ -10,6 +10,7 @@ import pytest
 
 from friction_uq.campaign import RecordResult
 from friction_uq.campaign.analysis import WEIGHT_RULE, RecordPosterior, analyse_tests, supported_laws, verdict
+from friction_uq.campaign.law_comparison import SLIP_CAVEAT
 from friction_uq.campaign.flags import causes_sentence, setup_flags, tally_causes
 from friction_uq.campaign.laws import Elpd, Model
 from friction_uq.campaign.outputs import campaign_doc, summary_text, write_netcdf
@@ -197,6 +198,20 @@ def test_the_verdict_reads_the_weights_and_never_defaults_to_constant():
     # constant is named only when it carries the weight itself
     spread = verdict({"velocity": 0.3, "pressure+velocity": 0.3, "pressure": 0.2, "constant": 0.2}, ranking)
     assert "do not separate" in spread[0] and spread[1].startswith("no dependence of f on V or p is resolved")
+
+
+def test_a_velocity_term_is_said_to_stand_for_v_or_the_distance_slid():
+    """At a test's window the mean slip grows in proportion to V within a set-up, and no law in the slip is compared:
+    wherever a law with a velocity term is named, the verdict says that slip weakening would read the same."""
+    row = lambda m, d, se: {"model": m, "d_elpd": d, "d_se": se}  # noqa: E731
+    far = [row("velocity", 0.0, 0.0), row("pressure+velocity", 6.0, 2.0), row("pressure", 5.0, 2.0),
+           row("constant", 9.0, 3.0)]
+    named = verdict({"velocity": 0.93, "pressure+velocity": 0.07, "pressure": 0.0, "constant": 0.0}, far)
+    assert named[-1] == SLIP_CAVEAT and "distance slid" in SLIP_CAVEAT
+    pressure = [row("pressure", 0.0, 0.0), row("pressure+velocity", 6.0, 2.0), row("velocity", 5.0, 2.0),
+                row("constant", 9.0, 3.0)]
+    only_p = verdict({"pressure": 0.93, "pressure+velocity": 0.07, "velocity": 0.0, "constant": 0.0}, pressure)
+    assert SLIP_CAVEAT not in only_p  # no velocity term named: nothing for slip to stand behind
 
 
 def test_the_supported_set_does_not_follow_where_stacking_put_its_weight():

@@ -57,6 +57,12 @@ def simplest_supported(weights: dict[str, float], ranking: Sequence[dict[str, ob
     return min(supported_laws(weights, ranking), key=lambda law: (len(LAW_PARAMS[law]), -weights[law]))
 
 
+#: Said beside a verdict that names a law with a velocity term (docs/campaigns.md: no slip law among the candidates).
+SLIP_CAVEAT = ("a dependence on the distance slid would read the same: at each test's window the mean slip grows in "
+               "proportion to V within a set-up, and no law in the slip is compared, so a velocity term may stand for "
+               "slip weakening (docs/campaigns.md)")
+
+
 def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
     """What the comparison supports (:func:`supported_laws`), in sentences: the law, or the laws the data do not
     separate (with their stacking weights and how far behind the best each is); and that f is not constant
@@ -82,6 +88,8 @@ def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> 
     elif "constant" in supported and len(supported) > 1:
         out.append(f"no dependence of f on V or p is resolved: a constant f carries {weights['constant']:.2f} of "
                    "the weight, and the laws beside it predict the tests as well")
+    if any("log_vc" in LAW_PARAMS[law] for law in supported if law in LAW_PARAMS):
+        out.append(SLIP_CAVEAT)
     return out
 
 
