@@ -33,6 +33,7 @@ import time
 import numpy as np
 
 from friction_uq import cli
+from friction_uq.errors import FrictionUQError
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -62,7 +63,7 @@ def study_records(names: str, per: int, seed: int, folder: str) -> list[str]:
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from verdict_records import groups, make, write
 
-    chosen = groups() if names == "all" else names.split(",")
+    chosen = groups() if names == "all" else [g for g in names.split(",") if g]
     unknown = sorted(set(chosen) - set(groups()) - {"clean"})
     if unknown:
         raise SystemExit(f"unknown group(s) {', '.join(unknown)}; known: clean, {', '.join(groups())}")
@@ -72,7 +73,11 @@ def study_records(names: str, per: int, seed: int, folder: str) -> list[str]:
         for k in range(per):
             cfg, edit, note, header = make(group, k, rng)
             path = os.path.join(folder, f"{group}-{k}.h5")
-            write(cfg, path, int(rng.integers(2**31)), edit, header)
+            try:
+                write(cfg, path, int(rng.integers(2**31)), edit, header)
+            except FrictionUQError as exc:  # a record the simulator refuses: said, and the study goes on
+                print(f"{os.path.basename(path)} ({note}) refused: {exc}", flush=True)
+                continue
             print(f"{os.path.basename(path)}: {note}", flush=True)
             paths.append(path)
     return paths
@@ -115,8 +120,9 @@ def check(records: list[str], seeds: list[int], label: str) -> None:
         stable += same
         print(f"{os.path.basename(path)}: {'the same verdict and causes' if same else 'NOT the same'} with "
               f"{len(seeds)} seeds", flush=True)
-    print(f"\n{stable} of {len(records)} records give the same verdict and causes with seeds {label}; "
-          f"diagnose's time per run: median {statistics.median(secs):.0f} s")
+    if secs:
+        print(f"\n{stable} of {len(records)} records give the same verdict and causes with seeds {label}; "
+              f"diagnose's time per run: median {statistics.median(secs):.0f} s")
 
 
 if __name__ == "__main__":

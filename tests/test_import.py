@@ -20,7 +20,7 @@ from friction_uq.acquisition import TEMPLATE, import_scope_files, parse_setup
 from friction_uq.acquisition.scope_export import export_record, gauge_signals, write_scope_csv
 from friction_uq.analysis import identify, prepare
 from friction_uq.cli import main
-from friction_uq.errors import SetupError
+from friction_uq.errors import ScopeFileError, SetupError
 from friction_uq.record import read_record
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -268,6 +268,24 @@ def test_a_damaged_row_near_the_end_is_named_by_its_line(tmp_path, scope_csv, ca
     err = _refused(tmp_path, [scope_csv], setup_doc(), capsys)
     assert f"scope.csv: line {k + 1} {words}" in err, err
     assert f"where the rows around it are {ncols} numbers each" in err, err
+
+
+def test_a_damaged_row_is_found_by_its_place_not_by_its_text(tmp_path):
+    """A flat signal: every row the same, one cut short, whose text is the start of every later row; and a footer
+    after the data, which is not a damaged row (the general sentence stays)."""
+    from friction_uq.acquisition.delimited import read_delimited
+
+    rows = ["time,a,b"] + ["0.000,0.000,0.000"] * 100
+    rows[91] = "0.000,0.000"
+    for name, end in (("lf", "\n"), ("crlf", "\r\n")):
+        path = tmp_path / f"flat-{name}.csv"
+        path.write_bytes(end.join(rows).encode() + end.encode())
+        with pytest.raises(ScopeFileError, match=r"line 92 has 2 fields, where the rows around it are 3 numbers"):
+            read_delimited(path, [1, 2])
+    footer = tmp_path / "footer.csv"
+    footer.write_text("\n".join(["time,a,b"] + [f"{k},1,2" for k in range(100)] + ["END OF DATA"]) + "\n")
+    with pytest.raises(ScopeFileError, match="its last lines are not rows of numbers"):
+        read_delimited(footer, [1, 2])
 
 
 def test_unequal_lengths_are_named(tmp_path, capsys):

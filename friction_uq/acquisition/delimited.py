@@ -73,12 +73,31 @@ def _numeric_row(line: str, delim: str | None, decimal: str) -> int:
     return len(f) if f and all(_number(c, decimal) for c in f) else 0
 
 
-def _dialect(path: Path, tail: list[str], text: str = "") -> tuple[str | None, str, int]:
-    """(delimiter, decimal mark, fields per row) under which every line of ``tail`` is a row of numbers; else
-    one sentence naming the line that breaks the layout most of them share (its number found in ``text``)."""
+def _tail(text: str, head: list[str]) -> list[tuple[int, str]]:
+    """The last :data:`_TAIL_LINES` lines that are not blank, each with its offset in ``text`` (a short file's
+    from its head): the lines the layout is read from."""
+    chunk = text[-(1 << 15):]
+    base, out, at = len(text) - len(chunk), [], 0
+    for k, line in enumerate(chunk.split("\n")):
+        if k and line.strip():  # the chunk's first line may be cut
+            out.append((base + at, line))
+        at += len(line) + 1
+    if not out:  # a short file: its tail is its head
+        at = 0
+        for line in head:
+            if line.strip():
+                out.append((at, line))
+            at += len(line) + 1
+    return out[-_TAIL_LINES:]
+
+
+def _dialect(path: Path, tail: list[tuple[int, str]], text: str) -> tuple[str | None, str, int]:
+    """(delimiter, decimal mark, fields per row) under which every line of ``tail`` (offset, line) is a row of
+    numbers; else one sentence naming the line that breaks the layout the others share, or saying there is none."""
+    lines = [ln for _, ln in tail]
     best: tuple[str | None, str, int] | None = None
     for delim, dec in DIALECTS:
-        counts = {_numeric_row(line, delim, dec) for line in tail}
+        counts = {_numeric_row(line, delim, dec) for line in lines}
         if len(counts) == 1 and (n := counts.pop()) > 0 and (best is None or n > best[2]):
             best = (delim, dec, n)
     if best is None:
@@ -92,26 +111,34 @@ def _dialect(path: Path, tail: list[str], text: str = "") -> tuple[str | None, s
     return best
 
 
-def _odd_line(tail: list[str], text: str) -> tuple[str, int] | None:
-    """The first line of ``tail`` that breaks the layout most of them share (the layout with the most numbers per
-    row among those), located in ``text`` ('line N has k fields'), and the rows' count of numbers; None when no
-    layout is shared by more than half of them."""
+def _odd_line(tail: list[tuple[int, str]], text: str) -> tuple[str, int] | None:
+    """The first line of ``tail`` (offset, line) that breaks the layout more than half of them share (of such
+    layouts, the one with the most numbers per row): a row of numbers with another count of them, or a line
+    between rows of the layout that is not a row of numbers ('line N has k fields'), and the rows' count of
+    numbers; None when there is no such layout or no such line (a footer after the data, a header above it)."""
+    lines = [ln for _, ln in tail]
     shared: tuple[int, int, str | None, str] | None = None  # (rows, fields, delimiter, decimal mark)
     for delim, dec in DIALECTS:
-        counts = [_numeric_row(line, delim, dec) for line in tail]
+        counts = [_numeric_row(line, delim, dec) for line in lines]
         top = max(set(counts) - {0}, key=lambda n: (counts.count(n), n), default=0)
-        if top and 2 * counts.count(top) > len(tail) and (shared is None or (counts.count(top), top) > shared[:2]):
+        if top and 2 * counts.count(top) > len(lines) and (shared is None or (counts.count(top), top) > shared[:2]):
             shared = (counts.count(top), top, delim, dec)
     if shared is None:
         return None
     _, ncols, delim, dec = shared
-    line = next(ln for ln in tail if _numeric_row(ln, delim, dec) != ncols)
-    n = len(_fields(line, delim))
-    what = (f"has {n} field{'s' if n != 1 else ''}" if _numeric_row(line, delim, dec)
-            else f"is not a row of numbers ({line.strip()[:40]!r})")
-    pos = text.rfind(line)
-    where = f"line {text.count(chr(10), 0, pos) + 1}" if text and pos >= 0 else "a line near the end"
-    return f"{where} {what}", ncols
+    fits = [_numeric_row(line, delim, dec) == ncols for line in lines]
+    for k, (pos, line) in enumerate(tail):
+        if fits[k]:
+            continue
+        if _numeric_row(line, delim, dec):
+            n = len(_fields(line, delim))
+            what = f"has {n} field{'s' if n != 1 else ''}"
+        elif any(fits[:k]) and any(fits[k + 1:]):
+            what = f"is not a row of numbers ({line.strip()[:40]!r})"
+        else:
+            continue
+        return f"line {text.count(chr(10), 0, pos) + 1} {what}", ncols
+    return None
 
 
 def _data_start(path: Path, head: list[str], delim: str | None, dec: str, ncols: int) -> int:
@@ -218,9 +245,7 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
     if "\n" not in text[: 1 << 16] and "\r" in text[: 1 << 16]:
         text = text.replace("\r", "\n")  # old Macintosh line ends
     head = text[: 1 << 18].split("\n")[:_HEAD_LINES]
-    tail = [ln for ln in text[-(1 << 15):].split("\n")[1:] if ln.strip()][-_TAIL_LINES:]
-    if not tail:  # a short file: its tail is its head
-        tail = [ln for ln in head if ln.strip()][-_TAIL_LINES:]
+    tail = _tail(text, head)
     if not tail:
         raise ScopeFileError(f"{p}: is empty")
     delim, dec, ncols = _dialect(p, tail, text)
@@ -258,8 +283,7 @@ def describe_text(path: str | Path) -> list[str]:
     if "\n" not in text[: 1 << 16] and "\r" in text[: 1 << 16]:
         text = text.replace("\r", "\n")
     head = text[: 1 << 18].split("\n")[:_HEAD_LINES]
-    tail = [ln for ln in text[-(1 << 15):].split("\n")[1:] if ln.strip()][-_TAIL_LINES:] or \
-        [ln for ln in head if ln.strip()][-_TAIL_LINES:]
+    tail = _tail(text, head)
     if not tail:
         raise ScopeFileError(f"{p}: is empty")
     delim, dec, ncols = _dialect(p, tail, text)
