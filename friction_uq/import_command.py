@@ -28,6 +28,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--show", action="store_true",
                    help="print what each FILE holds (layout, columns or channels, first values) and exit: "
                    "what SETUP.toml refers to")
+    s.add_argument("--overwrite", action="store_true", help="replace the record -o names if it exists (refused otherwise)")
     s.add_argument("--no-check", action="store_true",
                    help="write the record even when a gauge's sign or scale contradicts the others (warnings only)")
 
@@ -58,6 +59,10 @@ def run(args: argparse.Namespace, parser: argparse.ArgumentParser, output_check)
         parser.error(f"import needs {', '.join(missing)}: friction-uq import FILE... --setup SETUP.toml -o test.h5 "
                      "(friction-uq import --template prints a SETUP.toml to start from)")
     output_check(args.output, (".h5", ".hdf5"), "record")
+    if args.output.exists() and not args.overwrite:  # a lab's record is not replaced by a second import unasked
+        from .errors import OutputError
+
+        raise OutputError(f"{args.output}: a file of that name exists; give another name, or --overwrite to replace it")
     from .acquisition import describe, import_scope_files
 
     outcome = import_scope_files(args.files, args.setup, args.output, check=not args.no_check)

@@ -102,6 +102,19 @@ def test_one_file_with_metadata_volts_and_a_reversed_bridge(tmp_path, capsys):
         assert fh["signals/input_bar"].attrs["units"] == "V"
 
 
+def test_an_existing_record_is_not_replaced_unasked(tmp_path, capsys):
+    (csv,) = export_record(RECORD, tmp_path, strain_per_volt=SPV, names=COLUMNS)
+    setup = write_setup(tmp_path / "SETUP.toml", setup_doc())
+    out = tmp_path / "A-03.h5"
+    out.write_bytes(b"a lab's earlier record")
+    assert main(["import", str(csv), "--setup", str(setup), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "A-03.h5: a file of that name exists; give another name, or --overwrite to replace it" in err
+    assert err.count("\n") == 1 and out.read_bytes() == b"a lab's earlier record"
+    assert main(["import", str(csv), "--setup", str(setup), "-o", str(out), "--overwrite"]) == 0
+    assert read_record(out).n_samples == read_record(RECORD).n_samples
+
+
 def test_one_file_per_channel_semicolons_and_decimal_commas(tmp_path):
     files = export_record(RECORD, tmp_path, strain_per_volt=SPV, names=COLUMNS, per_channel=True,
                           delimiter=";", decimal=",")
