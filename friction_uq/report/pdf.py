@@ -198,7 +198,7 @@ def render_record_part(prepared: Prepared, whole_record: WholeRecordCheck, *, ho
 
     p = prepared
     return _render([lambda fig=fig: fig for fig in pages_whole_record(
-        whole_record, test=f"{p.record.campaign} {p.record.test_id}", first_page=10 if hoop else 9)])
+        whole_record, test=f"{p.record.campaign} {p.record.test_id}", first_page=first_whole_record_page(hoop))])
 
 
 def render_posterior_part(r: ReportInputs) -> bytes:
@@ -250,10 +250,15 @@ def _span(first: int, n: int) -> str:
     return f"{first:2d}" if n <= 1 else f"{first}-{first + n - 1}"
 
 
-def whole_record_page(r: ReportInputs) -> int:
+def first_whole_record_page(hoop: bool) -> int:
     """PDF page number of the first whole-record page (after page 8, or 9 with the hoop page; the summary is
     page 1)."""
-    return 10 if r.samples.hoop else 9
+    return 10 if hoop else 9
+
+
+def whole_record_page(r: ReportInputs) -> int:
+    """:func:`first_whole_record_page` of a report's inputs."""
+    return first_whole_record_page(r.samples.hoop)
 
 
 def diagnosis_pages(r: ReportInputs) -> list[Figure]:

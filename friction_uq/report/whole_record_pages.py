@@ -48,15 +48,20 @@ def _channel(ax_sig, ax_res, chk: WholeRecordCheck, ch: str) -> None:
     ax_res.set_ylim(-lim, lim)
 
 
+def _drawn(chk: WholeRecordCheck) -> list[str]:
+    """The channels the pages draw, in order, two a page."""
+    return [c for c in CHANNEL_LABELS if c in chk.comparison.spans]
+
+
 def page_count(chk: WholeRecordCheck) -> int:
-    """How many pages :func:`pages_whole_record` draws: two channels a page."""
-    return (sum(c in chk.comparison.spans for c in CHANNEL_LABELS) + 1) // 2
+    """How many pages :func:`pages_whole_record` draws."""
+    return (len(_drawn(chk)) + 1) // 2
 
 
 def pages_whole_record(chk: WholeRecordCheck, *, test: str, first_page: int | None = None) -> list[Figure]:
     """Two pages, two channels each (reflected and internal; external and hoop); ``first_page``: the PDF page
     number of the first, written before the titles."""
-    chans = [c for c in CHANNEL_LABELS if c in chk.comparison.spans]
+    chans = _drawn(chk)
     out = []
     for k in range(0, len(chans), 2):
         pair = chans[k:k + 2]

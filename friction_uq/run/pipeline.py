@@ -267,6 +267,7 @@ def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck
                    doc: dict[str, object], warns: list[str], outputs: dict[str, Path], seconds: float, *,
                    page: bool) -> None:
     """The terminal's headline, warnings and summary table (``page``: a report was written to point at)."""
+    from ..report.pdf import first_whole_record_page
     from ..report.quote import quote_line
 
     print(quote_line(post.f_quoted, diag, len(warns), hoop=post.samples.hoop))
@@ -274,7 +275,7 @@ def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck
         print(f"WARNING: {w}")
     lines = []
     if wrc is not None:
-        lines.append(wrc.decision.sentence(page=(10 if s.use_hoop else 9) if page else None))
+        lines.append(wrc.decision.sentence(page=first_whole_record_page(s.use_hoop) if page else None))
     if diag is not None:
         lines.append(doc["discrepancy"]["sentence"])
     print(summary_table(s.record.campaign, s.record.test_id, dict(post.summary) | {"V": post.V}, post.convergence,
