@@ -14,9 +14,8 @@ Laws (the simulator's, ``friction_uq/simulate/friction.py``) and the campaign la
 * ``velocity``: f = 0.035 + 0.040 exp(-V / 8 m/s)            -> velocity
 * ``pressure``: f = 0.09 / (1 + p / 200 MPa) (hyperbolic)     -> pressure
 * ``constant``: f = 0.05 (Coulomb)                            -> constant
-* ``slip``: f from 0.08 to 0.04 over 3 mm of slip             -> none of the campaign's laws holds it (the
-  window's mean f depends on the slip before and through the window, so on V only through it): reported, not
-  scored
+* ``slip``: f from 0.08 to 0.04 over 3 mm of slip (linear)    -> slip (read from kappa's change across each
+  test's window: the window means alone cannot tell it from velocity, ``friction_uq.campaign.laws``)
 
 Per design, simulator and law: campaigns, how often the true law carries the largest stacking weight, how
 often it is among the laws the verdict names, how often "constant" is named on a non-constant law, how
@@ -62,7 +61,7 @@ LAWS = {
     "velocity": ("velocity", {"f_s": 0.075, "f_d": 0.035, "v_c": 8.0}, "velocity"),
     "pressure": ("hyperbolic", {"f0": 0.09, "p0": 200e6}, "pressure"),
     "constant": ("coulomb", {"f": 0.05}, "constant"),
-    "slip": ("slip_weakening", {"f_s": 0.08, "f_d": 0.04, "d_c": 3e-3}, None),
+    "slip": ("slip_weakening", {"f_s": 0.08, "f_d": 0.04, "d_c": 3e-3}, "slip"),
 }
 
 #: set-up C: a steel internal output bar (A's otherwise)

@@ -38,7 +38,8 @@ def test_a_result_reads_back_as_written(tmp_path):
 @pytest.mark.parametrize(("edit", "message"), [
     ({"schema": "other"}, "not a campaign record result \\(key 'schema'"),
     ({"schema_version": SCHEMA_VERSION + 1}, f"key 'schema_version' is {SCHEMA_VERSION + 1}, this friction-uq reads"),
-    ({"colour": "red"}, "unknown key\\(s\\) colour in a schema version 1 result"),
+    ({"colour": "red"}, f"unknown key\\(s\\) colour in a schema version {SCHEMA_VERSION} result"),
+    ({"schema_version": 1}, "key 'schema_version' is 1, this friction-uq reads version 2"),  # no window_halves
     ({"status": "maybe"}, "key 'status' is 'maybe', allowed values: done, skipped, failed"),
 ])
 def test_a_result_of_another_schema_is_refused(tmp_path, edit, message):

@@ -73,7 +73,19 @@ def _law_data(tests: Sequence[RecordPosterior], *, diagnosed: bool | None = None
                    np.array([np.mean(v) for v in y]), np.array([np.std(v) for v in y]),
                    np.array([t.V["mean"] for t in tests]), np.array([t.V["sd"] for t in tests]),
                    np.array([np.mean(t.p_mean) for t in tests]), np.array([np.std(t.p_mean) for t in tests]),
-                   basis="f" if diagnosed else "kappa", draws=tuple(y), draws_log_prior=log_prior)
+                   basis="f" if diagnosed else "kappa", draws=tuple(y), draws_log_prior=log_prior,
+                   **_window_changes(tests))
+
+
+def _window_changes(tests: Sequence[RecordPosterior]) -> dict[str, np.ndarray | None]:
+    """The slip law's data (:class:`~.laws.LawData`'s ``slip``, ``trend``, ``halves``) when every test carries
+    its window's halves; else none, and the slip law is not compared."""
+    if any(t.halves is None for t in tests):
+        return {"slip": None, "trend": None, "halves": None}
+    hs = [t.halves for t in tests]
+    return {"slip": np.array([h.mean_slip for h in hs]),
+            "trend": np.array([[h.log_kappa_change, h.sd] for h in hs]),
+            "halves": np.array([[[h.slip[k], h.V[k], h.pressure_rel[k]] for k in (0, 1)] for h in hs])}
 
 
 def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np.ndarray]:
@@ -92,6 +104,9 @@ def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np
         p_rel = np.array([np.min(fit.data.p), np.max(fit.data.p)]) / fit.p_ref - 1.0
         at = law_mean(law, {k: v[:, None] for k, v in col.items()}, np.zeros(2), p_rel)
         out["f_at_lowest_p"], out["f_at_highest_p"] = at[:, 0] * g, at[:, 1] * g
+    elif law == "slip":
+        out["f_at_start_of_slip"], out["f_after_long_slip"] = col["s"] * g, col["d"] * g
+        out["S_c_mm"] = np.exp(col["log_sc"]) * 1e3
     else:  # pressure+velocity: the velocity law's values at the mean pressure, where its pressure term is 0
         at = "" if law == "velocity" else "_at_mean_p"
         out["f_s" + at], out["f_d" + at], out["v_c"] = col["s"] * g, col["d"] * g, np.exp(col["log_vc"])

@@ -47,6 +47,7 @@ class CampaignAnalysis:
         fit = self.fits[model]
         x = fit.draws[:: max(1, len(fit.draws) // n)]
         th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
-        y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref)
+        y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref,
+                     fit.data.slip_at(setup, V))
         y = y * fit.model.setup_scale(th, [setup] * len(np.atleast_1d(V)))
         return y * fit.kbar * fit.data.to_f(self.nu[0])

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import FrictionUQError
 from ..priors import load_priors
+from ..window_halves import WindowHalves
 from .job import RecordResult
 from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin
 
@@ -40,6 +41,9 @@ class RecordPosterior:
     #: f_effective as the run stored it beside them, or the prior file's f prior for the stationary f; None
     #: when the record's version stored no prior (the diagnosed f is then not pooled)
     f_model_log_prior: np.ndarray | None = None
+    #: kappa's change across the stationary window and the halves' slip, speed and pressure (the slip law's
+    #: data); None when the run gave none
+    halves: WindowHalves | None = None
 
 
 def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
@@ -64,13 +68,15 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
             elif final is not None:  # diagnosed, no cause named: the stationary f, under the prior file's f prior
                 f_model = draws["f"]
                 f_log_prior = np.asarray(load_priors(r.prior_file)["f"].logpdf(f_model), float)
-    except (OSError, KeyError, ValueError) as exc:
+        halves = None if r.window_halves is None else WindowHalves.from_json(r.window_halves)
+    except (OSError, KeyError, ValueError, TypeError) as exc:
         raise FrictionUQError(f"{nc}: cannot read the posterior draws of {r.label} ({exc})") from None
     if f_log_prior is not None and not np.all(np.isfinite(f_log_prior)):
         raise FrictionUQError(f"{nc}: group {final or 'posterior'}: the log prior of f under the diagnosed model is "
                               "not finite at some draws (a draw where its prior has no density cannot be pooled)")
     return RecordPosterior(r.label, str(r.campaign), draws["f"], draws["kappa"], draws["nu"], draws["p_mean"],
-                           r.summary["V"], str(r.prior_file), f_model, f_log_prior)
+                           r.summary["V"], str(r.prior_file), f_model, f_log_prior,
+                           halves)
 
 
 def _text(value: object) -> str | None:

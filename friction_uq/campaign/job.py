@@ -13,14 +13,17 @@ up to date (same record sha256, same settings, same prior file checksum, same pa
 outputs present and holding the bytes the run JSON names) is not analysed again: the job returns
 the stored result with ``status = "skipped"``; one that cannot be read is analysed again.
 
-Schema version 1 (``schema = "friction-uq/campaign-record"``): ``path``, ``status``
+Schema version 2 (``schema = "friction-uq/campaign-record"``): ``path``, ``status``
 (``done`` | ``skipped`` | ``failed``), ``message``, ``campaign`` (the set-up), ``test_id``,
 ``material``, ``record_sha256``, ``prior_file``, ``prior_sha256``, ``friction_uq_version``,
 ``settings`` (seed, dispersion, hoop, pdf), ``outputs`` (file names in the same folder),
 ``summary`` (f, kappa, nu, V, p_mean: mean, sd, q05, q50, q95), ``converged``, ``notes``,
 ``seconds`` (wall), ``cpu_seconds`` (the worker process's user + system time for this record),
 ``peak_rss_mb`` (the worker process's peak resident memory so far) and ``causes``: the causes a per-record diagnosis names (a list of strings, or null
-when no diagnosis was made); the campaign tallies them per set-up.
+when no diagnosis was made); the campaign tallies them per set-up; ``window_halves``: kappa's change across the
+stationary window as the run JSON gives it (:mod:`friction_uq.window_halves`; null where it could not be read),
+which the campaign's slip law reads. Version 1 had no ``window_halves``: such a stored result is not read back,
+so its record is analysed again.
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ from .._atomic import atomic_path
 from ..errors import FrictionUQError, LockedError
 
 SCHEMA = "friction-uq/campaign-record"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 SUMMARY_VARIABLES = ("f", "kappa", "nu", "V", "p_mean")
 STATUSES = ("done", "skipped", "failed")
 #: Seconds a record waits for its lock in the campaign's folder: only a killed campaign's worker can hold it
@@ -94,6 +97,7 @@ class RecordResult:
     cpu_seconds: float = 0.0
     peak_rss_mb: float = 0.0
     causes: list[str] | None = None
+    window_halves: dict[str, Any] | None = None
 
     @property
     def ok(self) -> bool:
@@ -245,7 +249,8 @@ def run_record(task: RecordTask) -> RecordResult:
             base, status="done", outputs={k: p.name for k, p in run.outputs.items()}, summary=_summary(doc),
             converged=bool(doc.get("converged")), notes=notes, seconds=time.perf_counter() - t0,
             cpu_seconds=time.process_time() - c0, peak_rss_mb=_peak_rss_mb(),
-            causes=[c["name"] for c in doc["discrepancy"]["causes"]] if "discrepancy" in doc else None)
+            causes=[c["name"] for c in doc["discrepancy"]["causes"]] if "discrepancy" in doc else None,
+            window_halves=doc.get("window_halves"))
         write_result(result, stored)
         return result
     except FrictionUQError as exc:

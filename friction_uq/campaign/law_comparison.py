@@ -19,7 +19,7 @@ from .conclusions import CampaignAnalysis
 from .flags import setup_flags
 from .kernels import warm_up_kernels
 from .law_loo import loo_elpd, psis_loo, refit_elpd, to_refit
-from .laws import LAW_PARAMS, LAWS, SPECIAL_CASES, Elpd, Fit, LawData, Model, rank
+from .laws import LAW_PARAMS, SPECIAL_CASES, Elpd, Fit, LawData, Model, rank
 
 #: The verdict's rule on the laws' stacking weights (friction_uq.stats.weights).
 WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
@@ -88,8 +88,8 @@ def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> 
     elif "constant" in supported and len(supported) > 1:
         out.append(f"no dependence of f on V or p is resolved: a constant f carries {weights['constant']:.2f} of "
                    "the weight, and the laws beside it predict the tests as well")
-    if any("log_vc" in LAW_PARAMS[law] for law in supported if law in LAW_PARAMS):
-        out.append(SLIP_CAVEAT)
+    if "slip" not in weights and any("log_vc" in LAW_PARAMS[law] for law in supported if law in LAW_PARAMS):
+        out.append(SLIP_CAVEAT)  # the slip law was not compared (the tests carry no change across their windows)
     return out
 
 
@@ -159,7 +159,7 @@ class LawComparison:
         ``elpds``: the four models fitted already (a free offset on one set-up is the same model whether it was
         fitted to flag the set-up or to leave its level out)."""
         if elpds is None:
-            models = [Model(law, None, cal, freed) for law in LAWS]
+            models = [Model(law, None, cal, freed) for law in self.data.laws]
             elpds = {m.name: e for m, (_, e) in zip(models, self.fit_all(models))}
         self.ca.ranking = rank(list(elpds.values()))
         self.ca.weights = {Model(k.split(" + ")[0]).law: w
@@ -182,7 +182,7 @@ class LawComparison:
         freed: list[str] = []
         first: dict[str, tuple[Elpd, dict[str, float]]] = {}
         while True:
-            laws = LAWS if every_law and not first else (law,)
+            laws = self.data.laws if every_law and not first else (law,)
             models = [Model(x, s, cal, tuple(freed)) for s in offsets if s not in freed for x in laws]
             fitted = {m: (e, draw_summary(fit.draws[:, -2])) for m, (fit, e) in zip(models, self.fit_all(models))}
             if not freed:
@@ -202,11 +202,11 @@ class LawComparison:
     def offset_models(self, setup: str, cal: tuple[str, ...]) -> dict[str, tuple[Elpd, dict[str, float]]]:
         """Every law with a free offset on ``setup`` (those not fitted yet are fitted now): name -> (ELPD, summary
         of the offset's draws)."""
-        todo = [m for m in (Model(law, setup, cal) for law in LAWS) if m.name not in self.offset_fits]
+        todo = [m for m in (Model(law, setup, cal) for law in self.data.laws) if m.name not in self.offset_fits]
         if todo:
             self.offset_fits |= {m.name: (e, draw_summary(fit.draws[:, -2]))
                                  for m, (fit, e) in zip(todo, self.fit_all(todo))}
-        return {m.name: self.offset_fits[m.name] for m in (Model(law, setup, cal) for law in LAWS)}
+        return {m.name: self.offset_fits[m.name] for m in (Model(law, setup, cal) for law in self.data.laws)}
 
     def offset_alternative(self, setup: str, cal: tuple[str, ...]) -> dict[str, object]:
         """With two set-ups: every law with a free offset on ``setup`` beside every law without, their stacking

@@ -45,12 +45,15 @@ def _e(log_c: np.ndarray, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray,
 
 
 class LawCoordinates:
-    """The change of coordinates for one model's parameter tuple (``params``), the tested speeds ``V`` and the
-    tested pressures over the campaign's mean, ``P`` (None: no pressure term is changed)."""
+    """The change of coordinates for one model's parameter tuple (``params``), the tested speeds ``V``, the
+    tested pressures over the campaign's mean, ``P`` (None: no pressure term is changed) and the tests' mean
+    slips ``S`` (m; None: no slip law)."""
 
-    def __init__(self, params: Sequence[str], V: np.ndarray, P: np.ndarray | None = None) -> None:
+    def __init__(self, params: Sequence[str], V: np.ndarray, P: np.ndarray | None = None,
+                 S: np.ndarray | None = None) -> None:
         names = list(params)
         v_range, p_range = _spread(np.asarray(V, float)), _spread(None if P is None else np.asarray(P, float))
+        s_range = _spread(None if S is None else np.asarray(S, float))
         #: (index of d, of s, of the log scale, lowest and highest tested value): d and s to y_lo and y_hi
         self._pairs: list[tuple[int, int, int, float, float]] = []
         #: (index of the amplitude, of the log scale, lowest and highest tested value)
@@ -59,6 +62,8 @@ class LawCoordinates:
             self._pairs.append((names.index("d"), names.index("s"), names.index("log_vc"), *v_range))
         elif {"d", "s", "log_pc"} <= set(names) and "log_vc" not in names and p_range:  # the pressure law
             self._pairs.append((names.index("d"), names.index("s"), names.index("log_pc"), *p_range))
+        elif {"d", "s", "log_sc"} <= set(names) and s_range:  # the slip law
+            self._pairs.append((names.index("d"), names.index("s"), names.index("log_sc"), *s_range))
         if {"amp_p", "log_pc"} <= set(names) and p_range:
             self._amps.append((names.index("amp_p"), names.index("log_pc"), *p_range))
         self._r = names.index("r") if "r" in names else None

@@ -11,9 +11,11 @@ friction) no longer biases:
 * ``constant``:           y = a
 * ``velocity``:           y = d + (s - d) exp(-V / v_c)   (the mechanism catalogue's form)
 * ``pressure``:           y = d + (s - d) exp(-P / P_c)
+* ``slip``:               y = d + (s - d) exp(-S / S_c)
 * ``pressure+velocity``:  y = d + (s - d) exp(-V / v_c) + amp_p [exp(-P / P_c) - exp(-1 / P_c)]
 
-with P = p / p_ref, p_ref the campaign's mean pressure. The pressure and the velocity terms have one shape, a
+with P = p / p_ref, p_ref the campaign's mean pressure, and S the test's mean slip over its window (eq. 7
+integrated from the start of loading). The pressure and the velocity terms have one shape, a
 monotone change between two levels over a scale (rising or falling, nearly straight when the scale is long,
 saturating when it is short), so that the law's formula does not decide which variable is named: a pressure law
 of one straight line (y = a (1 + c (P - 1)), before the nineteenth session) was 8 % off a hyperbolic wall over
@@ -41,6 +43,21 @@ Priors: a, d, s uniform on (0, 5); v_c log-uniform on (0.3, 300) m/s; P_c log-un
 units of p_ref: about the span of v_c's range over the tested speeds); amp_p uniform on (-5, 5), as s - d; the law
 positive at every test; cal_s ~ N(0, 0.03); delta ~ N(0, 0.3).
 
+**Inside each test** (:mod:`friction_uq.window_halves`). Across a campaign a test's mean slip is nearly V
+times a time the set-up fixes, so the slip law and the velocity law predict the window means alike. Each
+test also gives kappa's change from the first half of its window to the second, ln(kappa_2 / kappa_1),
+with its standard error s_i, and the halves' slip, speed and pressure: the sample slides 1-2 mm through a
+window at a nearly constant V. Every law predicts that change, ln(y(V_2, P_2, S_2) / y(V_1, P_1, S_1))
+(the set-up's offsets cancel), and each test's likelihood carries it as a second, independent term
+
+    ln(kappa_2 / kappa_1) ~ N(pred, s_i^2 + TREND_FLOOR^2 + (TREND_REL pred)^2),
+
+TREND_FLOOR (0.005) for what the window does that no law describes and TREND_REL (0.3) for how far the
+change a quasi-static law predicts is from the one a dynamic test shows: both from records of the
+axisymmetric simulation (docs/campaigns.md). When a test carries no such change (a result of an older
+version), the slip law is not compared and no test's likelihood has the term.
+Priors: S_c log-uniform on (0.1, 100) mm (the tested slips are 0.5-4 mm).
+
 Sampled with emcee (:mod:`.law_coordinates`); leave-one-test-out ELPD in :mod:`.law_loo`.
 """
 
@@ -56,18 +73,23 @@ from ..stats.streams import legacy_state
 from .kernels import draw_kernels, log_kernel_mixture
 from .law_coordinates import LawCoordinates
 
-LAWS = ("constant", "velocity", "pressure", "pressure+velocity")
+LAWS = ("constant", "velocity", "pressure", "slip", "pressure+velocity")
 #: What the laws are fitted to, in words (``LawData.basis``).
 BASES = {"kappa": "kappa = f nu/(1-nu) of the stationary phase, converted with the campaign's nu",
          "f": "f under each test's diagnosed model"}
 #: law -> the laws it contains as a special case (constant is in all)
 NESTS = {"constant": set(LAWS), "velocity": {"velocity", "pressure+velocity"},
-         "pressure": {"pressure", "pressure+velocity"}, "pressure+velocity": {"pressure+velocity"}}
+         "pressure": {"pressure", "pressure+velocity"}, "slip": {"slip"}, "pressure+velocity": {"pressure+velocity"}}
 LAW_PARAMS = {"constant": ("a",), "velocity": ("d", "s", "log_vc"), "pressure": ("d", "s", "log_pc"),
-              "pressure+velocity": ("d", "s", "log_vc", "amp_p", "log_pc")}
+              "slip": ("d", "s", "log_sc"), "pressure+velocity": ("d", "s", "log_vc", "amp_p", "log_pc")}
 LOG_VC_RANGE = (np.log(0.3), np.log(300.0))
 #: log of the pressure scale P_c = p_c / p_ref (module docstring)
 LOG_PC_RANGE = (np.log(1.0 / 30.0), np.log(30.0))
+#: log of the slip scale S_c (m)
+LOG_SC_RANGE = (np.log(0.1e-3), np.log(100e-3))
+#: The model-form terms of kappa's change across a window (module docstring).
+TREND_FLOOR = 0.005
+TREND_REL = 0.3
 #: Prior sd of a set-up's calibration offset (module docstring).
 CALIBRATION_SD = 0.03
 #: Prior sd of a free set-up offset (flag models only).
@@ -93,6 +115,12 @@ class LawData:
     #: drawn under; None: the tests are summarised by ``kappa`` and ``kappa_sd`` alone
     draws: tuple[np.ndarray, ...] | None = None
     draws_log_prior: tuple[np.ndarray, ...] | None = None
+    #: each test's mean slip over its window (m); None: the tests carry no slip (the slip law is not compared)
+    slip: np.ndarray | None = None
+    #: kappa's change across each window, ln(kappa_2 / kappa_1), and its standard error: (n, 2)
+    trend: np.ndarray | None = None
+    #: each window half's slip (m), speed (m/s) and pressure over the test's mean: (n, 2, 3)
+    halves: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -116,10 +144,26 @@ class LawData:
 
         return LawData([self.labels[i] for i in idx], [self.setups[i] for i in idx],
                        *(getattr(self, f)[idx] for f in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")),
-                       basis=self.basis, draws=pick(self.draws), draws_log_prior=pick(self.draws_log_prior))
+                       basis=self.basis, draws=pick(self.draws), draws_log_prior=pick(self.draws_log_prior),
+                       **{f: None if getattr(self, f) is None else getattr(self, f)[idx]
+                          for f in ("slip", "trend", "halves")})
+
+    @property
+    def laws(self) -> tuple[str, ...]:
+        """The laws these data can compare: the slip law only where every test carries its slip and window change."""
+        return LAWS if self.slip is not None and self.trend is not None else tuple(x for x in LAWS if x != "slip")
 
     def drop(self, i: int) -> LawData:
         return self.select(np.arange(self.n) != i)
+
+    def slip_at(self, setup: str, V: np.ndarray | float) -> np.ndarray | None:
+        """A test's mean slip over its window at speed ``V`` on ``setup`` (m): V times the set-up's median S / V
+        (the window's place in the test is the set-up's); None without slips."""
+        if self.slip is None:
+            return None
+        on = np.array([s == setup for s in self.setups])
+        ratio = np.median((self.slip / self.V)[on]) if on.any() else np.median(self.slip / self.V)
+        return np.asarray(V, float) * ratio
 
     def kernels(self, scale: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """The tests' draws over ``scale`` (n, J; padded where a test has fewer; shrunk, see above), their
@@ -171,14 +215,20 @@ class Model:
 
 #: The laws each law holds as special cases (:func:`law_mean`): velocity's and pressure's are constant where s = d;
 #: pressure+velocity is velocity where amp_p = 0 and pressure where s = d.
-SPECIAL_CASES = {"velocity": ("constant",), "pressure": ("constant",),
+SPECIAL_CASES = {"velocity": ("constant",), "pressure": ("constant",), "slip": ("constant",),
                  "pressure+velocity": ("velocity", "pressure", "constant")}
 
 
-def law_mean(law: str, theta: dict[str, np.ndarray], V: np.ndarray, p_rel: np.ndarray) -> np.ndarray:
-    """y for parameter arrays of shape (W, 1) and data of shape (n,) (``p_rel`` = P - 1); returns (W, n)."""
+def law_mean(law: str, theta: dict[str, np.ndarray], V: np.ndarray, p_rel: np.ndarray,
+             slip: np.ndarray | None = None) -> np.ndarray:
+    """y for parameter arrays of shape (W, 1) and data of shape (n,) (``p_rel`` = P - 1, ``slip`` in m, needed by
+    the slip law only); returns (W, n)."""
     if law == "constant":
         return theta["a"] + 0.0 * V
+    if law == "slip":
+        if slip is None:
+            raise ValueError("the slip law needs each test's slip")
+        return theta["d"] + (theta["s"] - theta["d"]) * np.exp(-np.asarray(slip, float) / np.exp(theta["log_sc"]))
     P = 1.0 + p_rel
     if law == "pressure":
         return theta["d"] + (theta["s"] - theta["d"]) * np.exp(-P / np.exp(theta["log_pc"]))
@@ -210,22 +260,44 @@ class Fit:
         if len(x) > chunk:
             return np.vstack([self.pointwise(x[i:i + chunk], data, chunk=chunk) for i in range(0, len(x), chunk)])
         th = self._theta(x)
+        law = self.model.law
         p_rel = (d.p - self.p_ref) / self.p_ref
         y = d.kappa / self.kbar
-        mean = law_mean(self.model.law, th, d.V, p_rel)
+
+        def at(V: np.ndarray, p: np.ndarray, S: np.ndarray | None) -> np.ndarray:
+            return law_mean(law, th, V, p, S)
+
+        mean = at(d.V, p_rel, d.slip)
         hV, hp = 1e-3 * np.maximum(d.V, 1.0), 1e-3
-        dV = (law_mean(self.model.law, th, d.V + hV, p_rel) - law_mean(self.model.law, th, d.V - hV, p_rel)) / (2 * hV)
-        dp = (law_mean(self.model.law, th, d.V, p_rel + hp) - law_mean(self.model.law, th, d.V, p_rel - hp)) / (2 * hp)
+        # errors in variables: the measured V and p, and the slip (V integrated: V's relative error)
+        dV = (at(d.V + hV, p_rel, d.slip) - at(d.V - hV, p_rel, d.slip)) / (2 * hV)
+        dp = (at(d.V, p_rel + hp, d.slip) - at(d.V, p_rel - hp, d.slip)) / (2 * hp)
+        var_x = (dV * d.V_sd) ** 2 + (dp * d.p_sd / self.p_ref) ** 2
+        if law == "slip":
+            hS = 1e-3 * d.slip
+            dS = (at(d.V, p_rel, d.slip + hS) - at(d.V, p_rel, d.slip - hS)) / (2 * hS)
+            var_x = var_x + (dS * d.slip * d.V_sd / np.maximum(d.V, 1e-9)) ** 2
         if self.model.offset_setup is not None or self.model.cal_setups or self.model.freed:
             scale = self.model.setup_scale(th, d.setups)
-            mean, dV, dp = mean * scale, dV * scale, dp * scale
-        var = (dV * d.V_sd) ** 2 + (dp * d.p_sd / self.p_ref) ** 2 + (th["r"] * mean) ** 2
+            mean, var_x = mean * scale, var_x * scale**2
+        var = var_x + (th["r"] * mean) ** 2
         if kernels is None:
             var = var + (d.kappa_sd / self.kbar) ** 2
-            return -0.5 * (y - mean) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
-        yj, logw, h2 = kernels
-        return log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]),
-                                  yj, logw)
+            out = -0.5 * (y - mean) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
+        else:
+            yj, logw, h2 = kernels
+            out = log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]),
+                                     yj, logw)
+        return out if d.trend is None else out + self.trend_pointwise(th, d)
+
+    def trend_pointwise(self, th: dict[str, np.ndarray], d: LawData) -> np.ndarray:
+        """log p(kappa's change across test i's window | theta): (W, n) (module docstring)."""
+        halves = [law_mean(self.model.law, th, d.halves[:, k, 1], (d.p * d.halves[:, k, 2] - self.p_ref) / self.p_ref,
+                           d.halves[:, k, 0]) for k in (0, 1)]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            pred = np.log(np.maximum(halves[1], 1e-12) / np.maximum(halves[0], 1e-12))
+        var = d.trend[:, 1] ** 2 + TREND_FLOOR**2 + (TREND_REL * pred) ** 2
+        return -0.5 * (d.trend[:, 0] - pred) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
 
     def log_prior(self, x: np.ndarray) -> np.ndarray:
         th = self._theta(x)
@@ -238,6 +310,8 @@ class Fit:
                 lp += np.where((v > LOG_VC_RANGE[0]) & (v < LOG_VC_RANGE[1]), 0.0, -np.inf)
             elif name == "log_pc":
                 lp += np.where((v > LOG_PC_RANGE[0]) & (v < LOG_PC_RANGE[1]), 0.0, -np.inf)
+            elif name == "log_sc":
+                lp += np.where((v > LOG_SC_RANGE[0]) & (v < LOG_SC_RANGE[1]), 0.0, -np.inf)
             elif name == "amp_p":
                 lp += np.where(np.abs(v) < 5, 0.0, -np.inf)
             elif name == "delta" or name.startswith("free_"):
@@ -261,8 +335,8 @@ class Fit:
         return out
 
     def _start(self, rng: np.random.Generator, nwalkers: int) -> np.ndarray:
-        guess = {"a": 1.0, "d": 0.8, "s": 1.3, "log_vc": np.log(8.0), "log_pc": 0.0, "amp_p": 0.0, "delta": 0.0,
-                 "r": 0.02}
+        guess = {"a": 1.0, "d": 0.8, "s": 1.3, "log_vc": np.log(8.0), "log_pc": 0.0, "log_sc": np.log(2e-3),
+                 "amp_p": 0.0, "delta": 0.0, "r": 0.02}
         x0 = np.array([guess.get(p, 0.0) for p in self.model.params])
         best = x0
         # a few rounds of random search from the guess: a start inside the support, near the mode
@@ -281,7 +355,7 @@ class Fit:
 
         rng = np.random.default_rng(seed)
         start = self._start(rng, nwalkers) if start is None else np.asarray(start, float)
-        coords = LawCoordinates(self.model.params, self.data.V, self.data.p / self.p_ref)
+        coords = LawCoordinates(self.model.params, self.data.V, self.data.p / self.p_ref, self.data.slip)
 
         def log_prob(z: np.ndarray) -> np.ndarray:
             x, log_jac = coords.to_law(z)

@@ -46,7 +46,8 @@ def _predictive(fit: Fit, setup: str, V: float, p: float, test_sd: float) -> tup
     """Mean and variance of the law's predictive of one new test (in the fit's units, y = kappa / kappa_bar)."""
     x = fit.draws[:: max(1, len(fit.draws) // 400)]
     th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
-    y = law_mean(fit.model.law, th, np.array([V]), np.array([(p - fit.p_ref) / fit.p_ref]))
+    y = law_mean(fit.model.law, th, np.array([V]), np.array([(p - fit.p_ref) / fit.p_ref]),
+                 fit.data.slip_at(setup, np.array([V])))
     y = (y * fit.model.setup_scale(th, [setup]))[:, 0]
     var = float(np.var(y) + np.mean((th["r"][:, 0] * y) ** 2) + test_sd**2)
     return float(np.mean(y)), var

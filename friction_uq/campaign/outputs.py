@@ -54,6 +54,10 @@ MEANINGS = {
     "f_s_at_mean_p": "f at rest, V -> 0, at the campaign's mean wall pressure (-)",
     "f_d_at_mean_p": "f at high sliding speed, at the campaign's mean wall pressure (-)",
     "v_c": "sliding speed over which f changes by 63 % of its way from its value at rest to its value at high speed (m/s)",
+    "f_at_start_of_slip": "f before any slip, S -> 0 (-)",
+    "f_after_long_slip": "f after a long slip (-)",
+    "S_c_mm": "slip over which f changes by 63 % of its way from its value before any slip to its value after a long "
+              "slip (mm)",
     "f_at_lowest_p": "f at the lowest wall pressure tested (-)",
     "f_at_highest_p": "f at the highest wall pressure tested (-)",
     "p_c_MPa": "wall pressure over which the pressure term changes f by 63 % of its whole change (MPa)",

@@ -31,6 +31,7 @@ from ..errors import check_seed
 from ..likelihood import LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..sampler import PosteriorSamples
+from ..window_halves import window_halves
 from .alongside import alongside, whole_record_start
 from .outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION, netcdf_bytes, quoted_f, sha256_hex, summary_table
 from .steps import RunSetup, StationaryPosterior, set_up, stationary_posterior
@@ -227,8 +228,10 @@ def run_document(s: RunSetup, post: StationaryPosterior, *, seed: int, seconds: 
     if "hoop_gain" in summary:
         doc["hoop_gain"] = _summary_json(summary["hoop_gain"])
     lab = s.lab
+    halves = window_halves(s.prepared.data)
     doc |= {
         "window": [s.prepared.window.t0, s.prepared.window.t1],
+        "window_halves": None if halves is None else halves.to_json(),
         "rhat_max": conv.r_hat_max,
         "ess_min": min(conv.ess_bulk_min, conv.ess_tail_min),
         "seed": seed,
