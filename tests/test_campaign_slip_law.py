@@ -3,9 +3,14 @@ from V (each test's mean slip is V times its set-up's time), kappa's change acro
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
+from friction_uq.campaign import RecordResult
+from friction_uq.campaign.outputs import campaign_doc, summary_text
+from friction_uq.report.campaign_pages import write_campaign_report
 from friction_uq.campaign.analysis import RecordPosterior, analyse_tests, supported_laws
 from friction_uq.campaign.flags import tally_causes
 from friction_uq.campaign.law_comparison import SLIP_CAVEAT
@@ -53,7 +58,7 @@ def _campaign(law, seed):
 
 
 @pytest.mark.parametrize("law, seed", [(lambda V, S: f_slip(S), 5), (f_velocity, 6)], ids=["slip wall", "velocity wall"])
-def test_the_change_across_each_window_separates_slip_from_velocity(law, seed):
+def test_the_change_across_each_window_separates_slip_from_velocity(law, seed, tmp_path):
     ca = _campaign(law, seed)
     true = "slip" if seed == 5 else "velocity"
     assert set(ca.weights) == set(LAWS)  # the slip law is compared when every test carries its window's change
@@ -63,6 +68,17 @@ def test_the_change_across_each_window_separates_slip_from_velocity(law, seed):
     gap = next(r for r in ca.ranking if r["law"] == other)
     assert gap["d_elpd"] > 2 * gap["d_se"], ca.ranking  # the other reading is decisively behind
     assert SLIP_CAVEAT not in ca.sentences  # slip was compared: no caveat that it was not
+    # the report draws the named law's band along what it depends on, and the JSON says its parameters in words
+    results = [RecordResult(path=f"{t.label}.h5", status="done", campaign=t.setup, test_id=t.label) for t in ca.tests]
+    doc = json.loads(json.dumps(campaign_doc(results, ca, seed=1, settings={}), default=float))
+    if true == "slip":
+        post = doc["friction_law"]["posterior"]
+        assert {"f_at_start_of_slip", "f_after_long_slip", "S_c_mm"} <= set(post)
+        assert post["f_at_start_of_slip"]["q05"] < 0.08 < post["f_at_start_of_slip"]["q95"]
+        assert "mm" in doc["friction_law"]["meanings"]["S_c_mm"]
+        assert "S_c_mm" not in summary_text(doc)
+    pdf = write_campaign_report(ca, doc, tmp_path / "campaign.pdf")
+    assert pdf.read_bytes()[:4] == b"%PDF"
 
 
 def test_without_the_windows_changes_the_slip_law_is_left_out_and_said():

@@ -39,15 +39,17 @@ class CampaignAnalysis:
     pooled_stationary: dict[str, Pooled] = field(default_factory=dict)
     #: two set-ups, none flagged by the ELPD: every law with and without the second set-up's offset, compared
     #: (:meth:`~.law_comparison.LawComparison.offset_alternative`), with the sentence where a law with a pressure term
-    #: is named or the set-up is flagged by the eight models' weights; else empty
+    #: is named or the set-up is flagged by the weights of every law with and without the offset; else empty
     pressure_or_setup: dict[str, object] = field(default_factory=dict)
 
-    def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400) -> np.ndarray:
-        """Draws of f along (V, p) for one set-up under a fitted model, at the campaign's nu: (draws, len(V))."""
+    def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400,
+                slip: np.ndarray | None = None) -> np.ndarray:
+        """Draws of f along (V, p) for one set-up under a fitted model, at the campaign's nu: (draws, len(V)).
+        ``slip`` (m): the mean slips along the curve; without it, V times the set-up's slip per speed."""
         fit = self.fits[model]
         x = fit.draws[:: max(1, len(fit.draws) // n)]
         th = {k: x[:, i:i + 1] for i, k in enumerate(fit.model.params)}
         y = law_mean(fit.model.law, th, np.asarray(V, float), (np.asarray(p, float) - fit.p_ref) / fit.p_ref,
-                     fit.data.slip_at(setup, V))
+                     fit.data.slip_at(setup, V) if slip is None else np.asarray(slip, float))
         y = y * fit.model.setup_scale(th, [setup] * len(np.atleast_1d(V)))
         return y * fit.kbar * fit.data.to_f(self.nu[0])

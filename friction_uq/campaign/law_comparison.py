@@ -220,17 +220,18 @@ class LawComparison:
         top = max(self.base.values(), key=lambda e: e.elpd)
         d, se = paired_difference(done[best][0].pointwise, top.pointwise)
         return {"setup": setup, "best_with_offset": best, "offset": done[best][1], "best_without": top.model,
-                "d_elpd": d, "d_se": se, "weight_with_offset": float(sum(weights[k] for k in done))}
+                "d_elpd": d, "d_se": se, "weight_with_offset": float(sum(weights[k] for k in done)), "laws": len(done)}
 
 
 def offset_sentence(alt: dict[str, object], flagged: bool, *, pressure: bool = True) -> str:
     """What :meth:`LawComparison.offset_alternative` found, in one sentence (``flagged``: the set-up was flagged
     by it; ``pressure``: a law with a pressure term is among those named)."""
     delta = alt["offset"]
+    n = int(alt.get("laws", 4))  # the laws compared (an analysis stored before the slip law had four)
     lead = (f"{alt['best_with_offset']} (set-up {alt['setup']} {delta['q50'] * 100:+.0f} % [{delta['q05'] * 100:+.0f}, "
             f"{delta['q95'] * 100:+.0f}] off the shared law) predicts the tests {alt['d_elpd']:+.1f} +- {alt['d_se']:.1f} "
             f"against {alt['best_without']}, and the laws with that offset carry {alt['weight_with_offset']:.2f} of "
-            "the weight of all eight models (the four laws with and without the offset)")
+            f"the weight of all {2 * n} models (the {n} laws with and without the offset)")
     if not pressure:  # the weights of every law with and without the offset, no pressure term named
         return (f"with two set-ups, {lead}" + (f", so set-up {alt['setup']} is flagged; `--diagnose` (a plug friction "
                 "or a gauge's gain fitted per test), or a third set-up, says which set-up is off" if flagged else ""))

@@ -99,8 +99,10 @@ def _law_page(ca: CampaignAnalysis):
     d = ca.law_data
     name = ca.chosen or ca.law_models[max(ca.weights, key=ca.weights.get)]
     nu = ca.nu[0]
+    in_slip = ca.fits[name].model.law == "slip" and d.slip is not None  # the band along the slip, not along V
     head = f"f at the campaign's nu = {nu:.3f}" if d.basis == "kappa" else d.meaning
-    fig, axes = figure(f"{head} against V and p (median, 90 %); band: {name} (90 %)", nrows=1, ncols=2)
+    fig, axes = figure(f"{head} against {'the slip S' if in_slip else 'V'} and p (median, 90 %); band: {name} (90 %)",
+                       nrows=1, ncols=2)
     setups = sorted(set(d.setups))
     for k, s in enumerate(setups):
         on = np.array([x == s for x in d.setups])
@@ -110,15 +112,22 @@ def _law_page(ca: CampaignAnalysis):
         f, ferr = q[1], np.abs(q[[0, 2]] - q[1])
         # the set-up's (V, p) line: p rises with V through the striker speed
         coef = np.polyfit(d.V[on], d.p[on], 1) if on.sum() > 1 else np.array([0.0, d.p[on][0]])
-        vv = np.linspace(d.V[on].min() * 0.9, d.V[on].max() * 1.1, 60)
-        pp = np.polyval(coef, vv)
-        band = np.quantile(ca.f_curve(name, vv, pp, s), [0.05, 0.5, 0.95], axis=0)
-        for ax, x, xx, xs in ((axes[0], d.V[on], vv, 1.0), (axes[1], d.p[on], pp, 1e-6)):
+        if in_slip:  # the slip law is in S alone: its band along the tested slips, on the first panel only
+            ss = np.linspace(d.slip[on].min() * 0.9, d.slip[on].max() * 1.1, 60)
+            band = np.quantile(ca.f_curve(name, ss, ss, s, slip=ss), [0.05, 0.5, 0.95], axis=0)
+            lines = ((axes[0], d.slip[on], ss, 1e3, band), (axes[1], d.p[on], None, 1e-6, None))
+        else:
+            vv = np.linspace(d.V[on].min() * 0.9, d.V[on].max() * 1.1, 60)
+            pp = np.polyval(coef, vv)
+            band = np.quantile(ca.f_curve(name, vv, pp, s), [0.05, 0.5, 0.95], axis=0)
+            lines = ((axes[0], d.V[on], vv, 1.0, band), (axes[1], d.p[on], pp, 1e-6, band))
+        for ax, x, xx, xs, b in lines:
             ax.errorbar(x * xs, f, yerr=ferr, fmt="o", color=f"C{k}", capsize=3, label=f"set-up {s}")
-            ax.fill_between(xx * xs, band[0], band[2], color=f"C{k}", alpha=0.2)
-            ax.plot(xx * xs, band[1], color=f"C{k}", lw=1)
-    axes[0].set_xlabel("sliding velocity V (m/s)")
-    axes[1].set_xlabel("mean wall pressure p_mean (MPa)")
+            if b is not None:
+                ax.fill_between(xx * xs, b[0], b[2], color=f"C{k}", alpha=0.2)
+                ax.plot(xx * xs, b[1], color=f"C{k}", lw=1)
+    axes[0].set_xlabel("mean slip over the window S (mm)" if in_slip else "sliding velocity V (m/s)")
+    axes[1].set_xlabel("mean wall pressure p_mean (MPa)" + (" (the slip law has no pressure term)" if in_slip else ""))
     for ax in axes:
         ax.set_ylabel("f = kappa (1-nu)/nu" if d.basis == "kappa" else d.meaning)
         ax.legend(fontsize=8)
