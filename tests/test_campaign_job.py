@@ -41,6 +41,7 @@ def test_a_result_reads_back_as_written(tmp_path):
     ({"colour": "red"}, f"unknown key\\(s\\) colour in a schema version {SCHEMA_VERSION} result"),
     ({"schema_version": 1}, "key 'schema_version' is 1, this friction-uq reads version 2"),  # no window_halves
     ({"status": "maybe"}, "key 'status' is 'maybe', allowed values: done, skipped, failed"),
+    ({"window_halves": {"sd": 1}}, "key 'window_halves': key 'log_kappa_change' must be a finite number"),
 ])
 def test_a_result_of_another_schema_is_refused(tmp_path, edit, message):
     path = write_result(_result(), tmp_path / "r.json")

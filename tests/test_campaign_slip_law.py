@@ -73,8 +73,8 @@ def test_the_change_across_each_window_separates_slip_from_velocity(law, seed, t
     doc = json.loads(json.dumps(campaign_doc(results, ca, seed=1, settings={}), default=float))
     if true == "slip":
         post = doc["friction_law"]["posterior"]
-        assert {"f_at_start_of_slip", "f_after_long_slip", "S_c_mm"} <= set(post)
-        assert post["f_at_start_of_slip"]["q05"] < 0.08 < post["f_at_start_of_slip"]["q95"]
+        assert {"f_at_least_slip", "f_at_most_slip", "S_c_mm"} <= set(post)
+        assert post["f_at_least_slip"]["q05"] > post["f_at_most_slip"]["q95"]  # f falls as the sample slides
         assert "mm" in doc["friction_law"]["meanings"]["S_c_mm"]
         assert "S_c_mm" not in summary_text(doc)
     pdf = write_campaign_report(ca, doc, tmp_path / "campaign.pdf")
@@ -91,7 +91,22 @@ def test_without_the_windows_changes_the_slip_law_is_left_out_and_said():
         assert SLIP_CAVEAT in ca.sentences
 
 
+def test_laws_fitted_to_f_under_diagnosed_models_leave_the_slip_law_out():
+    """A named cause (a plug friction, a clearance) changes kappa across the window by itself: the stationary change
+    is not read against f under the diagnosed model."""
+    from friction_uq.campaign.analysis import _law_data
+
+    rng = np.random.default_rng(8)
+    tests = [_test(rng, f"{s}-0{k + 1}", s, V, f_velocity) for s in ("A", "B") for k, V in enumerate((7.0, 10.0, 13.0))]
+    assert _law_data(tests).reads_window_changes and "slip" in _law_data(tests).laws
+    for t in tests:
+        t.f_model, t.f_model_log_prior = t.f, np.zeros_like(t.f)
+    data = _law_data(tests)
+    assert data.basis == "f" and not data.reads_window_changes and "slip" not in data.laws
+
+
 def test_the_floor_is_what_the_axisymmetric_records_allow():
-    # docs/campaigns.md: the batch means' error alone gave an rms z of 0.95 on 24 clean-wall records of the
-    # axisymmetric simulation; the floor adds at most half a typical error (0.005 against 0.004-0.017)
+    # docs/campaigns.md: the batch means' error alone gave an rms z of 1.04 on 24 records of walls whose f does not
+    # change with slip, in the axisymmetric simulation (a t(6) has 1.22); the floor adds at most about a typical
+    # error (0.005 against 0.003-0.017)
     assert 0.0 < TREND_FLOOR <= 0.005

@@ -25,6 +25,19 @@ def test_laws_that_predict_alike_gain_nothing_and_laws_far_apart_gain_the_weight
     assert 0.0 < mid[0] < mid[1] < mid[2] < math.log(2.0)
 
 
+def test_two_outcomes_independent_given_the_law_add_what_the_second_tells():
+    """Slip and velocity predict the same level at every test and differ in the change across the window: the
+    2-D information is the second outcome's alone; a second outcome the laws predict alike adds nothing."""
+    w = np.array([0.5, 0.5])
+    level_only = information(np.array([[1.0, 0.0], [1.0, 0.0]]), np.array([[0.01, 1e-4], [0.01, 1e-4]]), w)
+    change_apart = information(np.array([[1.0, 0.0], [1.0, -0.1]]), np.array([[0.01, 1e-4], [0.01, 1e-4]]), w)
+    assert level_only == pytest.approx(0.0, abs=1e-4)
+    assert change_apart == pytest.approx(math.log(2.0), abs=2e-3)
+    one = information(np.array([1.0, 1.1]), np.array([0.01, 0.01]), w)
+    two = information(np.array([[1.0, 0.0], [1.1, 0.0]]), np.array([[0.01, 0.01], [0.01, 0.01]]), w)
+    assert two == pytest.approx(one, abs=2e-3)  # the grid's resolution
+
+
 def test_the_advice_names_the_best_candidate():
     cands = [Candidate("B", 12.0, 1.4e8, 0.41), Candidate("A", 6.0, 5e7, 0.02)]
     text = advice(cands, {"velocity": 0.5, "pressure": 0.45, "constant": 0.05})

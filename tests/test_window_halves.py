@@ -3,7 +3,10 @@ the coverage of its standard error on noise the record's own model makes."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -36,7 +39,6 @@ def test_a_step_in_f_between_the_halves_gives_its_log_ratio_exactly():
     h = window_halves(data(f))
     assert h is not None
     assert np.isclose(h.log_kappa_change, np.log(0.045 / 0.06), rtol=1e-12)
-    assert h.sd == 0.0  # no spread inside either half
     # the halves' slip and speed: the means of each half of the window
     assert np.isclose(h.slip[1] - h.slip[0], 8.0 * DT * N / 2) and h.V == (8.0, 8.0)
     # p = tau / f (eq. 18, 20): the friction force grows faster than f (eq. 5, 13), so the half with the higher f
@@ -76,6 +78,31 @@ def test_the_standard_error_covers_the_truth_as_often_as_it_says():
     z = np.array([c / s for c, s in changes])
     assert abs(np.mean(np.abs(z) < 1.943) - 0.90) < 0.045
     assert np.mean(np.abs(z) < 1.645) < 0.90
+
+
+def test_a_steady_change_does_not_widen_its_own_error():
+    """The batches' spread is taken about a line: a change of 10 % across the window leaves sd that of the noise."""
+    flat = window_halves(data(np.full(N, 0.05), noise=300.0, seed=11))
+    sloped = window_halves(data(0.05 * (1.0 - 0.1 * np.linspace(0.0, 1.0, N)), noise=300.0, seed=11))
+    assert flat is not None and sloped is not None
+    assert sloped.log_kappa_change < -0.04
+    assert sloped.sd == pytest.approx(flat.sd, rel=0.1)
+
+
+@pytest.mark.parametrize("edit, words", [
+    ({"sd": float("nan")}, "'sd' must be a finite number"),
+    ({"sd": -0.1}, "sd must be >= 0"),
+    ({"slip_m": [0.0, 1e-3]}, "slips, speeds and pressures > 0"),
+    ({"V_m_per_s": [True, 8.0]}, "'V_m_per_s' must be a finite number"),
+    ({"pressure_over_window_mean": [1.0]}, "a list of two numbers"),
+    ({"log_kappa_change": "-0.1"}, "'log_kappa_change' must be a finite number"),
+])
+def test_a_damaged_record_of_the_change_is_refused_naming_its_key(edit, words):
+    good = WindowHalves(-0.05, 0.01, (1e-3, 2e-3), (8.0, 8.1), (1.01, 0.99)).to_json()
+    with pytest.raises(ValueError, match=re.escape(words)):
+        WindowHalves.from_json(good | edit)
+    with pytest.raises(ValueError, match="not an object"):
+        WindowHalves.from_json([1, 2])
 
 
 def test_too_short_a_window_or_a_batch_without_kappa_gives_none():

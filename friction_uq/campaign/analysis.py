@@ -104,8 +104,10 @@ def f_law_draws(fit: Fit, nu: tuple[float, float], *, seed: int) -> dict[str, np
         p_rel = np.array([np.min(fit.data.p), np.max(fit.data.p)]) / fit.p_ref - 1.0
         at = law_mean(law, {k: v[:, None] for k, v in col.items()}, np.zeros(2), p_rel)
         out["f_at_lowest_p"], out["f_at_highest_p"] = at[:, 0] * g, at[:, 1] * g
-    elif law == "slip":
-        out["f_at_start_of_slip"], out["f_after_long_slip"] = col["s"] * g, col["d"] * g
+    elif law == "slip":  # at the least and the most slip tested: what the tests fix, not the law's limits
+        S = np.array([np.min(fit.data.slip), np.max(fit.data.slip)])
+        at = law_mean(law, {k: v[:, None] for k, v in col.items()}, np.zeros(2), np.zeros(2), S)
+        out["f_at_least_slip"], out["f_at_most_slip"] = at[:, 0] * g, at[:, 1] * g
         out["S_c_mm"] = np.exp(col["log_sc"]) * 1e3
     else:  # pressure+velocity: the velocity law's values at the mean pressure, where its pressure term is 0
         at = "" if law == "velocity" else "_at_mean_p"

@@ -68,9 +68,12 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
             elif final is not None:  # diagnosed, no cause named: the stationary f, under the prior file's f prior
                 f_model = draws["f"]
                 f_log_prior = np.asarray(load_priors(r.prior_file)["f"].logpdf(f_model), float)
-        halves = None if r.window_halves is None else WindowHalves.from_json(r.window_halves)
-    except (OSError, KeyError, ValueError, TypeError) as exc:
+    except (OSError, KeyError, ValueError) as exc:
         raise FrictionUQError(f"{nc}: cannot read the posterior draws of {r.label} ({exc})") from None
+    try:
+        halves = None if r.window_halves is None else WindowHalves.from_json(r.window_halves)
+    except ValueError as exc:
+        raise FrictionUQError(f"the result of {r.label} ({r.path}): key 'window_halves': {exc}") from None
     if f_log_prior is not None and not np.all(np.isfinite(f_log_prior)):
         raise FrictionUQError(f"{nc}: group {final or 'posterior'}: the log prior of f under the diagnosed model is "
                               "not finite at some draws (a draw where its prior has no density cannot be pooled)")

@@ -42,6 +42,7 @@ from typing import Any
 from .. import __version__
 from .._atomic import atomic_path
 from ..errors import FrictionUQError, LockedError
+from ..window_halves import WindowHalves
 
 SCHEMA = "friction-uq/campaign-record"
 SCHEMA_VERSION = 2
@@ -139,6 +140,11 @@ def read_result(path: str | os.PathLike[str]) -> RecordResult:
         raise FrictionUQError(f"{p}: key 'status' is {doc.get('status')!r}, allowed values: {', '.join(STATUSES)}")
     if "path" not in doc:
         raise FrictionUQError(f"{p}: key 'path' missing")
+    if doc.get("window_halves") is not None:
+        try:
+            WindowHalves.from_json(doc["window_halves"])
+        except ValueError as exc:
+            raise FrictionUQError(f"{p}: key 'window_halves': {exc}") from None
     return RecordResult(**{k: v for k, v in doc.items() if k in names})
 
 

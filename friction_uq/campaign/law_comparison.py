@@ -57,10 +57,12 @@ def simplest_supported(weights: dict[str, float], ranking: Sequence[dict[str, ob
     return min(supported_laws(weights, ranking), key=lambda law: (len(LAW_PARAMS[law]), -weights[law]))
 
 
-#: Said beside a verdict that names a law with a velocity term (docs/campaigns.md: no slip law among the candidates).
+#: Said beside a verdict that names a law with a velocity term when the slip law was not compared (a test without
+#: its change across the window, or the laws fitted to f under diagnosed models: docs/campaigns.md).
 SLIP_CAVEAT = ("a dependence on the distance slid would read the same: at each test's window the mean slip grows in "
-               "proportion to V within a set-up, and no law in the slip is compared, so a velocity term may stand for "
-               "slip weakening (docs/campaigns.md)")
+               "proportion to V within a set-up, and the slip law was not compared here (it reads each test's change "
+               "across its window: the stationary analysis' change, without --diagnose), so a velocity term may stand "
+               "for slip weakening (docs/campaigns.md)")
 
 
 def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
@@ -86,10 +88,11 @@ def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> 
     if "constant" not in supported and weights.get("constant", 1.0) < WEIGHT_RULE.little:
         out.append(f"f is not constant: the constant law carries {weights['constant']:.2f} of the weight")
     elif "constant" in supported and len(supported) > 1:
-        out.append(f"no dependence of f on V or p is resolved: a constant f carries {weights['constant']:.2f} of "
+        on = "V, p or the slip" if "slip" in weights else "V or p"
+        out.append(f"no dependence of f on {on} is resolved: a constant f carries {weights['constant']:.2f} of "
                    "the weight, and the laws beside it predict the tests as well")
     if "slip" not in weights and any("log_vc" in LAW_PARAMS[law] for law in supported if law in LAW_PARAMS):
-        out.append(SLIP_CAVEAT)  # the slip law was not compared (the tests carry no change across their windows)
+        out.append(SLIP_CAVEAT)  # the slip law was not compared (no change across the windows, or f of diagnosed models)
     return out
 
 

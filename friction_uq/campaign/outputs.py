@@ -1,9 +1,10 @@
 """The campaign's outputs: ``campaign.json`` (schema below), ``campaign.nc`` and the text summary.
 
-``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 3``; version 1 had no weights, and its
+``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 5``; version 1 had no weights, and its
 set-up offsets were free; version 2 pooled the stationary f whatever the records carried, and had no ``basis``
 nor ``pooled_stationary``; version 3's pressure law was a straight line in p, its parameters ``f_ref`` and
-``c_per_p_ref``): ``records`` (each
+``c_per_p_ref``; version 4 had no slip law, and its ELPDs were of the tests' levels alone, without each
+test's change across its window, so they are not comparable with version 5's): ``records`` (each
 record's path, set-up, test id, ``status`` done | skipped | failed, the refusal ``message``,
 seconds, the ``causes`` its diagnosis named or null), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
 scatter ``sigma`` with 90 % intervals, each test's effective sample size, the Monte Carlo variance
@@ -11,7 +12,7 @@ of the hyper-log-likelihood, or ``refused`` with the reason; ``basis``: ``diagno
 test's diagnosed model (every test diagnosed), its prior on f_effective divided out, else ``stationary``),
 ``pooled_stationary`` (``f`` of the stationary analysis, as in ``pooled``, when ``pooled.f`` is the diagnosed f;
 else empty), ``friction_law`` (``best``: the law that
-carries the stacking weight (one of constant, velocity, pressure, pressure+velocity) or null;
+carries the stacking weight (one of constant, velocity, pressure, slip, pressure+velocity) or null;
 ``chosen_model``; ``weights``: each law's stacking weight; ``supported``: the fewest laws carrying 90 %
 of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and its weight;
 ``posterior`` of the best (else heaviest) law's parameters in f units; ``models``: the same for every
@@ -19,7 +20,9 @@ model; ``meanings``: each parameter in words with its unit; ``next_tests``: when
 each candidate test (set-up, V, p) with the expected information it brings on which law holds, most
 informative first (:mod:`.next_test`); ``pressure_or_setup``: with two set-ups, when a law with a pressure term
 is named or the second set-up is flagged by the weights, the best law with a free offset on that set-up against the
-best without (dELPD, SE, the weight the laws with the offset carry among all eight; empty otherwise); ``nu`` the campaign's nu),
+best without (dELPD, SE, the weight the laws with the offset carry among all the models, ``laws`` the number of laws
+compared; empty otherwise); ``windows_read``: whether each test's change across its window entered the laws'
+likelihood (the slip law is compared only then); ``nu`` the campaign's nu),
 ``wall_seconds`` (``records``: the records' tasks, ``analysis``: the campaign's own analysis; added by
 ``run_campaign``), ``flagged`` (set-ups and tests; a set-up's entry says the ``basis`` its offset was measured on:
 the law's, or, for a diagnosed campaign, also ``kappa`` of the stationary analysis with
@@ -43,7 +46,7 @@ from .analysis import CampaignAnalysis, f_law_draws, supported_laws
 from .job import RecordResult
 
 SCHEMA = "friction-uq/campaign"
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 
 
 #: The law parameters' meanings and units, as the JSON's ``friction_law.meanings`` and the sentences give them.
@@ -54,10 +57,9 @@ MEANINGS = {
     "f_s_at_mean_p": "f at rest, V -> 0, at the campaign's mean wall pressure (-)",
     "f_d_at_mean_p": "f at high sliding speed, at the campaign's mean wall pressure (-)",
     "v_c": "sliding speed over which f changes by 63 % of its way from its value at rest to its value at high speed (m/s)",
-    "f_at_start_of_slip": "f before any slip, S -> 0 (-)",
-    "f_after_long_slip": "f after a long slip (-)",
-    "S_c_mm": "slip over which f changes by 63 % of its way from its value before any slip to its value after a long "
-              "slip (mm)",
+    "f_at_least_slip": "f at the smallest mean slip over a window tested (-)",
+    "f_at_most_slip": "f at the largest mean slip over a window tested (-)",
+    "S_c_mm": "slip over which the slip law changes f by 63 % of its whole change (mm)",
     "f_at_lowest_p": "f at the lowest wall pressure tested (-)",
     "f_at_highest_p": "f at the highest wall pressure tested (-)",
     "p_c_MPa": "wall pressure over which the pressure term changes f by 63 % of its whole change (MPa)",
@@ -154,7 +156,8 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
                                         for c in ca.next_tests],
                          "pressure_or_setup": {k: v for k, v in ca.pressure_or_setup.items() if k != "sentence"},
                          "nu": {"mean": ca.nu[0], "sd": ca.nu[1]},
-                         "fitted_to": None if ca.law_data is None else ca.law_data.meaning},
+                         "fitted_to": None if ca.law_data is None else ca.law_data.meaning,
+                         "windows_read": bool(ca.law_data is not None and ca.law_data.reads_window_changes)},
         "flagged": ca.flagged,
         "causes": ca.tallies,
         "statements": statements(ca),
@@ -185,16 +188,26 @@ def write_netcdf(ca: CampaignAnalysis, path: Path) -> Path:
                                                         attrs={"basis": p.basis, "draws": POOLED_BASIS[p.basis]})
     if ca.law_data is not None:
         d = ca.law_data
+        window = {}
+        if d.slip is not None and d.trend is not None and d.halves is not None:
+            window = {"slip": ("test", d.slip, {"units": "m"}),
+                      "log_kappa_change": ("test", d.trend[:, 0], {"meaning": "ln(kappa_2 / kappa_1) across the window"}),
+                      "log_kappa_change_sd": ("test", d.trend[:, 1]),
+                      "half_slip": (("test", "half"), d.halves[:, :, 0], {"units": "m"}),
+                      "half_V": (("test", "half"), d.halves[:, :, 1], {"units": "m/s"}),
+                      "half_p_over_p": (("test", "half"), d.halves[:, :, 2])}
         groups["tests"] = xr.Dataset(
             {k: ("test", getattr(d, k)) for k in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")}
-            | {"setup": ("test", np.array(d.setups, dtype=str))}, coords={"test": np.array(d.labels, dtype=str)},
-            attrs={"kappa_holds": d.basis})
+            | {"setup": ("test", np.array(d.setups, dtype=str))} | window,
+            coords={"test": np.array(d.labels, dtype=str)},
+            attrs={"kappa_holds": d.basis, "windows_read": int(d.reads_window_changes)})
         for name, fit in ca.fits.items():
             groups[f"law_{_group(name)}"] = xr.Dataset(
                 {"draws": (("draw", "parameter"), fit.draws)},
                 coords={"parameter": list(fit.model.params)},
                 attrs={"model": name, "kappa_bar": fit.kbar, "p_ref": fit.p_ref,
-                       "units": "kappa / kappa_bar" if fit.data.basis == "kappa" else "f / f_bar"})
+                       "units": "kappa / kappa_bar" if fit.data.basis == "kappa" else "f / f_bar",
+                       "parameter_units": "log_vc: ln(m/s); log_pc: ln(p / p_ref); log_sc: ln(m); r: relative"})
     dt = xr.DataTree.from_dict({"/": xr.Dataset(attrs={"friction_uq_version": __version__,
                                                        "best_law": ca.best or "none"})}
                                | {f"/{k}": v for k, v in groups.items()})
