@@ -43,22 +43,8 @@ Priors: a, d, s uniform on (0, 5); v_c log-uniform on (0.3, 300) m/s; P_c log-un
 units of p_ref: about the span of v_c's range over the tested speeds); amp_p uniform on (-5, 5), as s - d; the law
 positive at every test; cal_s ~ N(0, 0.03); delta ~ N(0, 0.3).
 
-**Inside each test** (:mod:`friction_uq.window_halves`). Across a campaign a test's mean slip is nearly V
-times a time the set-up fixes, so the slip law and the velocity law predict the window means alike. Each
-test also gives kappa's change from the first half of its window to the second, ln(kappa_2 / kappa_1),
-with its standard error s_i, and the halves' slip, speed and pressure: the sample slides 1-2 mm through a
-window at a nearly constant V. Every law predicts that change, ln(y(V_2, P_2, S_2) / y(V_1, P_1, S_1))
-(the set-up's offsets cancel), and each test's likelihood carries it as a second, independent term
-
-    ln(kappa_2 / kappa_1) = pred + sqrt(s_i^2 + TREND_FLOOR^2 + (TREND_REL pred)^2) t,   t ~ Student-t(6),
-
-TREND_FLOOR (0.005) for what the window does that no law describes and TREND_REL (0.3) for how far the
-change a quasi-static law predicts is from the one a dynamic test shows: both from records of the
-axisymmetric simulation (docs/campaigns.md); a Student-t with the 6 degrees of freedom of s_i (eight batch
-means about a line), since s_i is itself an estimate. When a test carries no such change (a result of an
-older version), or when the laws are fitted to f under each test's diagnosed model (a named cause such as a
-plug friction or a clearance changes kappa across the window by itself, which the stationary change does not
-separate from the wall's), the slip law is not compared and no test's likelihood has the term.
+**Inside each test**: every law's likelihood also reads each test's change of kappa across its
+window, which separates a slip law from a velocity law (:mod:`.law_windows`).
 Priors: S_c log-uniform on (0.1, 100) mm (the tested slips are 0.5-4 mm).
 
 Sampled with emcee (:mod:`.law_coordinates`); leave-one-test-out ELPD in :mod:`.law_loo`.
@@ -70,120 +56,25 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from ..stats import RULE, paired_difference
 from ..stats.streams import legacy_state
-from ..window_halves import DOF
-from .kernels import draw_kernels, log_kernel_mixture
+from .kernels import log_kernel_mixture
 from .law_coordinates import LawCoordinates
+from .law_data import BASES, LawData
+from .law_forms import (LAW_PARAMS, LAWS, LOG_PC_RANGE, LOG_SC_RANGE, LOG_VC_RANGE, NESTS, SPECIAL_CASES,
+                        law_mean)
+from .law_windows import TREND_DOF, TREND_FLOOR, TREND_REL, halves_mean, window_change_loglike
 
-LAWS = ("constant", "velocity", "pressure", "slip", "pressure+velocity")
-#: What the laws are fitted to, in words (``LawData.basis``).
-BASES = {"kappa": "kappa = f nu/(1-nu) of the stationary phase, converted with the campaign's nu",
-         "f": "f under each test's diagnosed model"}
-#: law -> the laws it contains as a special case (constant is in all)
-NESTS = {"constant": set(LAWS), "velocity": {"velocity", "pressure+velocity"},
-         "pressure": {"pressure", "pressure+velocity"}, "slip": {"slip"}, "pressure+velocity": {"pressure+velocity"}}
-LAW_PARAMS = {"constant": ("a",), "velocity": ("d", "s", "log_vc"), "pressure": ("d", "s", "log_pc"),
-              "slip": ("d", "s", "log_sc"), "pressure+velocity": ("d", "s", "log_vc", "amp_p", "log_pc")}
-LOG_VC_RANGE = (np.log(0.3), np.log(300.0))
-#: log of the pressure scale P_c = p_c / p_ref (module docstring)
-LOG_PC_RANGE = (np.log(1.0 / 30.0), np.log(30.0))
-#: log of the slip scale S_c (m)
-LOG_SC_RANGE = (np.log(0.1e-3), np.log(100e-3))
-#: The model-form terms of kappa's change across a window (module docstring).
-TREND_FLOOR = 0.005
-TREND_REL = 0.3
-#: Degrees of freedom of the change's standard error (friction_uq.window_halves.DOF)
-TREND_DOF = DOF
+#: What the campaign's law modules give, from here (the laws' forms, data and window term live beside)
+__all__ = ["BASES", "CALIBRATION_SD", "FREE_OFFSET_SD", "LAWS", "LAW_PARAMS", "LOG_PC_RANGE", "LOG_SC_RANGE",
+           "LOG_VC_RANGE", "NESTS", "SPECIAL_CASES", "TREND_DOF", "TREND_FLOOR", "TREND_REL", "Elpd", "Fit", "LawData",
+           "Model", "best_law", "law_mean", "rank"]
+
 #: Prior sd of a set-up's calibration offset (module docstring).
 CALIBRATION_SD = 0.03
 #: Prior sd of a free set-up offset (flag models only).
 FREE_OFFSET_SD = 0.3
-
-
-@dataclass(frozen=True)
-class LawData:
-    """Per-test points of a campaign (SI units)."""
-
-    labels: list[str]
-    setups: list[str]
-    kappa: np.ndarray
-    kappa_sd: np.ndarray
-    V: np.ndarray
-    V_sd: np.ndarray
-    p: np.ndarray
-    p_sd: np.ndarray
-    #: what ``kappa`` holds: "kappa" (f nu/(1-nu) of the stationary phase) or "f" (f itself, under
-    #: each test's diagnosed model); :data:`BASES` says it in words
-    basis: str = "kappa"
-    #: each test's posterior draws of the same quantity (thinned), and the log prior density they were
-    #: drawn under; None: the tests are summarised by ``kappa`` and ``kappa_sd`` alone
-    draws: tuple[np.ndarray, ...] | None = None
-    draws_log_prior: tuple[np.ndarray, ...] | None = None
-    #: each test's mean slip over its window (m); None: the tests carry no slip (the slip law is not compared)
-    slip: np.ndarray | None = None
-    #: kappa's change across each window, ln(kappa_2 / kappa_1), and its standard error: (n, 2)
-    trend: np.ndarray | None = None
-    #: each window half's slip (m), speed (m/s) and pressure over the test's mean: (n, 2, 3)
-    halves: np.ndarray | None = None
-
-    @property
-    def n(self) -> int:
-        return len(self.labels)
-
-    @property
-    def meaning(self) -> str:
-        """What the laws were fitted to, in words."""
-        return BASES[self.basis]
-
-    def to_f(self, nu: float | np.ndarray) -> float | np.ndarray:
-        """Factor from the data's unit to f: (1-nu)/nu for kappa, 1 for f."""
-        return (1.0 - nu) / nu if self.basis == "kappa" else 1.0 + 0.0 * nu
-
-    def select(self, keep: np.ndarray) -> LawData:
-        """The tests where ``keep`` (a boolean mask) is true."""
-        idx = np.flatnonzero(keep)
-
-        def pick(seq: tuple[np.ndarray, ...] | None) -> tuple[np.ndarray, ...] | None:
-            return None if seq is None else tuple(seq[i] for i in idx)
-
-        return LawData([self.labels[i] for i in idx], [self.setups[i] for i in idx],
-                       *(getattr(self, f)[idx] for f in ("kappa", "kappa_sd", "V", "V_sd", "p", "p_sd")),
-                       basis=self.basis, draws=pick(self.draws), draws_log_prior=pick(self.draws_log_prior),
-                       **{f: None if getattr(self, f) is None else getattr(self, f)[idx]
-                          for f in ("slip", "trend", "halves")})
-
-    @property
-    def laws(self) -> tuple[str, ...]:
-        """The laws these data can compare: the slip law only where every test carries its slip and window change."""
-        return LAWS if self.reads_window_changes else tuple(x for x in LAWS if x != "slip")
-
-    @property
-    def reads_window_changes(self) -> bool:
-        """Whether each test's change across its window enters the laws' likelihood (module docstring)."""
-        return self.slip is not None and self.trend is not None and self.basis == "kappa"
-
-    def drop(self, i: int) -> LawData:
-        return self.select(np.arange(self.n) != i)
-
-    def slip_at(self, setup: str, V: np.ndarray | float) -> np.ndarray | None:
-        """A test's mean slip over its window at speed ``V`` on ``setup`` (m): V times the set-up's median S / V
-        (the window's place in the test is the set-up's); None without slips."""
-        if self.slip is None:
-            return None
-        on = np.array([s == setup for s in self.setups])
-        ratio = np.median((self.slip / self.V)[on]) if on.any() else np.median(self.slip / self.V)
-        return np.asarray(V, float) * ratio
-
-    def kernels(self, scale: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """The tests' draws over ``scale`` (n, J; padded where a test has fewer; shrunk, see above), their
-        normalised log weights 1/prior (n, J; -inf on padding) and squared kernel bandwidths (n,; Scott's rule, scipy's
-        ``gaussian_kde``); None without draws."""
-        if self.draws is None:
-            return None
-        return draw_kernels(self.draws, self.draws_log_prior, scale)
 
 
 @dataclass(frozen=True)
@@ -223,32 +114,6 @@ class Model:
             on = np.array([x == self.offset_setup for x in setups])
             scale = scale * np.where(on[None, :], 1.0 + theta["delta"], 1.0)
         return scale
-
-
-#: The laws each law holds as special cases (:func:`law_mean`): velocity's and pressure's are constant where s = d;
-#: pressure+velocity is velocity where amp_p = 0 and pressure where s = d.
-SPECIAL_CASES = {"velocity": ("constant",), "pressure": ("constant",), "slip": ("constant",),
-                 "pressure+velocity": ("velocity", "pressure", "constant")}
-
-
-def law_mean(law: str, theta: dict[str, np.ndarray], V: np.ndarray, p_rel: np.ndarray,
-             slip: np.ndarray | None = None) -> np.ndarray:
-    """y for parameter arrays of shape (W, 1) and data of shape (n,) (``p_rel`` = P - 1, ``slip`` in m, needed by
-    the slip law only); returns (W, n)."""
-    if law == "constant":
-        return theta["a"] + 0.0 * V
-    if law == "slip":
-        if slip is None:
-            raise ValueError("the slip law needs each test's slip")
-        return theta["d"] + (theta["s"] - theta["d"]) * np.exp(-np.asarray(slip, float) / np.exp(theta["log_sc"]))
-    P = 1.0 + p_rel
-    if law == "pressure":
-        return theta["d"] + (theta["s"] - theta["d"]) * np.exp(-P / np.exp(theta["log_pc"]))
-    y = theta["d"] + (theta["s"] - theta["d"]) * np.exp(-V / np.exp(theta["log_vc"]))
-    if law == "pressure+velocity":
-        pc = np.exp(theta["log_pc"])
-        y = y + theta["amp_p"] * (np.exp(-P / pc) - np.exp(-1.0 / pc))
-    return y
 
 
 class Fit:
@@ -300,21 +165,7 @@ class Fit:
             yj, logw, h2 = kernels
             out = log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]),
                                      yj, logw)
-        return out + self.trend_pointwise(th, d) if d.reads_window_changes else out
-
-    def halves_mean(self, th: dict[str, np.ndarray], d: LawData) -> tuple[np.ndarray, np.ndarray]:
-        """The law at each test's two window halves: two (W, n) arrays."""
-        return tuple(law_mean(self.model.law, th, d.halves[:, k, 1], (d.p * d.halves[:, k, 2] - self.p_ref) / self.p_ref,
-                              d.halves[:, k, 0]) for k in (0, 1))
-
-    def trend_pointwise(self, th: dict[str, np.ndarray], d: LawData) -> np.ndarray:
-        """log p(kappa's change across test i's window | theta): (W, n) (module docstring)."""
-        first, second = self.halves_mean(th, d)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            pred = np.where((first > 0) & (second > 0), np.log(second / first), np.nan)
-        scale = np.sqrt(d.trend[:, 1] ** 2 + TREND_FLOOR**2 + (TREND_REL * pred) ** 2)
-        out = stats.t.logpdf(d.trend[:, 0], df=TREND_DOF, loc=pred, scale=scale)
-        return np.where(np.isfinite(pred), out, -np.inf)
+        return out + window_change_loglike(law, th, d, self.p_ref) if d.reads_window_changes else out
 
     def log_prior(self, x: np.ndarray) -> np.ndarray:
         th = self._theta(x)
@@ -347,7 +198,8 @@ class Fit:
             mean = law_mean(self.model.law, th, d.V, (d.p - self.p_ref) / self.p_ref)
             positive = np.all(mean > 0, axis=1)
             if d.reads_window_changes:  # and within each window
-                positive &= np.all([np.all(h > 0, axis=1) for h in self.halves_mean(th, d)], axis=0)
+                positive &= np.all([np.all(h > 0, axis=1) for h in halves_mean(self.model.law, th, d, self.p_ref)],
+                                   axis=0)
             lp = np.where(positive, lp, -np.inf)
         ok = np.isfinite(lp)
         out = np.full(len(x), -np.inf)
