@@ -2,6 +2,7 @@
 
 import hashlib
 import json
+import math
 
 import pytest
 import xarray as xr
@@ -107,6 +108,12 @@ def test_pdf_pages_in_order_though_made_on_two_cores(paper_run):
         assert f"{n} {what}" in " ".join(pages.split()), (n, what)  # the summary's list uses the same numbers
     assert "(1/2)" in texts[9] and "(2/2)" in texts[10]
     assert reader.metadata["/Title"] == "friction-uq paper P-01"
+    # the window's change as the JSON gives it, in words on the first page
+    doc = json.loads((out / "paper_P-01.json").read_text())
+    h = doc["window_halves"]
+    first = " ".join(texts[0].split())
+    assert f"slides {h['slip_m'][0] * 1e3:.2f} to {h['slip_m'][1] * 1e3:.2f} mm" in first
+    assert f"kappa changes by {100 * math.expm1(h['log_kappa_change']):+.1f} %" in first
 
 
 def test_a_prior_file_with_a_typo_is_refused_and_nothing_is_written(paper_run, tmp_path, capsys):

@@ -22,6 +22,7 @@ from .quote import quote_line
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..quoted import quoted_summary
 from ..sampler import PosteriorSamples
+from ..window_halves import window_halves
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
 from .style import CORE_FONTS, figure
@@ -115,7 +116,7 @@ def page_summary(r: ReportInputs) -> Figure:
         f"{100 * share:.0f} % of the variance of f comes from the uncertainty of nu (law of total variance).",
         f"Stationary phase {r.prepared.window.t0 * 1e6:.1f} - {r.prepared.window.t1 * 1e6:.1f} us "
         f"({'automatic' if r.prepared.window.automatic else 'given by hand'}); sliding velocity "
-        f"V = {r.V.q50:.2f} m/s, mean wall pressure p_mean = {s['p_mean'].q50 / 1e6:.1f} MPa.",
+        f"V = {r.V.q50:.2f} m/s, mean wall pressure p_mean = {s['p_mean'].q50 / 1e6:.1f} MPa." + _halves_text(r),
         f"The lab's point estimate (eq. 17 with nu = {r.lab.nu:g}): f = {r.lab.f:.4f}, "
         f"F_eo/F_io = {r.lab.ratio:.4f}, equilibrium error {100 * r.lab.equilibrium_error:+.1f} %.",
         f"Hoop gauge term: {'used' if r.samples.hoop else 'not used'}. Convergence: "
@@ -274,6 +275,16 @@ def diagnosis_pages(r: ReportInputs) -> list[Figure]:
                                                                                          stationary_quoted(r)),
                          test=f"{n}. {test}"),
             page_extended_fit(r.diagnosis, test=f"{n + 1}. {test}")]
+
+
+def _halves_text(r: ReportInputs) -> str:
+    """kappa's change across the window (the run JSON's ``window_halves``), in words; empty when there is none."""
+    h = window_halves(r.prepared.data)
+    if h is None:
+        return ""
+    return (f" From the window's first half to its second the sample slides {h.slip[0] * 1e3:.2f} to "
+            f"{h.slip[1] * 1e3:.2f} mm and kappa changes by {100 * np.expm1(h.log_kappa_change):+.1f} % "
+            f"(sd {100 * h.sd:.1f} %), which a campaign reads to tell a slip law from a speed law.")
 
 
 def write_report(r: ReportInputs, path: str | os.PathLike[str]) -> Path:
