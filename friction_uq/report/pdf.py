@@ -22,7 +22,7 @@ from .quote import quote_line
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..quoted import quoted_summary
 from ..sampler import PosteriorSamples
-from ..window_halves import window_halves
+from ..window_halves import WindowHalves
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
 from .style import CORE_FONTS, figure
@@ -53,6 +53,7 @@ class ReportInputs:
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
     likelihood: object | None = None  # friction_uq.likelihood.Likelihood, built once by run
     warnings: tuple[str, ...] = ()  # the run's checks that failed (friction_uq.run.warnings), shown first
+    halves: WindowHalves | None = None  # kappa's change across the window (the run JSON's window_halves)
 
 
 #: Top of the summary page's table (axes fraction) for up to ten rows: the sentences above stay clear of it.
@@ -279,7 +280,7 @@ def diagnosis_pages(r: ReportInputs) -> list[Figure]:
 
 def _halves_text(r: ReportInputs) -> str:
     """kappa's change across the window (the run JSON's ``window_halves``), in words; empty when there is none."""
-    h = window_halves(r.prepared.data)
+    h = r.halves
     if h is None:
         return ""
     return (f" From the window's first half to its second the sample slides {h.slip[0] * 1e3:.2f} to "

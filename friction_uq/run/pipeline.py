@@ -31,7 +31,6 @@ from ..errors import check_seed
 from ..likelihood import LevelForceTerm
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..sampler import PosteriorSamples
-from ..window_halves import window_halves
 from .alongside import alongside, whole_record_start
 from .outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION, netcdf_bytes, quoted_f, sha256_hex, summary_table
 from .steps import RunSetup, StationaryPosterior, set_up, stationary_posterior
@@ -169,7 +168,7 @@ def _posterior_pages(s: RunSetup, post: StationaryPosterior) -> tuple[object, by
 
     inputs = ReportInputs(s.prepared, post.samples, post.datatree, post.summary, post.convergence, post.band,
                           post.sensitivity, post.nu_share, post.ppc, s.lab, post.V, __version__, post.conflict,
-                          likelihood=s.likelihood)
+                          likelihood=s.likelihood, halves=s.halves)
     return inputs, render_posterior_part(inputs)
 
 
@@ -228,10 +227,9 @@ def run_document(s: RunSetup, post: StationaryPosterior, *, seed: int, seconds: 
     if "hoop_gain" in summary:
         doc["hoop_gain"] = _summary_json(summary["hoop_gain"])
     lab = s.lab
-    halves = window_halves(s.prepared.data)
     doc |= {
         "window": [s.prepared.window.t0, s.prepared.window.t1],
-        "window_halves": None if halves is None else halves.to_json(),
+        "window_halves": None if s.halves is None else s.halves.to_json(),
         "rhat_max": conv.r_hat_max,
         "ess_min": min(conv.ess_bulk_min, conv.ess_tail_min),
         "seed": seed,

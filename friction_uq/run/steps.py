@@ -38,6 +38,7 @@ from ..quoted import quoted_summary
 from ..record import Record, read_record
 from ..sampler import PosteriorSamples, likelihood_priors, sample_posterior, stderr_progress
 from ..settings import AnalysisSettings
+from ..window_halves import WindowHalves, window_halves
 from .._atomic import check_unlocked
 from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
 from .outputs import safe_stem
@@ -62,6 +63,7 @@ class RunSetup:
     stem: str
     names: dict[str, Path]  # "netcdf", "pdf", "json" -> the output's path
     lab: Identification  # the lab's analysis: eq. 17 at the nominal nu (the prior's median)
+    halves: WindowHalves | None  # kappa's change across the window (the JSON's and the report's), or None
 
 
 def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | None, out_dir: Path, *,
@@ -90,7 +92,7 @@ def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | N
             raise OutputError(f"{p}: cannot write the output, a directory has that name")
     lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
     return RunSetup(record, p_path, priors, prep, settings, alternatives, left_out, use_hoop, likelihood, stem,
-                    names, lab)
+                    names, lab, window_halves(prep.data))
 
 
 @dataclass(frozen=True)
