@@ -200,6 +200,27 @@ def test_the_verdict_reads_the_weights_and_never_defaults_to_constant():
     assert "do not separate" in spread[0] and spread[1].startswith("no dependence of f on V or p is resolved")
 
 
+def test_a_law_far_behind_that_no_resampling_needs_is_ruled_out():
+    """A slip-weakening wall (2x3 campaign, 1-D seed 3): constant and pressure 19-22 behind with an SE of 10-11
+    over six tests (the evidence sits in the tests that slide furthest) and none of the bootstrap-stacking weight.
+    The paired SE alone left them named ("no dependence of f on V, p or the slip is resolved" beside a constant
+    with weight 0.00); the weights and the ELPD agree against them. A law close behind keeps its place whatever
+    its weight, and a law with a share of the weight keeps it however far behind."""
+    row = lambda m, d, se: {"model": m, "d_elpd": d, "d_se": se, "n_tests": 6}  # noqa: E731
+    slip_wall = [row("slip", 0.0, 0.0), row("velocity", 15.3, 10.1), row("pressure", 19.4, 10.0),
+                 row("constant", 21.7, 11.0), row("pressure+velocity", 16.0, 9.0)]
+    w = {"slip": 0.79, "velocity": 0.18, "pressure+velocity": 0.03, "pressure": 0.0, "constant": 0.0}
+    assert supported_laws(w, slip_wall) == ["slip", "velocity"]
+    said = verdict(w, slip_wall)
+    assert said[0].startswith("friction law: the data do not separate slip (weight 0.79), velocity (weight 0.18")
+    assert said[1] == "f is not constant: the constant law carries 0.00 of the weight"
+    close = [row("constant", 0.0, 0.0), row("slip", 0.4, 0.5), row("velocity", 0.6, 0.1), row("pressure", 0.5, 0.2)]
+    assert supported_laws({"constant": 1.0, "slip": 0.0, "velocity": 0.0, "pressure": 0.0}, close) == \
+        ["constant", "pressure", "slip", "velocity"]
+    shared = {"slip": 0.75, "velocity": 0.0, "pressure": 0.0, "constant": 0.25, "pressure+velocity": 0.0}
+    assert "constant" in supported_laws(shared, slip_wall)
+
+
 def test_a_velocity_term_is_said_to_stand_for_v_or_the_distance_slid():
     """At a test's window the mean slip grows in proportion to V within a set-up, and no law in the slip is compared:
     wherever a law with a velocity term is named, the verdict says that slip weakening would read the same."""

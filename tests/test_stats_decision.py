@@ -48,7 +48,11 @@ def test_every_consumer_reads_the_same_rule():
         rows = [{"model": "velocity", "d_elpd": 0.0, "d_se": 0.0, "n_tests": 10},
                 {"model": "constant", "d_elpd": d, "d_se": se, "n_tests": 10}]
         assert (best_law(rows, LAWS) == "velocity") == RULE.decisive(d, se, n=10)
-        assert (supported_laws({"constant": 0.0, "velocity": 1.0}, rows) == ["velocity"]) == RULE.decisive(d, se, n=10)
+        # constant with a share of the weight: named unless the ELPD rule rules it out
+        assert (supported_laws({"constant": 0.1, "velocity": 0.9}, rows) == ["velocity"]) == RULE.decisive(d, se, n=10)
+        # with none of it: also ruled out when it predicts more than min_delpd worse (the weights agreeing)
+        gone = RULE.decisive(d, se, n=10) or d > RULE.min_delpd
+        assert (supported_laws({"constant": 0.0, "velocity": 1.0}, rows) == ["velocity"]) == gone
 
 
 def test_the_campaign_flags_a_setup_by_the_rule():

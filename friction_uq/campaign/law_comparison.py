@@ -32,16 +32,17 @@ LAW_WORKERS = min(2, os.cpu_count() or 1)
 
 def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
     """The laws the comparison cannot set apart: those that carry the stacking weight (:data:`WEIGHT_RULE`) and
-    every law whose ELPD is not decisively behind the best's (:data:`friction_uq.stats.RULE`: dELPD > 4 and beyond
-    t(0.975, n - 1) SE over the n tests), less a law that holds another of them as a special case
+    every law it does not rule out (:meth:`~friction_uq.stats.WeightRule.ruled_out`: decisively behind the best,
+    :data:`friction_uq.stats.RULE`, dELPD > 4 and beyond t(0.975, n - 1) SE over the n tests; or more than 4
+    behind with less than 0.1 of the weight), less a law that holds another of them as a special case
     (:data:`~.laws.SPECIAL_CASES`, constant excepted) without predicting the tests more than 4 better than it:
     its extra term is not asked for by the data. Stacking puts its weight on one of several laws that predict the
     tests alike, and which one follows the sampler's bits (on the bundled campaign, three laws within 1.3 ELPD
     of each other took weights 0.83, 0.65 and 0.96 in turn over seeds 1-3); the set of laws not ruled out does
     not. Simplest first (fewest parameters, then name), so that the same set reads the same."""
     rows = {str(r.get("law", r["model"])): r for r in ranking}
-    close = [law for law, r in rows.items() if law in weights and not RULE.decisive(
-        float(r["d_elpd"]), float(r["d_se"]), n=int(r["n_tests"]) if r.get("n_tests") else None)]
+    close = [law for law, r in rows.items() if law in weights and not WEIGHT_RULE.ruled_out(
+        weights[law], float(r["d_elpd"]), float(r["d_se"]), n=int(r["n_tests"]) if r.get("n_tests") else None)]
     kept = set(WEIGHT_RULE.supported(weights)) | set(close)
     behind = {law: float(r["d_elpd"]) for law, r in rows.items()}
     richer = {law for law in kept for simple in SPECIAL_CASES.get(law, ())

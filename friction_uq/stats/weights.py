@@ -28,6 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .decision import RULE, DecisionRule
+
 
 def _elpd_data(pointwise: np.ndarray, n_samples: int):
     import xarray as xr
@@ -105,3 +107,25 @@ class WeightRule:
     def against(self, weights: Mapping[str, float]) -> list[str]:
         """The models with less than ``little`` of the weight."""
         return [k for k, w in weights.items() if w < self.little]
+
+    def ruled_out(self, weight: float, d_elpd: float, d_se: float, *, n: int | None = None,
+                  rule: DecisionRule = RULE) -> bool:
+        """Whether a model ``d_elpd`` +- ``d_se`` behind the best (over ``n`` paired points) with stacking weight
+        ``weight`` is ruled out: decisively behind (``rule``), or, the two measures agreeing, more than
+        ``rule.min_delpd`` behind with less than ``little`` of the weight.
+
+        The paired SE treats the points as exchangeable draws. Over a designed set of tests they are not: the
+        evidence against a law sits in the tests that reach where the laws part (the fastest, the longest slip),
+        so the SE over six tests is as large as the difference although nearly every test points the same way
+        (a slip-weakening wall: constant 17-27 +- 7-13 behind, 2x3 campaigns). The bootstrap-averaged weight
+        already asks whether any resampling of the points needs the model; a model that predicts more than
+        ``min_delpd`` worse and that none needs is not one the data leave open. Below ``min_delpd`` the weight
+        alone never rules a model out: among models that predict alike, which one stacking favours follows
+        the sampler's bits.
+
+        >>> WeightRule().ruled_out(0.0, 21.7, 11.0, n=6), WeightRule().ruled_out(0.2, 21.7, 11.0, n=6)
+        (True, False)
+        >>> WeightRule().ruled_out(0.0, 3.5, 0.5, n=6), WeightRule().ruled_out(0.5, 12.0, 1.0, n=6)
+        (False, True)
+        """
+        return rule.decisive(d_elpd, d_se, n=n) or (weight < self.little and d_elpd > rule.min_delpd)
