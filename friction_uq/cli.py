@@ -38,10 +38,11 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _seed(text: str) -> int:
+    """A seed in decimal ("010" is 10; "0x10" is refused, not read in another base)."""
     try:
-        v = int(text, 0)
+        v = int(text, 10)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"seed {text!r} is not an integer") from None
+        raise argparse.ArgumentTypeError(f"seed {text!r} is not a decimal integer") from None
     if not 0 <= v < 2**64:
         raise argparse.ArgumentTypeError(f"seed must be an integer in [0, 2**64), got {text}")
     return v

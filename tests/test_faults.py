@@ -203,7 +203,8 @@ def test_a_real_full_disk_is_one_sentence_and_leaves_nothing(record, tmp_path):
 @pytest.mark.parametrize("argv, words", [
     (["run", "{rec}", "--seed", "-1"], "seed must be an integer in [0, 2**64), got -1"),
     (["run", "{rec}", "--seed", str(2**64)], "seed must be an integer in [0, 2**64)"),
-    (["run", "{rec}", "--seed", "1.5"], "seed '1.5' is not an integer"),
+    (["run", "{rec}", "--seed", "1.5"], "seed '1.5' is not a decimal integer"),
+    (["run", "{rec}", "--seed", "0x10"], "seed '0x10' is not a decimal integer"),
     (["simulate", "{cfg}", "-o", "{tmp}/x.h5", "--seed", "-1"], "seed must be an integer in [0, 2**64), got -1"),
     (["simulate", "{cfg}", "-o", "{tmp}"], "is a directory; give a record file name ending in .h5"),
     (["simulate", "{cfg}", "-o", "{tmp}/x.txt"], "unknown record format '.txt'"),
