@@ -30,21 +30,30 @@ WEIGHT_RULE = WeightRule(mass=0.9, little=0.1)
 LAW_WORKERS = min(2, os.cpu_count() or 1)
 
 
-def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
+def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object]], *,
+                   by_weight: bool = True) -> list[str]:
     """The laws the comparison cannot set apart: those that carry the stacking weight (:data:`WEIGHT_RULE`) and
     every law it does not rule out (:meth:`~friction_uq.stats.WeightRule.ruled_out`: decisively behind the best,
-    :data:`friction_uq.stats.RULE`, dELPD > 4 and beyond t(0.975, n - 1) SE over the n tests; or more than 4
-    behind with less than 0.1 of the weight), less a law that holds another of them as a special case
+    :data:`friction_uq.stats.RULE`, dELPD > 4 and beyond t(0.975, n - 1) SE over the n tests; or, ``by_weight``,
+    more than 4 behind with and without the test that favours the best most, while it and the laws within 4 of
+    it carry less than 0.1 of the weight), less a law that holds another of them as a special case
     (:data:`~.laws.SPECIAL_CASES`, constant excepted) without predicting the tests more than 4 better than it:
     its extra term is not asked for by the data. Stacking puts its weight on one of several laws that predict the
     tests alike, and which one follows the sampler's bits (on the bundled campaign, three laws within 1.3 ELPD
     of each other took weights 0.83, 0.65 and 0.96 in turn over seeds 1-3); the set of laws not ruled out does
     not. Simplest first (fewest parameters, then name), so that the same set reads the same."""
-    rows = {str(r.get("law", r["model"])): r for r in ranking}
-    close = [law for law, r in rows.items() if law in weights and not WEIGHT_RULE.ruled_out(
-        weights[law], float(r["d_elpd"]), float(r["d_se"]), n=int(r["n_tests"]) if r.get("n_tests") else None)]
-    kept = set(WEIGHT_RULE.supported(weights)) | set(close)
+    rows = {str(r.get("law", r["model"])): r for r in ranking if str(r.get("law", r["model"])) in weights}
     behind = {law: float(r["d_elpd"]) for law, r in rows.items()}
+
+    def ruled_out(law: str) -> bool:
+        r = rows[law]
+        alike = sum(weights[o] for o in rows if abs(behind[o] - behind[law]) <= RULE.min_delpd)
+        rest = r.get("d_elpd_rest") if by_weight else None
+        return WEIGHT_RULE.ruled_out(alike, behind[law], float(r["d_se"]),
+                                     n=int(r["n_tests"]) if r.get("n_tests") else None,
+                                     d_rest=None if rest is None else float(rest))
+
+    kept = set(WEIGHT_RULE.supported(weights)) | {law for law in rows if not ruled_out(law)}
     richer = {law for law in kept for simple in SPECIAL_CASES.get(law, ())
               if simple != "constant" and simple in kept and law in behind and simple in behind
               and behind[simple] - behind[law] <= RULE.min_delpd}
@@ -52,10 +61,12 @@ def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object
 
 
 def simplest_supported(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> str:
-    """The law with the fewest parameters among the supported ones (:func:`supported_laws`; the heaviest among
-    equals): set-ups are flagged under it, since a richer law can absorb a set-up's offset into the term it adds
-    (a pressure term fits a set-up whose bars put it at other pressures)."""
-    return min(supported_laws(weights, ranking), key=lambda law: (len(LAW_PARAMS[law]), -weights[law]))
+    """The law with the fewest parameters among those the ELPD alone does not rule out (:func:`supported_laws`
+    without the weight route; the heaviest among equals): set-ups are flagged under it, since a richer law can
+    absorb a set-up's offset into the term it adds (a pressure term fits a set-up whose bars put it at other
+    pressures). Not the weight route: one set-up off by its calibration puts its evidence in its own tests, and
+    a law it pushes ahead could then take the offset into its term and leave the set-up unflagged."""
+    return min(supported_laws(weights, ranking, by_weight=False), key=lambda law: (len(LAW_PARAMS[law]), -weights[law]))
 
 
 #: Said beside a verdict that names a law with a velocity term when the slip law was not compared (a test without
@@ -69,7 +80,7 @@ SLIP_CAVEAT = ("a dependence on the distance slid would read the same: at each t
 def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
     """What the comparison supports (:func:`supported_laws`), in sentences: the law, or the laws the data do not
     separate (with their stacking weights and how far behind the best each is); and that f is not constant
-    whenever the constant law carries little weight and is decisively behind."""
+    whenever the constant law carries little weight and is ruled out."""
     supported = supported_laws(weights, ranking)
     by_name = {str(r.get("law", r["model"])): r for r in ranking}
 

@@ -109,23 +109,30 @@ class WeightRule:
         return [k for k, w in weights.items() if w < self.little]
 
     def ruled_out(self, weight: float, d_elpd: float, d_se: float, *, n: int | None = None,
-                  rule: DecisionRule = RULE) -> bool:
-        """Whether a model ``d_elpd`` +- ``d_se`` behind the best (over ``n`` paired points) with stacking weight
-        ``weight`` is ruled out: decisively behind (``rule``), or, the two measures agreeing, more than
-        ``rule.min_delpd`` behind with less than ``little`` of the weight.
+                  d_rest: float | None = None, rule: DecisionRule = RULE) -> bool:
+        """Whether a model ``d_elpd`` +- ``d_se`` behind the best (over ``n`` paired points) is ruled out:
+        decisively behind (``rule``); or more than ``rule.min_delpd`` behind even with the point that favours the
+        best most left out (``d_rest``), while it and the models that predict alike with it (within
+        ``min_delpd`` of its ELPD) carry less than ``little`` of the weight (``weight``: their sum).
 
-        The paired SE treats the points as exchangeable draws. Over a designed set of tests they are not: the
-        evidence against a law sits in the tests that reach where the laws part (the fastest, the longest slip),
-        so the SE over six tests is as large as the difference although nearly every test points the same way
-        (a slip-weakening wall: constant 17-27 +- 7-13 behind, 2x3 campaigns). The bootstrap-averaged weight
-        already asks whether any resampling of the points needs the model; a model that predicts more than
-        ``min_delpd`` worse and that none needs is not one the data leave open. Below ``min_delpd`` the weight
-        alone never rules a model out: among models that predict alike, which one stacking favours follows
+        The paired SE treats the points as exchangeable draws. A campaign's tests are a design: the evidence
+        against a law sits in the tests that reach where the laws part (the fastest, the longest slip), so over
+        six tests the SE can be as large as the difference although the tests point the same way (slip-weakening
+        walls: constant 17-27 +- 7-13 behind, weight 0.00). The second route asks instead that the difference
+        not hang on one point (one bad record would otherwise decide it) and that stacking, averaged over
+        Bayesian-bootstrap reweightings of the points, find no use for the model or its alike ones. Without
+        ``d_rest`` (a result stored before it was recorded) only the first route is open. Below ``min_delpd`` the
+        weight never rules a model out: among models that predict alike, which one stacking favours follows
         the sampler's bits.
 
-        >>> WeightRule().ruled_out(0.0, 21.7, 11.0, n=6), WeightRule().ruled_out(0.2, 21.7, 11.0, n=6)
+        >>> r = WeightRule()
+        >>> r.ruled_out(0.0, 21.7, 11.0, n=6, d_rest=13.0), r.ruled_out(0.2, 21.7, 11.0, n=6, d_rest=13.0)
         (True, False)
-        >>> WeightRule().ruled_out(0.0, 3.5, 0.5, n=6), WeightRule().ruled_out(0.5, 12.0, 1.0, n=6)
-        (False, True)
+        >>> r.ruled_out(0.0, 21.7, 11.0, n=6, d_rest=2.0), r.ruled_out(0.0, 21.7, 11.0, n=6)
+        (False, False)
+        >>> r.ruled_out(0.5, 12.0, 1.0, n=6), r.ruled_out(0.0, 3.5, 0.5, n=6, d_rest=3.5)
+        (True, False)
         """
-        return rule.decisive(d_elpd, d_se, n=n) or (weight < self.little and d_elpd > rule.min_delpd)
+        if rule.decisive(d_elpd, d_se, n=n):
+            return True
+        return d_rest is not None and weight < self.little and min(d_elpd, d_rest) > rule.min_delpd
