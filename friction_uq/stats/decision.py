@@ -1,7 +1,8 @@
 """When a difference in expected log predictive density (ELPD) decides: one rule, one standard error.
 
 Every comparison of models in the package (``diagnose`` naming a cause, the two-bar diagnosis naming a
-mechanism, the campaign choosing a friction law and flagging a set-up) reads its verdict here:
+mechanism, the campaign choosing a friction law and flagging a set-up) reads its verdict here (the campaign's
+naming of laws opens one more route beside it, on the stacking weights: :meth:`.weights.WeightRule.ruled_out`):
 
 * :func:`paired_difference`: ELPD(a) - ELPD(b) from the two models' pointwise values over the same
   observations (blocks of a record, tests of a campaign), with the standard error of a sum of paired
