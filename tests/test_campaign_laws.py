@@ -243,7 +243,11 @@ def test_one_test_alone_never_rules_a_law_out():
     weights, ranking = _compared({"velocity": np.array([-0.98] * 5 + [-1.0]), "constant": const})
     assert weights["constant"] < WEIGHT_RULE.little
     assert "constant" in supported_laws(weights, ranking)
-    assert not any(line.startswith("f is not constant") for line in verdict(weights, ranking))
+    said = verdict(weights, ranking)
+    assert not any(line.startswith("f is not constant") for line in said)
+    assert "the evidence against it rests on that test" in said[1], said  # not "predict the tests as well"
+    named = verdict(weights, ranking, ["A-01", "A-02", "A-03", "B-01", "B-02", "B-03"])
+    assert "11.1 +- 11.0 behind, but 0.1 with test B-03 left out" in named[1], named
 
 
 def test_laws_that_predict_alike_share_their_weight_before_it_rules_either_out():

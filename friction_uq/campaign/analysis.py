@@ -215,7 +215,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
         ca.sentences.append(f"the friction law is compared with the level of set-up {', '.join(freed)} left out: it "
                             "departs from the shared law beyond its calibration (3 %), a finding for diagnose to "
                             "explain, not a part of any law")
-    ca.sentences += verdict(ca.weights, ca.ranking)
+    ca.sentences += verdict(ca.weights, ca.ranking, data.labels)
     if "sentence" in ca.pressure_or_setup and not freed:  # the alternative the named law leaves open
         ca.sentences.append(str(ca.pressure_or_setup["sentence"]))
     supported = supported_laws(ca.weights, ca.ranking)

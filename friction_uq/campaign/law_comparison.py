@@ -77,10 +77,12 @@ SLIP_CAVEAT = ("a dependence on the distance slid would read the same: at each t
                "for slip weakening (docs/campaigns.md)")
 
 
-def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> list[str]:
+def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]],
+            labels: Sequence[str] | None = None) -> list[str]:
     """What the comparison supports (:func:`supported_laws`), in sentences: the law, or the laws the data do not
     separate (with their stacking weights and how far behind the best each is); and that f is not constant
-    whenever the constant law carries little weight and is ruled out."""
+    whenever the constant law carries little weight and is ruled out. ``labels``: the tests' names, in the
+    order of the pointwise densities (to name a test the evidence rests on)."""
     supported = supported_laws(weights, ranking)
     by_name = {str(r.get("law", r["model"])): r for r in ranking}
 
@@ -100,12 +102,25 @@ def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]]) -> 
     if "constant" not in supported and weights.get("constant", 1.0) < WEIGHT_RULE.little:
         out.append(f"f is not constant: the constant law carries {weights['constant']:.2f} of the weight")
     elif "constant" in supported and len(supported) > 1:
-        on = "V, p or the slip" if "slip" in weights else "V or p"
-        out.append(f"no dependence of f on {on} is resolved: a constant f carries {weights['constant']:.2f} of "
-                   "the weight, and the laws beside it predict the tests as well")
+        out.append(_unresolved(weights, by_name["constant"], labels))
     if "slip" not in weights and any("log_vc" in LAW_PARAMS[law] for law in supported if law in LAW_PARAMS):
         out.append(SLIP_CAVEAT)  # the slip law was not compared (no change across the windows, or f of diagnosed models)
     return out
+
+
+def _unresolved(weights: dict[str, float], const: dict[str, object], labels: Sequence[str] | None) -> str:
+    """Why a dependence of f is not resolved while the constant law is named beside others: it predicts the tests
+    about as well, or (far behind, with little weight) the evidence against it rests on one test."""
+    on = "V, p or the slip" if "slip" in weights else "V or p"
+    d, rest, w = float(const["d_elpd"]), const.get("d_elpd_rest"), weights["constant"]
+    if w < WEIGHT_RULE.little and d > RULE.min_delpd and rest is not None and float(rest) <= RULE.min_delpd:
+        i = const.get("rest_without_test")
+        test = f"test {labels[int(i)]}" if labels is not None and i is not None and int(i) < len(labels) else "one test"
+        return (f"no dependence of f on {on} is resolved, though a constant f carries {w:.2f} of the weight: it is "
+                f"{d:.1f} +- {float(const['d_se']):.1f} behind, but {float(rest):.1f} with {test} left out; the "
+                "evidence against it rests on that test, and another at its conditions would say whether it holds")
+    return (f"no dependence of f on {on} is resolved: a constant f carries {w:.2f} of the weight, and the laws "
+            "beside it predict the tests as well")
 
 
 def draw_summary(x: np.ndarray) -> dict[str, float]:

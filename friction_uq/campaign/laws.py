@@ -256,14 +256,17 @@ class Elpd:
 
 def rank(elpds: Sequence[Elpd]) -> list[dict[str, float | str]]:
     """Models by ELPD, each with dELPD and SE against the top one, and ``d_elpd_rest``: dELPD with the one test
-    that favours the top model most left out (:meth:`friction_uq.stats.WeightRule.ruled_out`)."""
+    that favours the top model most left out (:meth:`friction_uq.stats.WeightRule.ruled_out`), the test's index
+    in ``rest_without_test``."""
     order = sorted(elpds, key=lambda e: -e.elpd)
     top = order[0]
     out = []
     for e in order:
         d, se = paired_difference(top.pointwise, e.pointwise)
-        rest = d - float(np.max(top.pointwise - e.pointwise)) if e is not top else 0.0
+        worst = int(np.argmax(top.pointwise - e.pointwise))
+        rest = d - float(top.pointwise[worst] - e.pointwise[worst]) if e is not top else 0.0
         out.append({"model": e.model, "elpd": e.elpd, "se": e.se, "d_elpd": d, "d_se": se, "d_elpd_rest": rest,
+                    "rest_without_test": worst,
                     "n_tests": int(e.pointwise.size), "pareto_k_max": float(np.max(e.pareto_k)), "refits": e.refits})
     return out
 
