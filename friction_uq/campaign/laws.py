@@ -58,6 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..stats import RULE, paired_difference
+from ..stats.trimmed import trimmed_difference
 from ..stats.streams import legacy_state
 from .kernels import log_kernel_mixture
 from .law_coordinates import LawCoordinates
@@ -256,15 +257,17 @@ class Elpd:
 
 def rank(elpds: Sequence[Elpd]) -> list[dict[str, float | str]]:
     """Models by ELPD, each with dELPD and SE against the top one, and ``d_elpd_rest``: dELPD with the one test
-    that favours the top model most left out (:meth:`friction_uq.stats.WeightRule.ruled_out`), the test's index
-    in ``rest_without_test``."""
+    that favours the top model most left out (:func:`friction_uq.stats.trimmed.trimmed_difference`, as
+    ``diagnose`` asks of a cause's evidence; read by :meth:`friction_uq.stats.WeightRule.ruled_out`; None with
+    fewer than 3 tests), the test's index in ``rest_without_test``."""
     order = sorted(elpds, key=lambda e: -e.elpd)
     top = order[0]
     out = []
     for e in order:
         d, se = paired_difference(top.pointwise, e.pointwise)
         worst = int(np.argmax(top.pointwise - e.pointwise))
-        rest = d - float(top.pointwise[worst] - e.pointwise[worst]) if e is not top else 0.0
+        rest = (0.0 if e is top else trimmed_difference(top.pointwise, e.pointwise, drop=1)[0]
+                if e.pointwise.size >= 3 else None)
         out.append({"model": e.model, "elpd": e.elpd, "se": e.se, "d_elpd": d, "d_se": se, "d_elpd_rest": rest,
                     "rest_without_test": worst,
                     "n_tests": int(e.pointwise.size), "pareto_k_max": float(np.max(e.pareto_k)), "refits": e.refits})
