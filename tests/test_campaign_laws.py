@@ -261,6 +261,12 @@ def test_laws_that_predict_alike_share_their_weight_before_it_rules_either_out()
     for v, pv in ((0.19, 0.06), (0.06, 0.19)):
         w = {"slip": 0.75, "velocity": v, "pressure+velocity": pv, "pressure": 0.0, "constant": 0.0}
         assert supported_laws(w, ranking) == ["slip", "velocity"], w
+    # a law far behind borrows no weight from one close to the best: constant 7.4 behind (6 without its best test)
+    # is within 4 of velocity, 3.5 behind with 0.3 of the weight, and is ruled out all the same
+    near = [row("slip", 0.0, 0.0, 0.0), row("velocity", 3.5, 3.0, 2.0), row("constant", 7.4, 5.0, 6.0)]
+    w = {"slip": 0.7, "velocity": 0.3, "constant": 0.0}
+    assert supported_laws(w, near) == ["slip", "velocity"]
+    assert verdict(w, near)[1] == "f is not constant: the constant law carries 0.00 of the weight"
 
 
 def test_a_velocity_term_is_said_to_stand_for_v_or_the_distance_slid():

@@ -36,7 +36,7 @@ def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object
     every law it does not rule out (:meth:`~friction_uq.stats.WeightRule.ruled_out`: decisively behind the best,
     :data:`friction_uq.stats.RULE`, dELPD > 4 and beyond t(0.975, n - 1) SE over the n tests; or, ``by_weight``,
     more than 4 behind with and without the test that favours the best most, while it and the laws within 4 of
-    it carry less than 0.1 of the weight), less a law that holds another of them as a special case
+    it that are as far behind carry less than 0.1 of the weight), less a law that holds another of them as a special case
     (:data:`~.laws.SPECIAL_CASES`, constant excepted) without predicting the tests more than 4 better than it:
     its extra term is not asked for by the data. Stacking puts its weight on one of several laws that predict the
     tests alike, and which one follows the sampler's bits (on the bundled campaign, three laws within 1.3 ELPD
@@ -47,7 +47,8 @@ def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object
 
     def ruled_out(law: str) -> bool:
         r = rows[law]
-        alike = sum(weights[o] for o in rows if abs(behind[o] - behind[law]) <= RULE.min_delpd)
+        alike = sum(weights[o] for o in rows  # laws far behind as it is that predict alike (twins split weight)
+                    if abs(behind[o] - behind[law]) <= RULE.min_delpd and behind[o] > RULE.min_delpd)
         rest = r.get("d_elpd_rest") if by_weight else None
         return WEIGHT_RULE.ruled_out(alike, behind[law], float(r["d_se"]),
                                      n=int(r["n_tests"]) if r.get("n_tests") else None,

@@ -259,15 +259,16 @@ def rank(elpds: Sequence[Elpd]) -> list[dict[str, float | str]]:
     """Models by ELPD, each with dELPD and SE against the top one, and ``d_elpd_rest``: dELPD with the one test
     that favours the top model most left out (:func:`friction_uq.stats.trimmed.trimmed_difference`, as
     ``diagnose`` asks of a cause's evidence; read by :meth:`friction_uq.stats.WeightRule.ruled_out`; None with
-    fewer than 3 tests), the test's index in ``rest_without_test``."""
+    fewer than 3 tests), the test's index in ``rest_without_test`` (in the order of the tests' pointwise densities,
+    ``LawData.labels``; None for the top model and with fewer than 3 tests)."""
     order = sorted(elpds, key=lambda e: -e.elpd)
     top = order[0]
     out = []
     for e in order:
         d, se = paired_difference(top.pointwise, e.pointwise)
-        worst = int(np.argmax(top.pointwise - e.pointwise))
-        rest = (0.0 if e is top else trimmed_difference(top.pointwise, e.pointwise, drop=1)[0]
-                if e.pointwise.size >= 3 else None)
+        few, first = e.pointwise.size < 3, e is top
+        worst = None if first or few else int(np.argmax(top.pointwise - e.pointwise))
+        rest = None if few else 0.0 if first else trimmed_difference(top.pointwise, e.pointwise, drop=1)[0]
         out.append({"model": e.model, "elpd": e.elpd, "se": e.se, "d_elpd": d, "d_se": se, "d_elpd_rest": rest,
                     "rest_without_test": worst,
                     "n_tests": int(e.pointwise.size), "pareto_k_max": float(np.max(e.pareto_k)), "refits": e.refits})

@@ -153,7 +153,7 @@ def _comparison_page(ca: CampaignAnalysis, named: list[str]):
     ax.set_yticks(y, [f"{x}\n(dELPD {float(m['d_elpd']):.1f} +- {float(m['d_se']):.1f})" for x, m in zip(law, r)])
     ax.set_xlim(0, 1)
     ax.set_xlabel("stacking weight (0-1): the share of the campaign's predictions each law carries")
-    ax.set_title("blue: named by the verdict (carries the weight, or its ELPD is not decisively behind);\n"
+    ax.set_title("blue: named by the verdict (carries the weight, or is not ruled out: docs/campaigns.md);\n"
                  "grey: ruled out, or a richer law the tests do not ask for", loc="left", fontsize=9)
     ax = axes[1]
     if ca.next_tests:

@@ -113,7 +113,8 @@ class WeightRule:
         """Whether a model ``d_elpd`` +- ``d_se`` behind the best (over ``n`` paired points) is ruled out:
         decisively behind (``rule``); or more than ``rule.min_delpd`` behind even with the point that favours the
         best most left out (``d_rest``), while it and the models that predict alike with it (within
-        ``min_delpd`` of its ELPD) carry less than ``little`` of the weight (``weight``: their sum).
+        ``min_delpd`` of its ELPD, themselves more than ``min_delpd`` behind the best) carry less than
+        ``little`` of the weight (``weight``: their sum, which the caller forms).
 
         The paired SE treats the points as exchangeable draws. A campaign's tests are a design: the evidence
         against a law sits in the tests that reach where the laws part (the fastest, the longest slip), so over
