@@ -247,7 +247,12 @@ def test_one_test_alone_never_rules_a_law_out():
     assert not any(line.startswith("f is not constant") for line in said)
     assert "the evidence against it rests on that test" in said[1], said  # not "predict the tests as well"
     named = verdict(weights, ranking, ["A-01", "A-02", "A-03", "B-01", "B-02", "B-03"])
-    assert "11.1 +- 11.0 behind, but 0.1 with test B-03 left out" in named[1], named
+    assert "11.1 +- 11.0 behind, short of decisive over 6 tests, and 0.1 with test B-03 left out" in named[1], named
+    # far behind, not on one test, but laws as far behind that predict alike with it carry weight: not "as well"
+    far = [r | {"d_elpd_rest": 16.9} if r["law"] == "constant" else r for r in ranking] + [
+        {"model": "pressure", "law": "pressure", "d_elpd": 10.5, "d_se": 10.0, "d_elpd_rest": 7.0, "n_tests": 6}]
+    kept = verdict(weights | {"pressure": 0.13, "velocity": 0.87 - weights["constant"]}, far)
+    assert kept[1].endswith("is 11.1 +- 11.0 behind, short of decisive over 6 tests"), kept
 
 
 def test_laws_that_predict_alike_share_their_weight_before_it_rules_either_out():

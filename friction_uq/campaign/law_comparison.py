@@ -111,17 +111,22 @@ def verdict(weights: dict[str, float], ranking: Sequence[dict[str, object]],
 
 def _unresolved(weights: dict[str, float], const: dict[str, object], labels: Sequence[str] | None) -> str:
     """Why a dependence of f is not resolved while the constant law is named beside others: it predicts the tests
-    about as well, or (far behind, with little weight) the evidence against it rests on one test."""
+    about as well; or it is far behind but not decisively, and (with little weight) the evidence against it
+    rests on one test."""
     on = "V, p or the slip" if "slip" in weights else "V or p"
     d, rest, w = float(const["d_elpd"]), const.get("d_elpd_rest"), weights["constant"]
-    if w < WEIGHT_RULE.little and d > RULE.min_delpd and rest is not None and float(rest) <= RULE.min_delpd:
+    if d <= RULE.min_delpd:
+        return (f"no dependence of f on {on} is resolved: a constant f carries {w:.2f} of the weight, and the laws "
+                "beside it predict the tests as well")
+    n = const.get("n_tests")
+    head = (f"no dependence of f on {on} is resolved beyond doubt: a constant f carries {w:.2f} of the weight and "
+            f"is {d:.1f} +- {float(const['d_se']):.1f} behind, short of decisive over {n or 'these'} tests")
+    if w < WEIGHT_RULE.little and rest is not None and float(rest) <= RULE.min_delpd:
         i = const.get("rest_without_test")
         test = f"test {labels[int(i)]}" if labels is not None and i is not None and int(i) < len(labels) else "one test"
-        return (f"no dependence of f on {on} is resolved, though a constant f carries {w:.2f} of the weight: it is "
-                f"{d:.1f} +- {float(const['d_se']):.1f} behind, but {float(rest):.1f} with {test} left out; the "
-                "evidence against it rests on that test, and another at its conditions would say whether it holds")
-    return (f"no dependence of f on {on} is resolved: a constant f carries {w:.2f} of the weight, and the laws "
-            "beside it predict the tests as well")
+        return (f"{head}, and {float(rest):.1f} with {test} left out: the evidence against it rests on that test, and "
+                "another at its conditions would say whether it holds")
+    return head
 
 
 def draw_summary(x: np.ndarray) -> dict[str, float]:
