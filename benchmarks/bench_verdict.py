@@ -120,6 +120,7 @@ def main() -> None:
     rule = NamingRule()
     variants = {
         "the package's rule": rule,
+        "without the weight route (rivals ruled out by 2 SE of dELPD only)": dataclasses.replace(rule, by_weight=False),
         "without the misfit gate": dataclasses.replace(rule, require_misfit=False),
         "against passing rivals only": dataclasses.replace(rule, against_all=False),
         "no spread test": dataclasses.replace(rule, drop_fraction=0.0),

@@ -122,6 +122,31 @@ def test_two_mechanisms_the_record_does_not_separate_are_candidates_and_a_gain_o
                                    else ("external_output_bar",))
 
 
+def test_a_rival_behind_over_the_whole_record_with_no_weight_is_ruled_out_and_one_ahead_in_a_few_blocks_is_not():
+    """The weight route of the naming rule (friction_uq.discrepancy.verdict, 3.): a lead within 2 SE rules a rival
+    out when it holds with the spread test's blocks left out and the rival carries no stacking weight."""
+    from friction_uq.discrepancy.elpd import elpd_difference
+    from friction_uq.discrepancy.verdict import NamingRule
+
+    base = _fit("reference", None, _noise())
+    best = _noise(seed=5) + 1.0  # 200 nats over the reference, every block
+    lead = np.full(best.size, 0.1)
+    lead[:2] += 40.0  # 100 nats ahead of the rival: 20 over the whole record, 80 at a front (SE 56)
+    rival = best - lead
+    d, se = elpd_difference(_fit("reference", None, best).elpd, _fit("reference", None, rival).elpd)
+    assert d > 4 and d < 2 * se  # within 2 SE: the ELPD rule alone does not separate them
+    fits = [_fit("velocity_friction", None, best), _fit("bandwidth", None, rival)]
+    v = NamingRule().judge(base, _round(base, fits), misfit=True)
+    assert v.kind == "named" and v.named == "velocity_friction" and v.by_weight == ("bandwidth",)
+    assert v.weights["bandwidth"] < 0.1
+    assert NamingRule(by_weight=False).judge(base, _round(base, fits), misfit=True).kind == "candidates"
+    # the same lead at the front alone: with the blocks that favour the best left out it is gone, so no route
+    at_front = best - np.where(np.arange(best.size) < 2, 40.0, 0.0) + _noise(seed=6) * 0.1
+    v = NamingRule().judge(base, _round(base, [_fit("velocity_friction", None, best),
+                                              _fit("bandwidth", None, at_front)]), misfit=True)
+    assert v.kind == "candidates" and v.rivals == ("bandwidth",) and v.by_weight == ()
+
+
 def test_the_mixture_takes_each_model_in_proportion_to_its_weight():
     from friction_uq.discrepancy.verdict import mixture_draws
 

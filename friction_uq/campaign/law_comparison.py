@@ -47,8 +47,7 @@ def supported_laws(weights: dict[str, float], ranking: Sequence[dict[str, object
 
     def ruled_out(law: str) -> bool:
         r = rows[law]
-        alike = sum(weights[o] for o in rows  # laws far behind as it is that predict alike (twins split weight)
-                    if abs(behind[o] - behind[law]) <= RULE.min_delpd and behind[o] > RULE.min_delpd)
+        alike = WEIGHT_RULE.alike_weight(weights, behind, law)  # with the laws as far behind that predict alike
         rest = r.get("d_elpd_rest") if by_weight else None
         return WEIGHT_RULE.ruled_out(alike, behind[law], float(r["d_se"]),
                                      n=int(r["n_tests"]) if r.get("n_tests") else None,

@@ -39,7 +39,8 @@ def _entry(r: Ranked, verdict=None) -> dict[str, object]:
     v = r.fit.variants[-1]
     params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
     judged = {} if verdict is None else next(({"weight": c.weight, "delpd_trimmed": c.delpd_trimmed,
-                                               "se_trimmed": c.se_trimmed, "spread": c.spread}
+                                               "se_trimmed": c.se_trimmed, "spread": c.spread,
+                                               "ruled_out_by_weight": c.label in verdict.by_weight}
                                               for c in verdict.candidates if c.label == r.fit.label), {})
     return {"name": v.mechanism.name, "channel": v.channel, "model": r.fit.label, "delpd": r.delpd, "se": r.se,
             "decisive": r.decisive, **judged, "parameters": params,
@@ -75,6 +76,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.named_causes],
         "fitted_in_turn": [c.label for c in dg.causes],
         "open_candidates": list(dg.open_candidates),
+        # the candidates fitted in turn against their rounds' open rivals, with the later causes in the model
+        "swaps": [{"round": sw.round + 1, "rival": sw.rival, "model": sw.model, "delpd": sw.delpd, "se": sw.se,
+                   "weight": sw.weight, "ruled_out": sw.ruling} for sw in dg.swaps],
         "not_separable": list(dg.not_separable),
         "separate_by": dg.separate_by,
         "ranking": [_entry(r, v) for r in dg.ranking],
@@ -99,10 +103,14 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                          for ch, phases in dg.rms.items()},
         "rule": "a cause is named only of a misfit the whole-record check found, when its dELPD over the model without "
                 "it exceeds 4 and 2 SE, still does with the 5 % of blocks that favour it most left out (spread over "
-                "the record), and beats every other extended model by the same margin; several that pass but do not "
-                "beat each other are candidates, a misfit none explains is unexplained, and f is then the stacking "
+                "the record), and rules out every other extended model (by the same margin, or by the stacking weight: "
+                "more than 4 behind with the 5 % of blocks that favour the best left out, under 0.1 of the weight with "
+                "the models as far behind that predict alike); several it does not rule out are candidates, a misfit "
+                "none explains is unexplained, and f is then the stacking "
                 "mixture of the models that carry the weight (in equal parts with the stationary analysis' f when "
-                "nothing is named, with run); after a named cause the search goes on with it in the model",
+                "nothing is named, with run); after a named cause the search goes on with it in the model; a candidate "
+                "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
+                "left open by the same rule (swaps)",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "

@@ -11,8 +11,14 @@ answers each before it names a mechanism:
    blocks) must still pass the rule. Two simulators of the same test differ in a few blocks (the
    fronts' timing, the plug's impact); a mechanism with a flexible transient collects thousands of
    nats there from a record that has nothing of it, with a standard error as large as the estimate.
-3. **Is it decisive against every rival?** The best such mechanism must beat each other mechanism that
-   passed 1 and 2 by the same rule; otherwise the record does not separate them.
+3. **Is it decisive against every rival?** The best such mechanism must rule out each other mechanism:
+   beat it by the same rule, or (``by_weight``) lead it by more than 4 nats with the blocks that favour the
+   best most left out (the spread test's share) while the rival, with the mechanisms as far behind that
+   predict alike with it, carries less than 0.1 of the stacking weight (:meth:`friction_uq.stats.WeightRule.
+   ruled_out`, the route the campaign's law comparison takes). Otherwise the record does not separate them.
+   The SE of a sum over hundreds of blocks is dominated by the few where two mechanisms part (a front, the
+   unloading): a second cause behind a first one leads its rivals by tens of nats spread over the record and
+   holds the whole weight, yet stays within 2 SE.
 
 Beside dELPD, the stacking weights of the reference and every candidate (stacking over the blocks,
 :func:`friction_uq.stats.stacking_weights`) say how the record shares its support among them.
@@ -47,6 +53,9 @@ from ..stats.trimmed import points_to_drop
 DROP_FRACTION = 0.05
 REQUIRE_MISFIT = True
 AGAINST_ALL = True
+BY_WEIGHT = True
+#: How the stacking weights read (mass 0.9 supported, under 0.1 little): the campaign's values.
+WEIGHT_RULE = WeightRule()
 
 
 @dataclass(frozen=True)
@@ -84,11 +93,15 @@ class Verdict:
     named: str | None = None  # the label of the named model
     rivals: tuple[str, ...] = ()  # labels: under "candidates", the models that pass but are not separated
     dropped: int = 0  # blocks left out by the spread test
+    #: labels of the models the named one rules out only by the weight route (not by 2 SE of dELPD)
+    by_weight: tuple[str, ...] = ()
+    #: labels of rivals a later check ruled out with the later causes in the model (:mod:`.rival_swaps`)
+    resolved: tuple[str, ...] = ()
 
     @property
     def supported(self) -> list[str]:
         """The labels (``reference`` included) that carry the stacking weight (:class:`WeightRule`)."""
-        return WeightRule().supported(self.weights)
+        return WEIGHT_RULE.supported(self.weights)
 
 
 def _points(elpd) -> np.ndarray:
@@ -106,6 +119,8 @@ class NamingRule:
     require_misfit: bool = REQUIRE_MISFIT
     #: the named model must beat every other extended model, not only those that pass the first two tests
     against_all: bool = AGAINST_ALL
+    #: a rival may also be ruled out by the stacking weight (module docstring, 3.)
+    by_weight: bool = BY_WEIGHT
 
     def candidate(self, fit, reference, delpd: float, se: float, weight: float) -> Candidate:
         """One model against the reference, with the spread test."""
@@ -125,7 +140,7 @@ class NamingRule:
         tolerance while the other two still move f by 10 %)."""
         from .elpd import elpd_difference
 
-        weights = _weights(reference, [r.fit for r in ranked], seed)
+        weights = round_weights(reference, [r.fit for r in ranked], seed)
         cands = tuple(self.candidate(r.fit, reference, r.delpd, r.se, weights[r.fit.label]) for r in ranked)
         drop = points_to_drop(len(reference.elpd.pointwise), self.drop_fraction)
         passing = [c for c in cands if c.passes]
@@ -134,21 +149,45 @@ class NamingRule:
         best = passing[0]
         if self.require_misfit and first and not misfit:
             return Verdict("unconfirmed", cands, weights, named=best.label, dropped=drop)
-        fits = {r.fit.label: r.fit for r in ranked}
-        rivals = []
-        for c in (cands if self.against_all else passing):
-            if c.label == best.label:
-                continue
-            d, se = elpd_difference(fits[best.label].elpd, fits[c.label].elpd)
-            if not RULE.decisive(d, se):
-                rivals.append(c)
+        rivals, by_weight = self._rivals(best, cands, passing, {r.fit.label: r.fit for r in ranked}, weights, drop)
         # the same mechanism on another gauge is a doubt about the gauge, not about the cause
         others = [c for c in rivals if c.mechanism != best.mechanism]
         kind = "candidates" if others else "named"
-        return Verdict(kind, cands, weights, named=best.label, rivals=tuple(c.label for c in rivals), dropped=drop)
+        return Verdict(kind, cands, weights, named=best.label, rivals=tuple(c.label for c in rivals), dropped=drop,
+                       by_weight=by_weight)
+
+    def _rivals(self, best: Candidate, cands, passing, fits, weights, drop: int) -> tuple[list, tuple[str, ...]]:
+        """The models ``best`` does not rule out (module docstring, 3.), and the labels of those it rules out
+        only by the weight route."""
+        from .elpd import elpd_difference
+
+        behind = {"reference": best.delpd} | {c.label: best.delpd - c.delpd for c in cands}
+        rivals, light = [], []
+        for c in (cands if self.against_all else passing):
+            if c.label == best.label:
+                continue
+            how = self.ruling(fits[best.label].elpd, fits[c.label].elpd,
+                              weight=WEIGHT_RULE.alike_weight(weights, behind, c.label), drop=drop)
+            if how is None:
+                rivals.append(c)
+            elif how == "weight":
+                light.append(c.label)
+        return rivals, tuple(light)
+
+    def ruling(self, best, other, *, weight: float, drop: int) -> str | None:
+        """How model ``best`` rules out ``other`` (their :class:`~.elpd.Elpd`): "elpd" (decisively, by the package's
+        rule), "weight" (the weight route, module docstring 3.; ``weight``: ``other``'s with the models that predict
+        alike with it, ``drop``: the blocks left out) or None (it does not)."""
+        from .elpd import elpd_difference
+
+        d, se = elpd_difference(best, other)
+        if RULE.decisive(d, se):
+            return "elpd"
+        rest = elpd_difference(best, other, drop=drop)[0] if self.by_weight else None
+        return "weight" if WEIGHT_RULE.ruled_out(weight, d, se, d_rest=rest) else None
 
 
-def _weights(reference, fits: Sequence, seed: int) -> dict[str, float]:
+def round_weights(reference, fits: Sequence, seed: int) -> dict[str, float]:
     """Stacking weights of the reference ("reference") and each fit, over the blocks and the calibration data
     they share (the calibration data are left out where the models do not all have the same)."""
     same = all(tuple(f.elpd.calibration_names) == tuple(reference.elpd.calibration_names) for f in fits)

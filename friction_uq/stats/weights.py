@@ -137,3 +137,19 @@ class WeightRule:
         if rule.decisive(d_elpd, d_se, n=n):
             return True
         return d_rest is not None and weight < self.little and min(d_elpd, d_rest) > rule.min_delpd
+
+    def alike_weight(self, weights: Mapping[str, float], behind: Mapping[str, float], name: str, *,
+                     rule: DecisionRule = RULE) -> float:
+        """The weight :meth:`ruled_out` reads for model ``name``: its own and that of every model that predicts
+        alike with it (``behind``: each model's ELPD behind the best; alike: within ``rule.min_delpd`` of
+        ``name``'s) and is itself more than ``rule.min_delpd`` behind the best. Twins split the weight stacking
+        would give one of them, so each alone may look light; a model close to the best lends none to a far one.
+
+        >>> b = {"best": 0.0, "close": 3.0, "a": 20.0, "a2": 21.0, "far": 30.0}
+        >>> w = {"best": 0.57, "close": 0.3, "a": 0.06, "a2": 0.06, "far": 0.01}
+        >>> round(WeightRule().alike_weight(w, b, "a"), 2), round(WeightRule().alike_weight(w, b, "far"), 2)
+        (0.12, 0.01)
+        """
+        me = behind[name]
+        return float(sum(weights.get(o, 0.0) for o, d in behind.items()
+                         if abs(d - me) <= rule.min_delpd and d > rule.min_delpd))
