@@ -82,3 +82,21 @@ def test_a_rival_the_final_model_rules_out_is_resolved_and_the_candidate_named_o
     assert [s.ruling for s in swaps] == ["elpd", None]
     assert out[0].resolved == ("channel_timing",) and unresolved_rounds(causes, out) == (0,)
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
+
+
+def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
+    from friction_uq.discrepancy.diagnose import Diagnosis
+    from friction_uq.discrepancy.diagnosis_words import _swapped
+
+    causes, verdicts, rounds, final = _record()
+    good = np.asarray(final.elpd.pointwise)
+    out, swaps = check_swaps(_Fitter({"channel_timing": good - 1.0, "bandwidth": good - 1.0}), final, causes,
+                             verdicts, rounds, rule=NamingRule(), workers=1, seed=0)
+    dg = Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
+                   separate_by=None, final=final, verdicts=tuple(out), swaps=swaps)
+    words = _swapped(dg)
+    assert words.startswith(" dispersion was one of the candidates of its round; with clearance in the model, each of "
+                            "its rivals explains the record worse (channel_timing 200 +- "), words
+    # without the swaps, nothing is said
+    assert _swapped(Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
+                              separate_by=None, final=final, verdicts=tuple(verdicts))) == ""

@@ -262,8 +262,8 @@ def _by_weight(dg: Diagnosis) -> str:
 
 
 def _swapped(dg: Diagnosis) -> str:
-    """' X was one of candidates its round did not tell apart (Y, Z); with the other causes in the model each of them
-    explains the record worse (...).' for each named cause whose round's rivals the swap check resolved
+    """' X was one of the candidates of its round; with the other causes in the model, each of its rivals explains the
+    record worse (...).' for each named cause whose round's rivals the swap check resolved
     (:mod:`.rival_swaps`); '' when none."""
     out = []
     for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
@@ -274,8 +274,8 @@ def _swapped(dg: Diagnosis) -> str:
         others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
         worse = ", ".join(f"{by[s.rival]} {s.delpd:.0f} +- {s.se:.0f} nats" + (" (by the weight)" if s.ruling == "weight"
                                                                                else "") for s in done)
-        out.append(f" {dg.causes[k].mechanism.name} was one of candidates its round did not tell apart; with {others} "
-                   f"in the model each rival explains the record worse ({worse}).")
+        out.append(f" {dg.causes[k].mechanism.name} was one of the candidates of its round; with {others} in the model, "
+                   f"each of its rivals explains the record worse ({worse}).")
     return "".join(out)
 
 
