@@ -138,8 +138,6 @@ class NamingRule:
         misfit gate decides whether there is anything to explain; once a cause is named, the next are named by
         their evidence: on the bundled B-02 the misfit after two of its four causes is within the check's
         tolerance while the other two still move f by 10 %)."""
-        from .elpd import elpd_difference
-
         weights = round_weights(reference, [r.fit for r in ranked], seed)
         cands = tuple(self.candidate(r.fit, reference, r.delpd, r.se, weights[r.fit.label]) for r in ranked)
         drop = points_to_drop(len(reference.elpd.pointwise), self.drop_fraction)
@@ -159,8 +157,6 @@ class NamingRule:
     def _rivals(self, best: Candidate, cands, passing, fits, weights, drop: int) -> tuple[list, tuple[str, ...]]:
         """The models ``best`` does not rule out (module docstring, 3.), and the labels of those it rules out
         only by the weight route."""
-        from .elpd import elpd_difference
-
         behind = {"reference": best.delpd} | {c.label: best.delpd - c.delpd for c in cands}
         rivals, light = [], []
         for c in (cands if self.against_all else passing):
