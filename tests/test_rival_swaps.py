@@ -9,7 +9,7 @@ from friction_uq.discrepancy.candidates_mixture import named_causes, unresolved_
 from friction_uq.discrepancy.elpd import Elpd
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
-from friction_uq.discrepancy.rival_swaps import check_swaps, swap_jobs
+from friction_uq.discrepancy.rival_swaps import WITHOUT, check_swaps, swap_jobs
 from friction_uq.discrepancy.verdict import Candidate, NamingRule, Verdict
 
 N = 200
@@ -42,6 +42,7 @@ def test_each_open_rival_is_swapped_in_for_the_candidate_with_the_later_cause_ke
     causes, verdicts, rounds, _ = _record()
     jobs = swap_jobs(causes, verdicts, rounds)
     assert [(k, label, tuple(v.label for v in variants)) for k, label, variants in jobs] == [
+        (0, WITHOUT, ("clearance",)),  # the candidate must still earn its place
         (0, "channel_timing", ("channel_timing", "clearance")), (0, "bandwidth", ("bandwidth", "clearance"))]
     # without a later cause the swap is the round's own comparison: nothing to ask
     assert swap_jobs(causes[:1], verdicts[:1], rounds[:1]) == []
@@ -66,10 +67,10 @@ class _Fitter:
 def test_a_rival_the_final_model_rules_out_is_resolved_and_the_candidate_named_only_when_all_are():
     causes, verdicts, rounds, final = _record()
     good = np.asarray(final.elpd.pointwise)
-    fitter = _Fitter({"channel_timing": good - 1.0, "bandwidth": good - 1.0})  # 200 nats worse, every block
+    fitter = _Fitter({"clearance": good - 1.0, "channel_timing": good - 1.0, "bandwidth": good - 1.0})  # 200 nats
     out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0)
-    assert fitter.asked == ["channel_timing+clearance", "bandwidth+clearance"]
-    assert [s.ruling for s in swaps] == ["elpd", "elpd"] and swaps[0].delpd > 100
+    assert fitter.asked == ["clearance", "channel_timing+clearance", "bandwidth+clearance"]
+    assert [s.ruling for s in swaps] == ["elpd", "elpd", "elpd"] and swaps[1].delpd > 100
     assert out[0].resolved == ("channel_timing", "bandwidth")
     assert unresolved_rounds(causes, out) == ()
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["dispersion", "clearance"]
@@ -77,10 +78,19 @@ def test_a_rival_the_final_model_rules_out_is_resolved_and_the_candidate_named_o
     assert [v.mechanism.name for v in named_causes(causes, verdicts)] == ["clearance"]
 
     # a rival that explains the record as well with the clearance in the model stays open: dispersion is not named
-    fitter = _Fitter({"channel_timing": good - 1.0, "bandwidth": good + np.random.default_rng(1).normal(0, 0.05, N)})
+    alike = good + np.random.default_rng(1).normal(0, 0.05, N)
+    fitter = _Fitter({"clearance": good - 1.0, "channel_timing": good - 1.0, "bandwidth": alike})
     out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0)
-    assert [s.ruling for s in swaps] == ["elpd", None]
+    assert [s.ruling for s in swaps] == ["elpd", "elpd", None]
     assert out[0].resolved == ("channel_timing",) and unresolved_rounds(causes, out) == (0,)
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
+
+    # a candidate the later cause makes superfluous (the model without it predicts as well) resolves nothing, however
+    # much worse its rivals are: a rival named in a later round may have been what it stood for
+    fitter = _Fitter({"clearance": alike, "channel_timing": good - 1.0, "bandwidth": good - 1.0})
+    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0)
+    assert [s.ruling for s in swaps] == [None, "elpd", "elpd"]
+    assert out[0].resolved == () and unresolved_rounds(causes, out) == (0,)
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
 
 
@@ -90,13 +100,15 @@ def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
 
     causes, verdicts, rounds, final = _record()
     good = np.asarray(final.elpd.pointwise)
-    out, swaps = check_swaps(_Fitter({"channel_timing": good - 1.0, "bandwidth": good - 1.0}), final, causes,
+    out, swaps = check_swaps(_Fitter({"clearance": good - 0.5, "channel_timing": good - 1.0, "bandwidth": good - 1.0}),
+                             final, causes,
                              verdicts, rounds, rule=NamingRule(), workers=1, seed=0)
     dg = Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
                    separate_by=None, final=final, verdicts=tuple(out), swaps=swaps)
     words = _swapped(dg)
     assert words.startswith(" dispersion was one of the candidates of its round; with clearance in the model, each of "
                             "its rivals explains the record worse (channel_timing 200 +- "), words
+    assert words.endswith("bandwidth 200 +- 0 nats; without it, 100 +- 0 nats worse)."), words
     # without the swaps, nothing is said
     assert _swapped(Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
                               separate_by=None, final=final, verdicts=tuple(verdicts))) == ""

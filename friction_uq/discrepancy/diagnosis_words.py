@@ -267,15 +267,17 @@ def _swapped(dg: Diagnosis) -> str:
     (:mod:`.rival_swaps`); '' when none."""
     out = []
     for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
-        done = [s for s in dg.swaps if s.round == k and s.ruling is not None]
+        done = [s for s in dg.swaps if s.round == k and s.ruling is not None and s.rival in v.resolved]
         if not done or dg.causes[k] not in dg.named_causes:
             continue
         by = {c.label: c.variant for c in v.candidates}
         others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
         worse = ", ".join(f"{by[s.rival]} {s.delpd:.0f} +- {s.se:.0f} nats" + (" (by the weight)" if s.ruling == "weight"
                                                                                else "") for s in done)
+        alone = next((f"; without it, {s.delpd:.0f} +- {s.se:.0f} nats worse" for s in dg.swaps
+                      if s.round == k and s.rival not in by), "")
         out.append(f" {dg.causes[k].mechanism.name} was one of the candidates of its round; with {others} in the model, "
-                   f"each of its rivals explains the record worse ({worse}).")
+                   f"each of its rivals explains the record worse ({worse}{alone}).")
     return "".join(out)
 
 

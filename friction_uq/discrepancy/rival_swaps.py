@@ -12,6 +12,12 @@ each such swap (:meth:`.verdict.NamingRule.ruling`: decisively better, or by the
 taken over the final model and its swaps). A rival ruled out is resolved (``Verdict.resolved``); when every open
 rival of a round is, the candidate fitted in turn is named (``Diagnosis.named_causes``).
 
+The candidate must also still earn its place: the final model without it (:data:`WITHOUT`, the other causes
+kept) must be ruled out the same way, or no rival of its round is resolved. On an axisymmetric record with a slip
+law and plug friction, a zero drift was fitted in turn among candidates (the plug friction, a channel's timing),
+the plug friction was named in the next round, and the timing swapped in explained the record worse; but with the
+plug friction in the model the zero drift was not needed, and without this test it would have been named.
+
 Asked only when the final model holds a cause besides the candidate: without one the swap is the round's own
 comparison, already judged. A rival of the same group as another cause (a second friction law) cannot be swapped
 in and stays open; so does one the final model does not rule out.
@@ -26,6 +32,10 @@ from .candidates_mixture import open_rivals
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant
 from .verdict import WEIGHT_RULE, NamingRule, Verdict, round_weights
+
+
+#: The ``rival`` of the swap that leaves the candidate out (the final model without it).
+WITHOUT = "(without it)"
 
 
 @dataclass(frozen=True)
@@ -45,17 +55,21 @@ class Swap:
 
 def swap_jobs(causes: list[Variant], verdicts: list[Verdict], rounds: list) -> list[tuple[int, str, tuple[Variant, ...]]]:
     """(round, rival label, the final model's variants with the round's candidate replaced by the rival) for each
-    rival a round of candidates left open that can be swapped in (module docstring)."""
+    rival a round of candidates left open that can be swapped in, after (round, :data:`WITHOUT`, the variants
+    without the candidate) for each such round (module docstring)."""
     if len(causes) < 2:
         return []
     out = []
     for k, verdict in enumerate(verdicts[:len(causes)]):
         fits = {r.fit.label: r.fit for r in rounds[k]}
         groups = {v.mechanism.group for j, v in enumerate(causes) if j != k and v.mechanism.group}
+        swaps = []
         for label in open_rivals(verdict, causes):
             rival = fits[label].variants[-1]
             if rival.mechanism.group is None or rival.mechanism.group not in groups:
-                out.append((k, label, tuple(causes[:k]) + (rival,) + tuple(causes[k + 1:])))
+                swaps.append((k, label, tuple(causes[:k]) + (rival,) + tuple(causes[k + 1:])))
+        if swaps:
+            out += [(k, WITHOUT, tuple(causes[:k]) + tuple(causes[k + 1:])), *swaps]
     return out
 
 
@@ -79,6 +93,9 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
         swaps.append(Swap(k, label, f.label, d, se, weights[f.label], how))
     out = list(verdicts)
     for k in {s.round for s in swaps}:
-        done = tuple(s.rival for s in swaps if s.round == k and s.ruling is not None)
+        mine = [s for s in swaps if s.round == k]
+        if any(s.rival == WITHOUT and s.ruling is None for s in mine):
+            continue  # the candidate is not needed with the later causes in the model: nothing is resolved
+        done = tuple(s.rival for s in mine if s.rival != WITHOUT and s.ruling is not None)
         out[k] = replace(out[k], resolved=out[k].resolved + done)
     return out, tuple(swaps)
