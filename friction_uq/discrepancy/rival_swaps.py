@@ -33,7 +33,6 @@ from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant
 from .verdict import WEIGHT_RULE, NamingRule, Verdict, round_weights
 
-
 #: The ``rival`` of the swap that leaves the candidate out (the final model without it).
 WITHOUT = "(without it)"
 
