@@ -102,8 +102,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
                         f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (given the headers; the sentence's f to quote adds the bars' calibration)")
     lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
                   "round's reference is > 4 and > 2 SE, still is with the 5 % of blocks most in its favour left "
-                  "out, and rules out every other mechanism (by the same margin, or, when the other stays > 4 behind "
-                  "with those blocks left out, by carrying under 0.1 of the stacking weight); several it does not "
+                  "out, and rules out every other mechanism (by the same margin, or when the other stays > 4 behind "
+                  "with those blocks left out and carries under 0.1 of the stacking weight); several it does not "
                   "rule out are candidates, a misfit none explains is unexplained (f then from the stacking mixture, "
                   "half of it the stationary analysis' f when nothing is named); "
                   "after a named cause the search goes on with it in the model."]
