@@ -102,16 +102,17 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
                         f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (given the headers; the sentence's f to quote adds the bars' calibration)")
     lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
                   "round's reference is > 4 and > 2 SE, still is with the 5 % of blocks most in its favour left "
-                  "out, and rules out every other mechanism (by the same margin, or when the other stays > 4 behind "
-                  "with those blocks left out and carries under 0.1 of the stacking weight); several it does not "
-                  "rule out are candidates, a misfit none explains is unexplained (f then from the stacking mixture, "
+                  "out, and rules out every other mechanism (by the same margin, or the other is > 4 behind without "
+                  "those blocks and carries < 0.1 of the weight); others not ruled out make candidates, a misfit none explains is unexplained (f then from the stacking mixture, "
                   "half of it the stationary analysis' f when nothing is named); "
                   "after a named cause the search goes on with it in the model."]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")
     text = "\n".join(textwrap.fill(line, WRAP) if line else line for line in lines)
-    ax2.text(0.0, 1.0, text, va="top", fontsize=8, transform=ax2.transAxes)
+    # 8 pt holds about 54 wrapped lines in the column; a record with four causes says more: the type shrinks to fit
+    lines_in = text.count("\n") + 1
+    ax2.text(0.0, 1.0, text, va="top", fontsize=min(8.0, max(5.5, 8.0 * 54 / lines_in)), transform=ax2.transAxes)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     return fig
 
