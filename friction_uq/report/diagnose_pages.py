@@ -110,7 +110,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")
     text = "\n".join(textwrap.fill(line, WRAP) if line else line for line in lines)
-    # 8 pt holds about 44 wrapped lines above the page's foot (B-02's 52 ran to its edge); a record with four causes says more: the type shrinks to fit
+    # 8 pt holds about 44 wrapped lines above the page's foot (B-02's 52 ran to its edge); a record with four
+    # causes says more: the type shrinks to fit
     lines_in = text.count("\n") + 1
     ax2.text(0.0, 1.0, text, va="top", fontsize=min(8.0, max(5.5, 8.0 * 44 / lines_in)), transform=ax2.transAxes)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
