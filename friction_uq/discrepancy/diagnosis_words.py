@@ -254,10 +254,10 @@ def _by_weight(dg: Diagnosis) -> str:
         if v.kind != "named" or not v.by_weight or dg.causes[k] not in dg.named_causes:
             continue
         by = {c.label: c.variant for c in v.candidates}
-        light = sum(v.weights.get(label, 0.0) for label in v.by_weight)
-        out.append(f" {dg.causes[k].mechanism.name} was preferred to {', '.join(by[x] for x in v.by_weight)} by the "
-                   f"stacking weight, not by 2 SE of the evidence: they stay more than 4 nats behind it with the "
-                   f"blocks that favour it most left out, and carry {light:.2f} of the weight together.")
+        out.append(f" {dg.causes[k].label} was preferred to {', '.join(by[x] for x in v.by_weight)} by the stacking "
+                   f"weight, not by 2 SE of the evidence: each stays more than 4 nats behind it with the blocks that "
+                   f"favour it most left out, and carries under 0.1 of the weight with the models that predict alike "
+                   f"with it.")
     return "".join(out)
 
 

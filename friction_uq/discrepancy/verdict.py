@@ -14,8 +14,9 @@ answers each before it names a mechanism:
 3. **Is it decisive against every rival?** The best such mechanism must rule out each other mechanism:
    beat it by the same rule, or (``by_weight``) lead it by more than 4 nats with the blocks that favour the
    best most left out (the spread test's share) while the rival, with the mechanisms as far behind that
-   predict alike with it, carries less than 0.1 of the stacking weight (:meth:`friction_uq.stats.WeightRule.
-   ruled_out`, the route the campaign's law comparison takes). Otherwise the record does not separate them.
+   predict alike with it, carries less than 0.1 of the stacking weight and is not among the models that carry
+   90 % of it (:meth:`friction_uq.stats.WeightRule.ruled_out`, the route the campaign's law comparison takes).
+   Otherwise the record does not separate them.
    The SE of a sum over hundreds of blocks is dominated by the few where two mechanisms part (a front, the
    unloading): a second cause behind a first one leads its rivals by tens of nats spread over the record and
    holds the whole weight, yet stays within 2 SE.
@@ -156,12 +157,13 @@ class NamingRule:
         """The models ``best`` does not rule out (module docstring, 3.), and the labels of those it rules out
         only by the weight route."""
         behind = {"reference": best.delpd} | {c.label: best.delpd - c.delpd for c in cands}
+        carried = set(WEIGHT_RULE.supported(weights))  # as in the campaign: the weight never rules these out
         rivals, light = [], []
         for c in (cands if self.against_all else passing):
             if c.label == best.label:
                 continue
-            how = self.ruling(fits[best.label].elpd, fits[c.label].elpd,
-                              weight=WEIGHT_RULE.alike_weight(weights, behind, c.label), drop=drop)
+            weight = 1.0 if c.label in carried else WEIGHT_RULE.alike_weight(weights, behind, c.label)
+            how = self.ruling(fits[best.label].elpd, fits[c.label].elpd, weight=weight, drop=drop)
             if how is None:
                 rivals.append(c)
             elif how == "weight":
