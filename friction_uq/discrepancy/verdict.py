@@ -162,8 +162,10 @@ class NamingRule:
         for c in (cands if self.against_all else passing):
             if c.label == best.label:
                 continue
-            weight = 1.0 if c.label in carried else WEIGHT_RULE.alike_weight(weights, behind, c.label)
-            how = self.ruling(fits[best.label].elpd, fits[c.label].elpd, weight=weight, drop=drop)
+            how = self.ruling(fits[best.label].elpd, fits[c.label].elpd,
+                              weight=WEIGHT_RULE.alike_weight(weights, behind, c.label), drop=drop)
+            if how == "weight" and c.label in carried:
+                how = None
             if how is None:
                 rivals.append(c)
             elif how == "weight":

@@ -103,7 +103,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
                   "round's reference is > 4 and > 2 SE, still is with the 5 % of blocks most in its favour left "
                   "out, and rules out every other mechanism (by the same margin, or the other is > 4 behind without "
-                  "those blocks and carries < 0.1 of the weight); others not ruled out make candidates, a misfit none explains is unexplained (f then from the stacking mixture, "
+                  "those blocks and carries < 0.1 of the weight); others not ruled out make candidates, a misfit "
+                  "none explains is unexplained (f then from the stacking mixture, "
                   "half of it the stationary analysis' f when nothing is named); "
                   "after a named cause the search goes on with it in the model."]
     if m0 is not None:
