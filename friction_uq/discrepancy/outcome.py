@@ -103,7 +103,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                 "the record), and rules out every other extended model (by the same margin, or by the stacking weight: "
                 "more than 4 behind with the 5 % of blocks that favour the best left out, under 0.1 of the weight with "
                 "the models as far behind that predict alike); several it does not rule out are candidates, a misfit "
-                "none explains is unexplained, and f is then the stacking mixture of the models that carry the weight (in equal parts with the stationary analysis' f when "
+                "none explains is unexplained, and f is then the stacking mixture of the models that carry the weight "
+                "(in equal parts with the stationary analysis' f when "
                 "nothing is named, with run); after a named cause the search goes on with it in the model",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
