@@ -44,16 +44,17 @@ def unresolved_rounds(causes, verdicts) -> tuple[int, ...]:
     model (an alternative to the candidate fitted in turn, not a second cause): the record does not tell them
     apart. A rival that is the same mechanism on another gauge does not count (the mechanism is named, its
     gauge uncertain)."""
-    return tuple(k for k, verdict in enumerate(verdicts) if _open_rivals(verdict, causes))
+    return tuple(k for k, verdict in enumerate(verdicts) if open_rivals(verdict, causes))
 
 
-def _open_rivals(verdict: Verdict, causes) -> list[str]:
-    """The labels of a round of candidates' rivals whose mechanism no round put in the model ([] otherwise)."""
+def open_rivals(verdict: Verdict, causes) -> list[str]:
+    """The labels of a round of candidates' rivals whose mechanism no round put in the model and that no later check
+    ruled out (``Verdict.resolved``, :mod:`.rival_swaps`) ([] otherwise)."""
     if verdict.kind != "candidates":
         return []
     named = {v.mechanism.name for v in causes}
     by = {c.label: c.mechanism for c in verdict.candidates}
-    return [label for label in verdict.rivals if by[label] not in named]
+    return [label for label in verdict.rivals if by[label] not in named and label not in verdict.resolved]
 
 
 def named_causes(causes, verdicts) -> list:
@@ -72,7 +73,7 @@ def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes
     (module docstring)."""
     for k in unresolved_rounds(causes, verdicts)[:1]:
         verdict = verdicts[k]
-        left = _open_rivals(verdict, causes)
+        left = open_rivals(verdict, causes)
         fits = {r.fit.label: r.fit for r in rounds[k]}
         draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
         w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}

@@ -38,6 +38,7 @@ from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide
 from .candidates_mixture import further_mixture, mixture, named_causes, rival_mixture, unresolved_rounds
+from .rival_swaps import Swap, check_swaps, swap_jobs
 from .verdict import NamingRule, Verdict
 from .whole_record import WholeRecord, compare_whole_record
 
@@ -130,6 +131,9 @@ class Diagnosis:
     mixture_weights: dict[str, float] = field(default_factory=dict)
     #: for each mixture draw, the index (in mixture_weights' order) of the model it was drawn from
     mixture_source: np.ndarray | None = None
+    #: the candidates fitted in turn against the rivals their rounds left open, with the later causes in the model
+    #: (:mod:`.rival_swaps`; the verdicts' ``resolved`` holds the rivals ruled out)
+    swaps: tuple[Swap, ...] = ()
 
     @property
     def verdict(self) -> Verdict | None:
@@ -222,8 +226,16 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     base = dg.fit((), start, "baseline")
     st = _search(dg, prep, _Search(base, base), max_causes=max_causes, workers=workers, seed=seed, say=say, t0=t0)
     final, causes, rounds, verdicts = st.reference, st.causes, st.rounds, st.verdicts
-    if st.not_sep and {m for m in st.not_sep[1:]} <= {v.mechanism.name for v in causes}:
-        st.not_sep, st.separate_by = (), None  # the rivals of round 1 were second causes, named in later rounds
+    swaps: tuple[Swap, ...] = ()
+    if swap_jobs(causes, verdicts, rounds):
+        say("the candidates fitted in turn against their open rivals, with the later causes in the model")
+        verdicts, swaps = check_swaps(
+            dg, final, causes, verdicts, rounds, rule=NAMING, workers=workers, seed=seed + len(rounds),
+            flagged=lambda fit: decide(compare_whole_record(prep, dg.predictive(fit))).detected)
+    if st.not_sep and verdicts and set(st.not_sep[1:]) <= {v.mechanism.name for v in causes} | {
+            c.mechanism for c in verdicts[0].candidates if c.label in verdicts[0].resolved}:
+        # the rivals of round 1 were second causes, named in later rounds, or ruled out with them in the model
+        st.not_sep, st.separate_by = (), None
     say("posterior predictive of the final model")
     if causes and len(next(iter(final.predicted.values()))) == 1:  # the mode only: a cause of the last round
         final = replace(final, predicted=dg.predictive(final))
@@ -245,7 +257,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
                      posterior_method=method, context=dg.context, seed=seed, verdicts=tuple(verdicts),
-                     mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src)
+                     mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src, swaps=swaps)
 
 
 def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, workers: int, seed: int,

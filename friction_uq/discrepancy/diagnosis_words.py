@@ -235,7 +235,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from "
             f"the stationary analysis {'alone' if STATIONARY in dg.mixture_weights else 'without them'}. Why: "
             f"{_describe(dg)}; the {evidence}'s evidence is "
-            f"{first.delpd:.0f} +- {first.se:.0f} nats.{_by_weight(dg)}{sep}{_remaining(dg)}"
+            f"{first.delpd:.0f} +- {first.se:.0f} nats.{_by_weight(dg)}{_swapped(dg)}{sep}{_remaining(dg)}"
             f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
 
 
@@ -258,6 +258,26 @@ def _by_weight(dg: Diagnosis) -> str:
                    f"weight, not by 2 SE of the evidence: each stays more than 4 nats behind it with the blocks that "
                    f"favour it most left out, and carries under 0.1 of the weight with the models that predict alike "
                    f"with it.")
+    return "".join(out)
+
+
+def _swapped(dg: Diagnosis) -> str:
+    """' X was one of the candidates of its round; with the other causes in the model, each of its rivals explains the
+    record worse (...).' for each named cause whose round's rivals the swap check resolved
+    (:mod:`.rival_swaps`); '' when none."""
+    out = []
+    for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
+        done = [s for s in dg.swaps if s.round == k and s.ruling is not None and s.rival in v.resolved]
+        if not done or dg.causes[k] not in dg.named_causes:
+            continue
+        by = {c.label: c.variant for c in v.candidates}
+        others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
+        worse = ", ".join(f"{by[s.rival]} {s.delpd:.0f} +- {s.se:.0f} nats" + (" (by the weight)" if s.ruling == "weight"
+                                                                               else "") for s in done)
+        alone = next((f"; without it, {s.delpd:.0f} +- {s.se:.0f} nats worse, and a misfit the whole-record check "
+                      f"flags" for s in dg.swaps if s.round == k and s.rival not in by), "")
+        out.append(f" {dg.causes[k].mechanism.name} was one of the candidates of its round; with {others} in the model, "
+                   f"each of its rivals explains the record worse ({worse}{alone}).")
     return "".join(out)
 
 

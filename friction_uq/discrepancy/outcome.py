@@ -76,6 +76,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.named_causes],
         "fitted_in_turn": [c.label for c in dg.causes],
         "open_candidates": list(dg.open_candidates),
+        # the candidates fitted in turn against their rounds' open rivals, with the later causes in the model
+        "swaps": [{"round": sw.round + 1, "rival": sw.rival, "model": sw.model, "delpd": sw.delpd, "se": sw.se,
+                   "weight": sw.weight, "ruled_out": sw.ruling, "check_flags": sw.flagged} for sw in dg.swaps],
         "not_separable": list(dg.not_separable),
         "separate_by": dg.separate_by,
         "ranking": [_entry(r, v) for r in dg.ranking],
@@ -105,7 +108,10 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                 "the models as far behind that predict alike); several it does not rule out are candidates, a misfit "
                 "none explains is unexplained, and f is then the stacking mixture of the models that carry the weight "
                 "(in equal parts with the stationary analysis' f when "
-                "nothing is named, with run); after a named cause the search goes on with it in the model",
+                "nothing is named, with run); after a named cause the search goes on with it in the model; a candidate "
+                "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
+                "left open by the same rule, and the model without it is ruled out and fails the whole-record check "
+                "(swaps)",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "

@@ -96,6 +96,8 @@ class Verdict:
     dropped: int = 0  # blocks left out by the spread test
     #: labels of the models the named one rules out only by the weight route (not by 2 SE of dELPD)
     by_weight: tuple[str, ...] = ()
+    #: labels of rivals a later check ruled out with the later causes in the model (:mod:`.rival_swaps`)
+    resolved: tuple[str, ...] = ()
 
     @property
     def supported(self) -> list[str]:

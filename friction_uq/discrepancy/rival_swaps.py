@@ -1,0 +1,114 @@
+"""A candidate fitted in turn, checked against the rivals its round left open, with the later causes in the model.
+
+A round of candidates puts its best in the model and the search goes on (:mod:`.diagnose`). When a later round
+names a further cause, the first round's question (which of the candidates explains the record?) can be asked
+again with that cause in the model. On a 1-D record with a clearance and dispersion, dispersion, a channel's
+timing and an amplifier's bandwidth explain the first misfit about alike, since the clearance's own signature sits
+at the same fronts; with the clearance in the model, the candidates part.
+
+For each rival a round left open, :func:`check_swaps` fits the final model with the candidate fitted in turn
+replaced by the rival (the other causes kept) and asks the naming rule's question of the final model against
+each such swap (:meth:`.verdict.NamingRule.ruling`: decisively better, or by the weight route, the stacking weights
+taken over the final model and its swaps). A rival ruled out is resolved (``Verdict.resolved``); when every open
+rival of a round is, the candidate fitted in turn is named (``Diagnosis.named_causes``).
+
+The candidate must also still earn its place: the final model without it (:data:`WITHOUT`, the other causes
+kept) must be ruled out the same way, or no rival of its round is resolved. On an axisymmetric record with a slip
+law and plug friction, a zero drift was fitted in turn among candidates (the plug friction, a channel's timing),
+the plug friction was named in the next round, and the timing swapped in explained the record worse; but with the
+plug friction in the model the zero drift was not needed, and without this test it would have been named.
+
+And the model without it must miss the record by more than two simulators of the same test differ: the whole-record
+check (:mod:`.misfit`, the first round's misfit gate, its tolerance calibrated on records the 1-D model did not make)
+must flag it (``flagged``). On another axisymmetric record with the same pair, the zero drift still gained
+125 +- 33 nats with the slip law and the plug friction in the model: a flexible transient on the hoop gauge absorbs
+where the axisymmetric cell's hoop strain departs from the 1-D model's, which the ELPD rule sees as evidence and the
+check's tolerance forgives.
+
+Asked only when the final model holds a cause besides the candidate: without one the swap is the round's own
+comparison, already judged. A rival of the same group as another cause (a second friction law) cannot be swapped
+in and stays open; so does one the final model does not rule out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+from ..stats.trimmed import points_to_drop
+from .candidates_mixture import open_rivals
+from .elpd import elpd_difference
+from .extended import Diagnoser, ModelFit, Variant
+from .verdict import WEIGHT_RULE, NamingRule, Verdict, round_weights
+
+#: The ``rival`` of the swap that leaves the candidate out (the final model without it).
+WITHOUT = "(without it)"
+
+
+@dataclass(frozen=True)
+class Swap:
+    """The final model against one swap: the round, the rival (its label in that round), the swapped model's label,
+    the final model's dELPD over it +- SE, the swap's stacking weight beside the final model and the other swaps,
+    how the final model rules it out ("elpd", "weight" or None: it does not), and for the model without the
+    candidate whether the whole-record check flags it (None: not asked, for a rival or when it is not ruled out)."""
+
+    round: int
+    rival: str
+    model: str
+    delpd: float
+    se: float
+    weight: float
+    ruling: str | None
+    flagged: bool | None = None
+
+
+def swap_jobs(causes: list[Variant], verdicts: list[Verdict], rounds: list) -> list[tuple[int, str, tuple[Variant, ...]]]:
+    """(round, rival label, the final model's variants with the round's candidate replaced by the rival) for each
+    rival a round of candidates left open that can be swapped in, after (round, :data:`WITHOUT`, the variants
+    without the candidate) for each such round (module docstring)."""
+    if len(causes) < 2:
+        return []
+    out = []
+    for k, verdict in enumerate(verdicts[:len(causes)]):
+        fits = {r.fit.label: r.fit for r in rounds[k]}
+        groups = {v.mechanism.group for j, v in enumerate(causes) if j != k and v.mechanism.group}
+        swaps = []
+        for label in open_rivals(verdict, causes):
+            rival = fits[label].variants[-1]
+            if rival.mechanism.group is None or rival.mechanism.group not in groups:
+                swaps.append((k, label, tuple(causes[:k]) + (rival,) + tuple(causes[k + 1:])))
+        if swaps:
+            out += [(k, WITHOUT, tuple(causes[:k]) + tuple(causes[k + 1:])), *swaps]
+    return out
+
+
+def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts: list[Verdict], rounds: list, *,
+                rule: NamingRule, flagged: Callable[[ModelFit], bool], workers: int,
+                seed: int) -> tuple[list[Verdict], tuple[Swap, ...]]:
+    """The verdicts with each round's rivals that the final model rules out against their swaps marked resolved,
+    and every swap's comparison (module docstring). ``flagged``: the whole-record check's decision on a fitted
+    model (True: a misfit beyond the tolerance), asked of a model without a candidate that the final model rules
+    out."""
+    jobs = swap_jobs(causes, verdicts, rounds)
+    if not jobs:
+        return verdicts, ()
+    start = dict(final.fit.mode)
+    fits = dg.fit_many([(variants, start, "+".join(v.label for v in variants)) for _, _, variants in jobs],
+                       workers=workers)
+    weights = round_weights(final, fits, seed)
+    behind = {"reference": 0.0} | {f.label: elpd_difference(final.elpd, f.elpd)[0] for f in fits}
+    drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
+    swaps = []
+    for (k, label, _), f in zip(jobs, fits):
+        d, se = elpd_difference(final.elpd, f.elpd)
+        how = rule.ruling(final.elpd, f.elpd, weight=WEIGHT_RULE.alike_weight(weights, behind, f.label), drop=drop)
+        misfit = flagged(f) if label == WITHOUT and how is not None else None
+        swaps.append(Swap(k, label, f.label, d, se, weights[f.label], how, misfit))
+    out = list(verdicts)
+    for k in {s.round for s in swaps}:
+        mine = [s for s in swaps if s.round == k]
+        if any(s.rival == WITHOUT and not s.flagged for s in mine):
+            continue  # the candidate is not needed with the later causes in the model: nothing is resolved
+        done = tuple(s.rival for s in mine if s.rival != WITHOUT and s.ruling is not None)
+        out[k] = replace(out[k], resolved=out[k].resolved + done)
+    return out, tuple(swaps)

@@ -1,0 +1,144 @@
+"""The candidate fitted in turn against its round's open rivals, with the later causes in the model
+(friction_uq.discrepancy.rival_swaps): which swaps are fitted, and which rivals the final model rules out."""
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from friction_uq.discrepancy.candidates_mixture import named_causes, unresolved_rounds
+from friction_uq.discrepancy.elpd import Elpd
+from friction_uq.discrepancy.extended import Variant
+from friction_uq.discrepancy.mechanisms import MECHANISMS
+from friction_uq.discrepancy.rival_swaps import WITHOUT, check_swaps, swap_jobs
+from friction_uq.discrepancy.verdict import Candidate, NamingRule, Verdict
+
+N = 200
+
+
+def _fit(label, blocks):
+    variants = tuple(Variant(MECHANISMS[x]) for x in label.split("+"))
+    return SimpleNamespace(label=label, variants=variants, elpd=Elpd(np.asarray(blocks, float), float("nan")),
+                           f_effective=np.full(50, 0.05), fit=SimpleNamespace(mode={"f": 0.05, "nu": 0.4}))
+
+
+def _cand(label):
+    return Candidate(label, label.split("+")[-1], None, 100.0, 10.0, 90.0, 10.0, 0.3, True, True)
+
+
+def _record(first_rivals=("channel_timing", "bandwidth"), second="clearance", first="dispersion"):
+    """Round 1: candidates, ``first`` fitted in turn, ``first_rivals`` open; round 2: ``second`` named."""
+    noise = np.random.default_rng(0).normal(0.0, 0.3, N)
+    r1 = [_fit(x, noise) for x in (first, *first_rivals)]
+    r2 = [_fit(f"{first}+{second}", noise + 1.0)]
+    v1 = Verdict("candidates", tuple(_cand(f.label) for f in r1), {"reference": 0.0} | {f.label: 0.3 for f in r1},
+                 named=first, rivals=tuple(first_rivals))
+    v2 = Verdict("named", (_cand(r2[0].label),), {"reference": 0.0, r2[0].label: 1.0}, named=r2[0].label)
+    rounds = [tuple(SimpleNamespace(fit=f) for f in r1), tuple(SimpleNamespace(fit=f) for f in r2)]
+    causes = [Variant(MECHANISMS[first]), Variant(MECHANISMS[second])]
+    return causes, [v1, v2], rounds, r2[0]
+
+
+def test_each_open_rival_is_swapped_in_for_the_candidate_with_the_later_cause_kept():
+    causes, verdicts, rounds, _ = _record()
+    jobs = swap_jobs(causes, verdicts, rounds)
+    assert [(k, label, tuple(v.label for v in variants)) for k, label, variants in jobs] == [
+        (0, WITHOUT, ("clearance",)),  # the candidate must still earn its place
+        (0, "channel_timing", ("channel_timing", "clearance")), (0, "bandwidth", ("bandwidth", "clearance"))]
+    # without a later cause the swap is the round's own comparison: nothing to ask
+    assert swap_jobs(causes[:1], verdicts[:1], rounds[:1]) == []
+    # a second friction law cannot join the model beside a named one: the rival stays open
+    causes, verdicts, rounds, _ = _record(first_rivals=("velocity_friction",), first="clearance",
+                                          second="pressure_friction")
+    assert swap_jobs(causes, verdicts, rounds) == []
+
+
+class _Fitter:
+    """Stands in for the Diagnoser: each swapped model's pointwise ELPD given by the rival it holds."""
+
+    def __init__(self, blocks):
+        self.blocks = blocks
+        self.asked = []
+
+    def fit_many(self, jobs, workers):
+        self.asked += [label for _, _, label in jobs]
+        return [_fit(label, self.blocks[label.split("+")[0]]) for _, _, label in jobs]
+
+
+def test_a_rival_the_final_model_rules_out_is_resolved_and_the_candidate_named_only_when_all_are():
+    causes, verdicts, rounds, final = _record()
+    good = np.asarray(final.elpd.pointwise)
+    fitter = _Fitter({"clearance": good - 1.0, "channel_timing": good - 1.0, "bandwidth": good - 1.0})  # 200 nats
+    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                                  flagged=lambda fit: True)
+    assert fitter.asked == ["clearance", "channel_timing+clearance", "bandwidth+clearance"]
+    assert [s.ruling for s in swaps] == ["elpd", "elpd", "elpd"] and swaps[1].delpd > 100
+    assert out[0].resolved == ("channel_timing", "bandwidth")
+    assert unresolved_rounds(causes, out) == ()
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["dispersion", "clearance"]
+    # before the check, dispersion was a candidate fitted in turn, not named
+    assert [v.mechanism.name for v in named_causes(causes, verdicts)] == ["clearance"]
+
+    # a rival that explains the record as well with the clearance in the model stays open: dispersion is not named
+    alike = good + np.random.default_rng(1).normal(0, 0.05, N)
+    fitter = _Fitter({"clearance": good - 1.0, "channel_timing": good - 1.0, "bandwidth": alike})
+    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                                  flagged=lambda fit: True)
+    assert [s.ruling for s in swaps] == ["elpd", "elpd", None]
+    assert out[0].resolved == ("channel_timing",) and unresolved_rounds(causes, out) == (0,)
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
+
+    # a candidate the later cause makes superfluous (the model without it predicts as well) resolves nothing, however
+    # much worse its rivals are: a rival named in a later round may have been what it stood for
+    fitter = _Fitter({"clearance": alike, "channel_timing": good - 1.0, "bandwidth": good - 1.0})
+    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                                  flagged=lambda fit: True)
+    assert [s.ruling for s in swaps] == [None, "elpd", "elpd"]
+    assert out[0].resolved == () and unresolved_rounds(causes, out) == (0,)
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
+
+
+def test_a_model_without_the_candidate_within_the_check_s_tolerance_resolves_nothing():
+    """The ELPD rule sees a flexible transient that absorbs model form as evidence; the whole-record check's tolerance
+    (what two simulators differ by) forgives it. Without the candidate the model must miss by more than that."""
+    causes, verdicts, rounds, final = _record()
+    good = np.asarray(final.elpd.pointwise)
+    fitter = _Fitter({"clearance": good - 1.0, "channel_timing": good - 1.0, "bandwidth": good - 1.0})
+    asked = []
+
+    def within(fit):
+        asked.append(fit.label)
+        return False
+
+    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                             flagged=within)
+    assert asked == ["clearance"]  # only the model without the candidate is checked
+    assert [(s.ruling, s.flagged) for s in swaps] == [("elpd", False), ("elpd", None), ("elpd", None)]
+    assert out[0].resolved == () and unresolved_rounds(causes, out) == (0,)
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
+    # not asked when the model without the candidate is not ruled out in the first place
+    alike = good + np.random.default_rng(1).normal(0, 0.05, N)
+    out, swaps = check_swaps(_Fitter({"clearance": alike, "channel_timing": good - 1.0, "bandwidth": good - 1.0}),
+                             final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0, flagged=within)
+    assert asked == ["clearance"] and swaps[0].flagged is None and out[0].resolved == ()
+
+
+def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
+    from friction_uq.discrepancy.diagnose import Diagnosis
+    from friction_uq.discrepancy.diagnosis_words import _swapped
+
+    causes, verdicts, rounds, final = _record()
+    good = np.asarray(final.elpd.pointwise)
+    out, swaps = check_swaps(_Fitter({"clearance": good - 0.5, "channel_timing": good - 1.0, "bandwidth": good - 1.0}),
+                             final, causes,
+                             verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                                  flagged=lambda fit: True)
+    dg = Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
+                   separate_by=None, final=final, verdicts=tuple(out), swaps=swaps)
+    words = _swapped(dg)
+    assert words.startswith(" dispersion was one of the candidates of its round; with clearance in the model, each of "
+                            "its rivals explains the record worse (channel_timing 200 +- "), words
+    assert words.endswith("bandwidth 200 +- 0 nats; without it, 100 +- 0 nats worse, and a misfit the whole-record "
+                          "check flags)."), words
+    # without the swaps, nothing is said
+    assert _swapped(Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
+                              separate_by=None, final=final, verdicts=tuple(verdicts))) == ""
