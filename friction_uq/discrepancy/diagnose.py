@@ -155,7 +155,7 @@ class Diagnosis:
             return ()
         v = self.verdicts[rounds[0]]
         by = {c.label: c.variant for c in v.candidates}
-        return tuple(by[label] for label in (v.named, *v.rivals))
+        return tuple(by[label] for label in (v.named, *v.rivals) if label not in v.resolved)
 
     @property
     def cause(self) -> Variant | None:
@@ -232,8 +232,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         verdicts, swaps = check_swaps(
             dg, final, causes, verdicts, rounds, rule=NAMING, workers=workers, seed=seed + len(rounds),
             flagged=lambda fit: decide(compare_whole_record(prep, dg.predictive(fit))).detected)
-    if st.not_sep and verdicts and set(st.not_sep[1:]) <= {v.mechanism.name for v in causes} | {
-            c.mechanism for c in verdicts[0].candidates if c.label in verdicts[0].resolved}:
+    if st.not_sep and verdicts and 0 not in unresolved_rounds(causes, verdicts):
         # the rivals of round 1 were second causes, named in later rounds, or ruled out with them in the model
         st.not_sep, st.separate_by = (), None
     say("posterior predictive of the final model")

@@ -25,8 +25,8 @@ must flag it (``flagged``). On another axisymmetric record with the same pair, t
 where the axisymmetric cell's hoop strain departs from the 1-D model's, which the ELPD rule sees as evidence and the
 check's tolerance forgives.
 
-Asked only when the final model holds a cause besides the candidate: without one the swap is the round's own
-comparison, already judged. A rival of the same group as another cause (a second friction law) cannot be swapped
+Asked only of a round followed by a later cause: for the last cause's round the swap is the round's own
+comparison, already judged. The weight route is the naming rule's own, its 90 % guard included. A rival of the same group as another cause (a second friction law) cannot be swapped
 in and stays open; so does one the final model does not rule out.
 """
 
@@ -69,7 +69,7 @@ def swap_jobs(causes: list[Variant], verdicts: list[Verdict], rounds: list) -> l
     if len(causes) < 2:
         return []
     out = []
-    for k, verdict in enumerate(verdicts[:len(causes)]):
+    for k, verdict in enumerate(verdicts[:len(causes) - 1]):  # the last cause's round has no later cause
         fits = {r.fit.label: r.fit for r in rounds[k]}
         groups = {v.mechanism.group for j, v in enumerate(causes) if j != k and v.mechanism.group}
         swaps = []
@@ -98,10 +98,12 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
     weights = round_weights(final, fits, seed)
     behind = {"reference": 0.0} | {f.label: elpd_difference(final.elpd, f.elpd)[0] for f in fits}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
+    carried = set(WEIGHT_RULE.supported(weights))
     swaps = []
     for (k, label, _), f in zip(jobs, fits):
         d, se = elpd_difference(final.elpd, f.elpd)
-        how = rule.ruling(final.elpd, f.elpd, weight=WEIGHT_RULE.alike_weight(weights, behind, f.label), drop=drop)
+        how = rule.ruling(final.elpd, f.elpd, weight=WEIGHT_RULE.alike_weight(weights, behind, f.label), drop=drop,
+                          carried=f.label in carried)
         misfit = flagged(f) if label == WITHOUT and how is not None else None
         swaps.append(Swap(k, label, f.label, d, se, weights[f.label], how, misfit))
     out = list(verdicts)

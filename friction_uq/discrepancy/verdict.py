@@ -165,24 +165,27 @@ class NamingRule:
             if c.label == best.label:
                 continue
             how = self.ruling(fits[best.label].elpd, fits[c.label].elpd,
-                              weight=WEIGHT_RULE.alike_weight(weights, behind, c.label), drop=drop)
-            if how == "weight" and c.label in carried:
-                how = None
+                              weight=WEIGHT_RULE.alike_weight(weights, behind, c.label), drop=drop,
+                              carried=c.label in carried)
             if how is None:
                 rivals.append(c)
             elif how == "weight":
                 light.append(c.label)
         return rivals, tuple(light)
 
-    def ruling(self, best, other, *, weight: float, drop: int) -> str | None:
+    def ruling(self, best, other, *, weight: float, drop: int, carried: bool = False) -> str | None:
         """How model ``best`` rules out ``other`` (their :class:`~.elpd.Elpd`): "elpd" (decisively, by the package's
         rule), "weight" (the weight route, module docstring 3.; ``weight``: ``other``'s with the models that predict
-        alike with it, ``drop``: the blocks left out) or None (it does not)."""
+        alike with it, ``drop``: the blocks left out) or None (it does not). ``carried``: ``other`` is among the
+        models that carry 90 % of the weight (:meth:`WeightRule.supported`), which, as in the campaign, the weight
+        never rules out."""
         from .elpd import elpd_difference
 
         d, se = elpd_difference(best, other)
         if RULE.decisive(d, se):
             return "elpd"
+        if carried:
+            return None
         rest = elpd_difference(best, other, drop=drop)[0] if self.by_weight else None
         return "weight" if WEIGHT_RULE.ruled_out(weight, d, se, d_rest=rest) else None
 
