@@ -1,6 +1,7 @@
 """The candidate fitted in turn against its round's open rivals, with the later causes in the model
 (friction_uq.discrepancy.rival_swaps): which swaps are fitted, and which rivals the final model rules out."""
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -50,6 +51,41 @@ def test_each_open_rival_is_swapped_in_for_the_candidate_with_the_later_cause_ke
     causes, verdicts, rounds, _ = _record(first_rivals=("velocity_friction",), first="clearance",
                                           second="pressure_friction")
     assert swap_jobs(causes, verdicts, rounds) == []
+    # the last cause's round: its swaps would be its own comparison again, with no later cause in the model
+    causes, verdicts, rounds, final = _record()
+    rival = _fit("dispersion+bandwidth", final.elpd.pointwise)
+    last = Verdict("candidates", verdicts[1].candidates + (_cand(rival.label),), verdicts[1].weights,
+                   named=verdicts[1].named, rivals=(rival.label,))
+    rounds = [rounds[0], rounds[1] + (SimpleNamespace(fit=rival),)]
+    assert swap_jobs(causes, [replace(verdicts[0], kind="named", rivals=()), last], rounds) == []
+    assert swap_jobs(causes + [Variant(MECHANISMS["plug_friction"])],  # with a cause after it, it is asked
+                     [replace(verdicts[0], kind="named", rivals=()), last, verdicts[1]], rounds + [()])[0][:2] == (
+        1, WITHOUT)
+
+
+def test_a_rival_that_cannot_be_swapped_in_keeps_its_round_open_whatever_the_others_do():
+    causes, verdicts, rounds, final = _record(first_rivals=("velocity_friction", "bandwidth"), first="clearance",
+                                              second="pressure_friction")
+    good = np.asarray(final.elpd.pointwise)
+    fitter = _Fitter({"pressure_friction": good - 1.0, "bandwidth": good - 1.0})
+    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                             flagged=lambda fit: True)
+    assert [s.rival for s in swaps] == [WITHOUT, "bandwidth"]
+    assert out[0].resolved == ("bandwidth",) and unresolved_rounds(causes, out) == (0,)
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["pressure_friction"]
+
+
+def test_the_weight_never_rules_out_a_model_among_those_that_carry_90_percent_of_it():
+    """The naming rule's guard, which the swaps take through the same method: 100 nats ahead but within 2 SE (two
+    blocks carry 80 of them), still 19 ahead without those blocks; a light rival is ruled out by the weight, one the
+    stacking carries is not."""
+    other = np.zeros(N)
+    best = other + 0.1
+    best[:2] += 40.0
+    rule, drop = NamingRule(), 10
+    a, b = Elpd(best, float("nan")), Elpd(other, float("nan"))
+    assert rule.ruling(a, b, weight=0.05, drop=drop) == "weight"
+    assert rule.ruling(a, b, weight=0.05, drop=drop, carried=True) is None
 
 
 class _Fitter:

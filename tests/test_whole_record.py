@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from friction_uq.analysis import prepare
 from friction_uq.discrepancy.check import check_whole_record
-from friction_uq.discrepancy.misfit import predictive_quadratic, tolerated
+from friction_uq.discrepancy.misfit import misfit_detected, predictive_quadratic, tolerated
 from friction_uq.discrepancy.whole_record import longest_sign_run, whiten
 from friction_uq.likelihood import ar1_noise
 from friction_uq.priors import default_prior_path, load_priors
@@ -75,6 +75,18 @@ def test_clean_record_has_no_misfit(tmp_path, seed):
     assert not chk.decision.detected, chk.decision.sentence()
     assert "reproduces all 4 gauges" in chk.decision.sentence()
     assert chk.fit.mode["nu"] == pytest.approx(0.41, abs=0.01)
+
+
+def test_the_gate_on_a_model_s_predicted_gauges_flags_a_gauge_read_10_percent_off(tmp_path):
+    """misfit_detected, which the swap check asks of the model without a candidate: the record's own gauges as the
+    prediction are within the tolerance; the input bar's read 10 % low is not."""
+    path = tmp_path / "clean.h5"
+    simulate_to_file(noisy_config(striker_velocity=9.0, friction_params=MappingProxyType({"f": 0.06})), path, seed=3)
+    prep = prepare(read_record(path))
+    exact = {ch: (prep.record.strain(ch) - prep.forces.channels[ch].noise.offset)[None, :]
+             for ch in prep.record.channels}
+    assert not misfit_detected(prep, exact)
+    assert misfit_detected(prep, exact | {"input_bar": 0.9 * exact["input_bar"]})
 
 
 def test_plug_friction_is_a_misfit(tmp_path):

@@ -36,7 +36,7 @@ from ..stats import RULE
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
-from .misfit import MisfitDecision, decide
+from .misfit import MisfitDecision, decide, misfit_detected
 from .candidates_mixture import further_mixture, mixture, named_causes, rival_mixture, unresolved_rounds
 from .rival_swaps import Swap, check_swaps, swap_jobs
 from .verdict import NamingRule, Verdict
@@ -231,7 +231,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         say("the candidates fitted in turn against their open rivals, with the later causes in the model")
         verdicts, swaps = check_swaps(
             dg, final, causes, verdicts, rounds, rule=NAMING, workers=workers, seed=seed + len(rounds),
-            flagged=lambda fit: decide(compare_whole_record(prep, dg.predictive(fit))).detected)
+            flagged=lambda fit: misfit_detected(prep, dg.predictive(fit)))
     if st.not_sep and verdicts and 0 not in unresolved_rounds(causes, verdicts):
         # the rivals of round 1 were second causes, named in later rounds, or ruled out with them in the model
         st.not_sep, st.separate_by = (), None

@@ -274,7 +274,8 @@ def _swapped(dg: Diagnosis) -> str:
         others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
         worse = ", ".join(f"{by[s.rival]} {s.delpd:.0f} +- {s.se:.0f} nats" + (" (by the weight)" if s.ruling == "weight"
                                                                                else "") for s in done)
-        alone = next((f"; without it, {s.delpd:.0f} +- {s.se:.0f} nats worse, and a misfit the whole-record check "
+        alone = next((f"; without it, {s.delpd:.0f} +- {s.se:.0f} nats worse"
+                      f"{' (by the weight)' if s.ruling == 'weight' else ''}, and a misfit the whole-record check "
                       f"flags" for s in dg.swaps if s.round == k and s.rival not in by), "")
         out.append(f" {dg.causes[k].mechanism.name} was one of the candidates of its round; with {others} in the model, "
                    f"each of its rivals explains the record worse ({worse}{alone}).")

@@ -69,7 +69,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..stats.ar1 import ar1_mean_sd
-from .whole_record import CHANNEL_LABELS, PHASES, WholeRecord, tolerance_sd, whiten
+from .whole_record import (
+    CHANNEL_LABELS,
+    PHASES,
+    WholeRecord,
+    compare_whole_record,
+    tolerance_sd,
+    whiten,
+)
 
 #: Decision threshold on the statistic (standard-normal units).
 THRESHOLD = 5.0
@@ -257,3 +264,10 @@ def decide(wr: WholeRecord, *, threshold: float | None = None) -> MisfitDecision
     worst = max(cells, key=lambda c: c.excess, default=None)
     return MisfitDecision(statistic=worst.statistic if worst else 0.0,
                           threshold=worst.threshold if worst else (threshold or THRESHOLD), cells=tuple(cells))
+
+
+def misfit_detected(prep, predicted: dict[str, np.ndarray]) -> bool:
+    """Whether the whole-record check flags a model's predicted gauges (channel -> (ndraw, n)) on the record of
+    ``prep`` (a :class:`~friction_uq.analysis.Prepared`): the first round's misfit gate, asked again by the swap
+    check of the model without a candidate (:mod:`.rival_swaps`)."""
+    return decide(compare_whole_record(prep, predicted)).detected

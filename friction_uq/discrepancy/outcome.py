@@ -110,7 +110,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                 "(in equal parts with the stationary analysis' f when "
                 "nothing is named, with run); after a named cause the search goes on with it in the model; a candidate "
                 "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
-                "left open by the same rule, and the model without it is ruled out and fails the whole-record check "
+                "left open by the same rule, and the model without it, which the whole-record check must flag "
                 "(swaps)",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
