@@ -37,7 +37,7 @@ from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide, misfit_detected
-from .candidates_mixture import further_mixture, mixture, named_causes, rival_mixture, unresolved_rounds
+from .candidates_mixture import further_mixture, mixture, named_causes, open_rivals, rival_mixture, unresolved_rounds
 from .rival_swaps import Swap, check_swaps, swap_jobs
 from .verdict import NamingRule, Verdict
 from .whole_record import WholeRecord, compare_whole_record
@@ -149,13 +149,14 @@ class Diagnosis:
     @property
     def open_candidates(self) -> tuple[str, ...]:
         """The mechanisms (a gain with its gauge: ``gauge_gain[input_bar]``) of the first round of candidates no
-        later round told apart, the one fitted in turn first, whose stacking mixture gives f; () when none."""
+        later round told apart, the one fitted in turn first, then its open rivals (not named in a later round nor
+        ruled out by the swap check), whose stacking mixture gives f; () when none."""
         rounds = unresolved_rounds(self.causes, self.verdicts)
         if not rounds:
             return ()
         v = self.verdicts[rounds[0]]
         by = {c.label: c.variant for c in v.candidates}
-        return tuple(by[label] for label in (v.named, *v.rivals) if label not in v.resolved)
+        return tuple(by[label] for label in (v.named, *open_rivals(v, self.causes)))
 
     @property
     def cause(self) -> Variant | None:
