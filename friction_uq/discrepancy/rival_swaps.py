@@ -26,8 +26,9 @@ where the axisymmetric cell's hoop strain departs from the 1-D model's, which th
 check's tolerance forgives.
 
 Asked only of a round followed by a later cause: for the last cause's round the swap is the round's own
-comparison, already judged. The weight route is the naming rule's own, its 90 % guard included. A rival of the same group as another cause (a second friction law) cannot be swapped
-in and stays open; so does one the final model does not rule out.
+comparison, already judged. The weight route is the naming rule's own, its 90 % guard included. A rival of the
+same group as another cause (a second friction law) cannot be swapped in and stays open; so does one the final
+model does not rule out.
 """
 
 from __future__ import annotations
