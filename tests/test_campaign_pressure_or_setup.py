@@ -39,8 +39,9 @@ def test_a_set_up_reading_high_is_flagged_where_pressure_varies_within_each_set_
     ca = analyse_tests(_tests(lambda V, p: 0.035 + 0.040 * np.exp(-V / 8.0), 0.20, p_with_v=False), {}, seed=2)
     assert [f["setup"] for f in ca.flagged if "setup" in f] == ["B"]
     assert "velocity" in supported_laws(ca.weights, ca.ranking)
-    if "sentence" in ca.pressure_or_setup:  # flagged by the weights, not by the offset's ELPD under the simplest law
-        assert ca.pressure_or_setup["weight_with_offset"] >= 0.9
+    if "sentence" in ca.pressure_or_setup:  # flagged by the laws with and without the offset, not by the offset's
+        # ELPD under the simplest law: those without it are ruled out by the package's rule
+        assert ca.pressure_or_setup["without_ruled_out"]
         assert ca.pressure_or_setup["sentence"] in ca.sentences
         assert "so set-up B is flagged" in ca.pressure_or_setup["sentence"]
     flag = next(f for f in ca.flagged if "setup" in f)
@@ -48,12 +49,15 @@ def test_a_set_up_reading_high_is_flagged_where_pressure_varies_within_each_set_
 
 
 def test_where_pressure_goes_with_speed_in_each_set_up_the_two_readings_are_both_said():
-    """Within each set-up p grows with V: a pressure term on a velocity law mimics B's 20 % (on these ten tests
-    velocity + offset B is 0.7 +- 1.7 behind pressure+velocity, with 0.4 of the weight): the campaign does not
-    flag B nor hide the alternative."""
+    """Within each set-up p grows with V: a pressure term on a velocity law mimics B's 20 %: on these ten tests
+    velocity + offset B and pressure+velocity predict alike (within 4 nats), so the campaign does not flag B nor
+    hide the alternative. Their stacking shares follow the sampler's bits (the laws with the offset carried 0.42
+    of the weight in the nineteenth session, 0.82-0.91 over analysis seeds 1-6 with numpy 2.5 and scipy 1.18):
+    below 4 nats the weight does not decide (``WeightRule.ruled_out``), else seed 2's 0.905 flagged B."""
     ca = analyse_tests(_tests(lambda V, p: 0.035 + 0.040 * np.exp(-V / 8.0), 0.20, p_with_v=True), {}, seed=2)
     alt = ca.pressure_or_setup
-    assert "offset B" in alt["best_with_offset"] and 0.1 < alt["weight_with_offset"] < 0.9
+    assert "offset B" in alt["best_with_offset"] and abs(alt["d_elpd"]) < 4.0, alt
+    assert not alt["without_ruled_out"]
     assert not [f for f in ca.flagged if "setup" in f]
     said = [s for s in ca.sentences if "told apart only by the pressures" in s]
     assert said and "velocity + offset B" in said[0]

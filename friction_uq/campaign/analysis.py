@@ -199,7 +199,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
         # law the ELPD could not rule out (under a constant law barely not ruled out, whose scatter takes up an
         # unmodelled trend, an offset of 20 % was not decisive), nor on a pressure term standing for the offset
         alt = laws.offset_alternative(offsets[0], cal)
-        if alt["weight_with_offset"] >= WEIGHT_RULE.mass:  # the offset, not a law's term, carries the weight
+        if alt["without_ruled_out"]:  # the offset, not a law's term, is what the tests need
             ca.flagged.append(setup_entry(offsets[0], alt["offset"], alt["d_elpd"], alt["d_se"], setups, tallies,
                                           quantity=data.basis) | {"weight_with_offset": alt["weight_with_offset"]})
             freed = [offsets[0]]

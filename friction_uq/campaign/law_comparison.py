@@ -15,6 +15,7 @@ import numpy as np
 
 from .._parallel import forked_map
 from ..stats import RULE, WeightRule, paired_difference, stacking_weights
+from ..stats.trimmed import trimmed_difference
 from .conclusions import CampaignAnalysis
 from .flags import setup_flags
 from .kernels import warm_up_kernels
@@ -254,8 +255,15 @@ class LawComparison:
         best = max(done, key=lambda k: done[k][0].elpd)
         top = max(self.base.values(), key=lambda e: e.elpd)
         d, se = paired_difference(done[best][0].pointwise, top.pointwise)
+        n = len(top.pointwise)
+        rest = trimmed_difference(done[best][0].pointwise, top.pointwise, drop=1)[0] if n >= 3 else None
+        with_offset = float(sum(weights[k] for k in done))
         return {"setup": setup, "best_with_offset": best, "offset": done[best][1], "best_without": top.model,
-                "d_elpd": d, "d_se": se, "weight_with_offset": float(sum(weights[k] for k in done)), "laws": len(done)}
+                "d_elpd": d, "d_se": se, "d_elpd_rest": rest, "weight_with_offset": with_offset, "laws": len(done),
+                # the laws without the offset ruled out by the package's rule (the ELPD's, or the weight route's):
+                # below 4 nats the weight never decides, since stacking's share among models that predict alike
+                # follows the sampler's bits
+                "without_ruled_out": WEIGHT_RULE.ruled_out(1.0 - with_offset, d, se, n=n, d_rest=rest)}
 
 
 def offset_sentence(alt: dict[str, object], flagged: bool, *, pressure: bool = True) -> str:
