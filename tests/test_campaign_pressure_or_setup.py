@@ -52,7 +52,7 @@ def test_where_pressure_goes_with_speed_in_each_set_up_the_two_readings_are_both
     """Within each set-up p grows with V: a pressure term on a velocity law mimics B's 20 %: on these ten tests
     velocity + offset B and pressure+velocity predict alike (within 4 nats), so the campaign does not flag B nor
     hide the alternative. Their stacking shares follow the sampler's bits (the laws with the offset carried 0.42
-    of the weight in the nineteenth session, 0.82-0.91 over analysis seeds 1-6 with numpy 2.5 and scipy 1.18):
+    of the weight in the nineteenth session, 0.82-0.91 over analysis seeds 1-6 on the twenty-sixth's install):
     below 4 nats the weight does not decide (``WeightRule.ruled_out``), else seed 2's 0.905 flagged B."""
     ca = analyse_tests(_tests(lambda V, p: 0.035 + 0.040 * np.exp(-V / 8.0), 0.20, p_with_v=True), {}, seed=2)
     alt = ca.pressure_or_setup
