@@ -39,7 +39,7 @@ class CampaignAnalysis:
     pooled_stationary: dict[str, Pooled] = field(default_factory=dict)
     #: two set-ups, none flagged by the ELPD: every law with and without the second set-up's offset, compared
     #: (:meth:`~.law_comparison.LawComparison.offset_alternative`), with the sentence where a law with a pressure term
-    #: is named or the set-up is flagged by the weights of every law with and without the offset; else empty
+    #: is named or the set-up is flagged by every law with and without the offset (those without ruled out); else empty
     pressure_or_setup: dict[str, object] = field(default_factory=dict)
 
     def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400,

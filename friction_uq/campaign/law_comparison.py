@@ -251,19 +251,25 @@ class LawComparison:
         one set-up's bars put all its tests at other pressures: the two readings are told apart only by the
         pressures within each set-up."""
         done = self.offset_models(setup, cal)
-        weights = stacking_weights({n: e.pointwise for n, e in (self.base | {k: v[0] for k, v in done.items()}).items()})
+        models = self.base | {k: v[0] for k, v in done.items()}
+        weights = stacking_weights({n: e.pointwise for n, e in models.items()})
         best = max(done, key=lambda k: done[k][0].elpd)
-        top = max(self.base.values(), key=lambda e: e.elpd)
-        d, se = paired_difference(done[best][0].pointwise, top.pointwise)
-        n = len(top.pointwise)
-        rest = trimmed_difference(done[best][0].pointwise, top.pointwise, drop=1)[0] if n >= 3 else None
+        top = max(self.base, key=lambda k: self.base[k].elpd)
+        d, se = paired_difference(done[best][0].pointwise, self.base[top].pointwise)
+        rest = trimmed_difference(done[best][0].pointwise, self.base[top].pointwise, drop=1)[0]
         with_offset = float(sum(weights[k] for k in done))
-        return {"setup": setup, "best_with_offset": best, "offset": done[best][1], "best_without": top.model,
+        # the weight the rule reads for the laws without the offset: theirs, and that of any law with it that predicts
+        # alike with the best of them (a twin that takes the share stacking would give it)
+        lead = max(e.elpd for e in models.values())
+        behind = {k: lead - e.elpd for k, e in models.items()}
+        twins = WEIGHT_RULE.alike_weight({k: w for k, w in weights.items() if k in done}, behind, top)
+        return {"setup": setup, "best_with_offset": best, "offset": done[best][1], "best_without": self.base[top].model,
                 "d_elpd": d, "d_se": se, "d_elpd_rest": rest, "weight_with_offset": with_offset, "laws": len(done),
                 # the laws without the offset ruled out by the package's rule (the ELPD's, or the weight route's):
                 # below 4 nats the weight never decides, since stacking's share among models that predict alike
                 # follows the sampler's bits
-                "without_ruled_out": WEIGHT_RULE.ruled_out(1.0 - with_offset, d, se, n=n, d_rest=rest)}
+                "without_ruled_out": WEIGHT_RULE.ruled_out(1.0 - with_offset + twins, d, se,
+                                                           n=len(self.base[top].pointwise), d_rest=rest)}
 
 
 def offset_sentence(alt: dict[str, object], flagged: bool, *, pressure: bool = True) -> str:
@@ -275,12 +281,15 @@ def offset_sentence(alt: dict[str, object], flagged: bool, *, pressure: bool = T
             f"{delta['q95'] * 100:+.0f}] off the shared law) predicts the tests {alt['d_elpd']:+.1f} +- {alt['d_se']:.1f} "
             f"against {alt['best_without']}, and the laws with that offset carry {alt['weight_with_offset']:.2f} of "
             f"the weight of all {2 * n} models (the {n} laws with and without the offset)")
+    why = "so the laws without it are ruled out and" if flagged else ""
     if not pressure:  # the weights of every law with and without the offset, no pressure term named
-        return (f"with two set-ups, {lead}" + (f", so set-up {alt['setup']} is flagged; `--diagnose` (a plug friction "
-                "or a gauge's gain fitted per test), or a third set-up, says which set-up is off" if flagged else ""))
+        return (f"with two set-ups, {lead}" + (f", {why} set-up {alt['setup']} is flagged; `--diagnose` (a plug "
+                "friction or a gauge's gain fitted per test), or a third set-up, says which set-up is off"
+                if flagged else ""))
     head = "with two set-ups a pressure term and a difference between the set-ups are told apart only by the pressures "
     if flagged:
-        return (head + f"within each: {lead}, so set-up {alt['setup']} is flagged and the laws compared with its level "
-                "left out; a third set-up, or `--diagnose` (a plug friction or a gauge's gain fitted per test), "
+        return (head + f"within each: {lead}, {why} set-up {alt['setup']} is flagged and the laws compared with its "
+                "level left out; a third set-up, or `--diagnose` (a plug friction or a gauge's gain fitted per test), "
                 "tells the two readings apart")
-    return head + f"within each: {lead}; a third set-up, or `--diagnose`, tells them apart"
+    return (head + f"within each: {lead}; the laws without the offset are not ruled out (within 4 nats the weight "
+            "decides nothing), and a third set-up, or `--diagnose`, tells them apart")

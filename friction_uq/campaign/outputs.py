@@ -19,9 +19,10 @@ of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and
 model; ``meanings``: each parameter in words with its unit; ``next_tests``: when the laws are not separated,
 each candidate test (set-up, V, p) with the expected information it brings on which law holds, most
 informative first (:mod:`.next_test`); ``pressure_or_setup``: with two set-ups, when a law with a pressure term
-is named or the second set-up is flagged by the weights, the best law with a free offset on that set-up against the
-best without (dELPD, SE, the weight the laws with the offset carry among all the models, ``laws`` the number of laws
-compared; empty otherwise); ``windows_read``: whether each test's change across its window entered the laws'
+is named or the second set-up is flagged by the laws with and without its offset, the best law with a free offset
+on that set-up against the best without (dELPD, SE, ``d_elpd_rest`` with the test that favours it most left out, the
+weight the laws with the offset carry among all the models, ``without_ruled_out``: the laws without it ruled out by
+the package's rule, which flags the set-up, ``laws`` the number of laws compared; empty otherwise); ``windows_read``: whether each test's change across its window entered the laws'
 likelihood (the slip law is compared only then); ``nu`` the campaign's nu),
 ``wall_seconds`` (``records``: the records' tasks, ``analysis``: the campaign's own analysis; added by
 ``run_campaign``), ``flagged`` (set-ups and tests; a set-up's entry says the ``basis`` its offset was measured on:
