@@ -1,8 +1,8 @@
 """Two hidden effects at once through every round of ``diagnose`` (slow: about 5 min): records of the pairs study
 (``benchmarks/bench_pairs.py``, seed 29).
 
-1d-0, a clearance with a velocity-weakening wall on the 1-D simulation. The clearance is named in the first round. In the second the velocity law leads the pressure and slip
-laws, a channel's timing and an amplifier's bandwidth by tens of nats over the whole record and holds 0.96 of the
+1d-0, a clearance with a velocity-weakening wall on the 1-D simulation. The clearance is named in the first round.
+In the second the velocity law leads the pressure and slip laws, a channel's timing and an amplifier's bandwidth by tens of nats over the whole record and holds 0.96 of the
 stacking weight, but within 2 SE of them: before the weight route (docs/methods.md) the round was candidates and
 only the clearance was named. Now both are, and f's interval holds the truth. (That a cause named first stays
 named when a later round's candidates stay open is tested on constructed verdicts in tests/test_diagnose.py.)

@@ -63,7 +63,8 @@ class Swap:
     flagged: bool | None = None
 
 
-def swap_jobs(causes: list[Variant], verdicts: list[Verdict], rounds: list) -> list[tuple[int, str, tuple[Variant, ...]]]:
+def swap_jobs(causes: list[Variant], verdicts: list[Verdict],
+              rounds: list) -> list[tuple[int, str, tuple[Variant, ...]]]:
     """(round, rival label, the final model's variants with the round's candidate replaced by the rival) for each
     rival a round of candidates left open that can be swapped in, after (round, :data:`WITHOUT`, the variants
     without the candidate) for each such round (module docstring)."""
