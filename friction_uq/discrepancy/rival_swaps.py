@@ -40,7 +40,7 @@ from ..stats.trimmed import points_to_drop
 from .candidates_mixture import open_rivals
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant
-from .verdict import WEIGHT_RULE, NamingRule, Verdict, round_weights
+from .verdict import NamingRule, Verdict, round_weights
 
 #: The ``rival`` of the swap that leaves the candidate out (the final model without it).
 WITHOUT = "(without it)"
@@ -100,12 +100,11 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
     weights = round_weights(final, fits, seed)
     behind = {"reference": 0.0} | {f.label: elpd_difference(final.elpd, f.elpd)[0] for f in fits}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
-    carried = set(WEIGHT_RULE.supported(weights))
+    how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits}, weights, behind, drop)
     swaps = []
     for (k, label, _), f in zip(jobs, fits):
         d, se = elpd_difference(final.elpd, f.elpd)
-        how = rule.ruling(final.elpd, f.elpd, weight=WEIGHT_RULE.alike_weight(weights, behind, f.label), drop=drop,
-                          carried=f.label in carried)
+        how = how_each[f.label]
         misfit = flagged(f) if label == WITHOUT and how is not None else None
         swaps.append(Swap(k, label, f.label, d, se, weights[f.label], how, misfit))
     out = list(verdicts)

@@ -159,19 +159,26 @@ class NamingRule:
         """The models ``best`` does not rule out (module docstring, 3.), and the labels of those it rules out
         only by the weight route."""
         behind = {"reference": best.delpd} | {c.label: best.delpd - c.delpd for c in cands}
-        carried = set(WEIGHT_RULE.supported(weights))  # as in the campaign: the weight never rules these out
+        others = [c for c in (cands if self.against_all else passing) if c.label != best.label]
+        how_each = self.rulings(fits[best.label].elpd, {c.label: fits[c.label].elpd for c in others}, weights,
+                                behind, drop)
         rivals, light = [], []
-        for c in (cands if self.against_all else passing):
-            if c.label == best.label:
-                continue
-            how = self.ruling(fits[best.label].elpd, fits[c.label].elpd,
-                              weight=WEIGHT_RULE.alike_weight(weights, behind, c.label), drop=drop,
-                              carried=c.label in carried)
+        for c in others:
+            how = how_each[c.label]
             if how is None:
                 rivals.append(c)
             elif how == "weight":
                 light.append(c.label)
         return rivals, tuple(light)
+
+    def rulings(self, best, others: Mapping, weights: Mapping[str, float], behind: Mapping[str, float],
+                drop: int) -> dict[str, str | None]:
+        """How model ``best`` rules out each of ``others`` (label -> :class:`~.elpd.Elpd`), by :meth:`ruling`: each
+        with the weight of the models that predict alike with it (``behind``: each label's ELPD behind the best),
+        the models that carry 90 % of ``weights`` guarded (as in the campaign: the weight never rules them out)."""
+        carried = set(WEIGHT_RULE.supported(weights))
+        return {label: self.ruling(best, other, weight=WEIGHT_RULE.alike_weight(weights, behind, label), drop=drop,
+                                   carried=label in carried) for label, other in others.items()}
 
     def ruling(self, best, other, *, weight: float, drop: int, carried: bool = False) -> str | None:
         """How model ``best`` rules out ``other`` (their :class:`~.elpd.Elpd`): "elpd" (decisively, by the package's
