@@ -68,7 +68,7 @@ def test_a_rival_that_cannot_be_swapped_in_keeps_its_round_open_whatever_the_oth
                                               second="pressure_friction")
     good = np.asarray(final.elpd.pointwise)
     fitter = _Fitter({"pressure_friction": good - 1.0, "bandwidth": good - 1.0})
-    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
                              flagged=lambda fit: True)
     assert [s.rival for s in swaps] == [WITHOUT, "bandwidth"]
     assert out[0].resolved == ("bandwidth",) and unresolved_rounds(causes, out) == (0,)
@@ -104,7 +104,7 @@ def test_a_rival_the_final_model_rules_out_is_resolved_and_the_candidate_named_o
     causes, verdicts, rounds, final = _record()
     good = np.asarray(final.elpd.pointwise)
     fitter = _Fitter({"clearance": good - 1.0, "channel_timing": good - 1.0, "bandwidth": good - 1.0})  # 200 nats
-    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
                                   flagged=lambda fit: True)
     assert fitter.asked == ["clearance", "channel_timing+clearance", "bandwidth+clearance"]
     assert [s.ruling for s in swaps] == ["elpd", "elpd", "elpd"] and swaps[1].delpd > 100
@@ -117,7 +117,7 @@ def test_a_rival_the_final_model_rules_out_is_resolved_and_the_candidate_named_o
     # a rival that explains the record as well with the clearance in the model stays open: dispersion is not named
     alike = good + np.random.default_rng(1).normal(0, 0.05, N)
     fitter = _Fitter({"clearance": good - 1.0, "channel_timing": good - 1.0, "bandwidth": alike})
-    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
                                   flagged=lambda fit: True)
     assert [s.ruling for s in swaps] == ["elpd", "elpd", None]
     assert out[0].resolved == ("channel_timing",) and unresolved_rounds(causes, out) == (0,)
@@ -126,7 +126,7 @@ def test_a_rival_the_final_model_rules_out_is_resolved_and_the_candidate_named_o
     # a candidate the later cause makes superfluous (the model without it predicts as well) resolves nothing, however
     # much worse its rivals are: a rival named in a later round may have been what it stood for
     fitter = _Fitter({"clearance": alike, "channel_timing": good - 1.0, "bandwidth": good - 1.0})
-    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
                                   flagged=lambda fit: True)
     assert [s.ruling for s in swaps] == [None, "elpd", "elpd"]
     assert out[0].resolved == () and unresolved_rounds(causes, out) == (0,)
@@ -145,7 +145,7 @@ def test_a_model_without_the_candidate_within_the_check_s_tolerance_resolves_not
         asked.append(fit.label)
         return False
 
-    out, swaps = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
                              flagged=within)
     assert asked == ["clearance"]  # only the model without the candidate is checked
     assert [(s.ruling, s.flagged) for s in swaps] == [("elpd", False), ("elpd", None), ("elpd", None)]
@@ -153,7 +153,7 @@ def test_a_model_without_the_candidate_within_the_check_s_tolerance_resolves_not
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
     # not asked when the model without the candidate is not ruled out in the first place
     alike = good + np.random.default_rng(1).normal(0, 0.05, N)
-    out, swaps = check_swaps(_Fitter({"clearance": alike, "channel_timing": good - 1.0, "bandwidth": good - 1.0}),
+    out, swaps, _ = check_swaps(_Fitter({"clearance": alike, "channel_timing": good - 1.0, "bandwidth": good - 1.0}),
                              final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0, flagged=within)
     assert asked == ["clearance"] and swaps[0].flagged is None and out[0].resolved == ()
 
@@ -164,7 +164,7 @@ def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
 
     causes, verdicts, rounds, final = _record()
     good = np.asarray(final.elpd.pointwise)
-    out, swaps = check_swaps(_Fitter({"clearance": good - 0.5, "channel_timing": good - 1.0, "bandwidth": good - 1.0}),
+    out, swaps, _ = check_swaps(_Fitter({"clearance": good - 0.5, "channel_timing": good - 1.0, "bandwidth": good - 1.0}),
                              final, causes,
                              verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
                                   flagged=lambda fit: True)
@@ -178,3 +178,68 @@ def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
     # without the swaps, nothing is said
     assert _swapped(Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
                               separate_by=None, final=final, verdicts=tuple(verdicts))) == ""
+
+
+def test_a_candidate_whose_rivals_later_rounds_all_named_must_still_earn_its_place():
+    """Round 1: dispersion fitted in turn among candidates whose only rival, the clearance, round 2 names. No rival is
+    left to swap in, but the rival named later may be what the candidate stood for: the model without it is fitted
+    alone and must be ruled out by the naming rule (as a later round's cause is, by evidence alone: the check's flag
+    is recorded, not asked), or the candidate is superfluous, not named, and f the mixture of the final model and the
+    model without it."""
+    from friction_uq.discrepancy.candidates_mixture import rival_mixture
+
+    causes, verdicts, rounds, final = _record(first_rivals=("clearance",))
+    assert [(k, label, tuple(v.label for v in variants)) for k, label, variants in
+            swap_jobs(causes, verdicts, rounds)] == [(0, WITHOUT, ("clearance",))]
+    good = np.asarray(final.elpd.pointwise)
+    # needed: without it the model is 200 nats worse and the check flags it; both are named, as before the check
+    out, swaps, spare = check_swaps(_Fitter({"clearance": good - 1.0}), final, causes, verdicts, rounds,
+                                    rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
+    assert [(s.rival, s.ruling, s.flagged) for s in swaps] == [(WITHOUT, "elpd", True)]
+    assert not out[0].superfluous and spare == {} and unresolved_rounds(causes, out) == ()
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["dispersion", "clearance"]
+    # 200 nats worse and within what two simulators differ by: named all the same, the check's answer recorded
+    out, swaps, spare = check_swaps(_Fitter({"clearance": good - 1.0}), final, causes, verdicts, rounds,
+                                    rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: False)
+    assert [(s.ruling, s.flagged) for s in swaps] == [("elpd", False)] and not out[0].superfluous
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["dispersion", "clearance"]
+    # the model without it predicts as well: superfluous, and the check is not asked
+    alike = good + np.random.default_rng(1).normal(0, 0.05, N)
+    out, swaps, spare = check_swaps(_Fitter({"clearance": alike}), final, causes, verdicts, rounds,
+                                    rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
+    assert [(s.ruling, s.flagged) for s in swaps] == [(None, None)] and out[0].superfluous
+    assert unresolved_rounds(causes, out) == (0,) and [v.mechanism.name for v in named_causes(causes, out)] == [
+        "clearance"]
+    # f is then the stacking mixture of the final model and the model without the candidate, both with the clearance
+    members, weights = spare[0]
+    assert list(members) == ["clearance"] and set(weights) == {"reference", "clearance"}
+    assert abs(sum(weights.values()) - 1.0) < 1e-9
+    final.f_effective = np.full(50, 0.04)  # the final model's f apart from the model without the candidate's 0.05
+    x, w, which = rival_mixture(final, rounds, out, causes, seed=0, alternatives=spare)
+    assert list(w) == [final.label, "clearance"] and abs(sum(w.values()) - 1.0) < 1e-9
+    assert set(np.unique(x)) <= {0.04, 0.05}  # drawn from these two models only, in their weights' shares
+    assert abs(np.mean(x == 0.05) - w["clearance"]) <= 1.0 / len(x)
+    # a round of candidates with no later cause is not asked
+    assert swap_jobs(causes[:1], verdicts[:1], rounds[:1]) == []
+
+
+def test_the_sentence_says_a_superfluous_candidate_is_not_named():
+    from friction_uq.discrepancy.diagnose import Diagnosis
+    from friction_uq.discrepancy.diagnosis_words import _superfluous
+
+    causes, verdicts, rounds, final = _record(first_rivals=("clearance",))
+    good = np.asarray(final.elpd.pointwise)
+    alike = good + np.random.default_rng(1).normal(0, 0.05, N)
+    out, swaps, _ = check_swaps(_Fitter({"clearance": alike}), final, causes, verdicts, rounds,
+                                rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: False)
+    dg = Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
+                   separate_by=None, final=final, verdicts=tuple(out), swaps=swaps)
+    assert dg.superfluous == ("dispersion",) and [v.label for v in dg.named_causes] == ["clearance"]
+    words = _superfluous(dg, "dispersion")
+    assert words == (" Fitted in turn among the candidates of its round: dispersion; with clearance in the model the "
+                     "record does not need it (the model without it is 1 +- 1 nats worse, not decisive by the naming "
+                     "rule): not named."), words
+    # a candidate that earned its place: nothing said
+    out, swaps, _ = check_swaps(_Fitter({"clearance": good - 0.5}), final, causes, verdicts, rounds,
+                                rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
+    assert _superfluous(replace(dg, verdicts=tuple(out), swaps=swaps), "dispersion") == ""

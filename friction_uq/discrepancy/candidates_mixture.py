@@ -23,7 +23,7 @@ the stationary analysis' draws for one half, the stacking mixture of the candida
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -42,9 +42,10 @@ STATIONARY_SHARE = 0.5
 def unresolved_rounds(causes, verdicts) -> tuple[int, ...]:
     """The rounds whose verdict was candidates and one of whose rivals is a mechanism no round put in the
     model (an alternative to the candidate fitted in turn, not a second cause): the record does not tell them
-    apart. A rival that is the same mechanism on another gauge does not count (the mechanism is named, its
-    gauge uncertain)."""
-    return tuple(k for k, verdict in enumerate(verdicts) if open_rivals(verdict, causes))
+    apart; and the rounds whose candidate the later causes made superfluous (``Verdict.superfluous``,
+    :mod:`.rival_swaps`). A rival that is the same mechanism on another gauge does not count (the mechanism is
+    named, its gauge uncertain)."""
+    return tuple(k for k, verdict in enumerate(verdicts) if verdict.superfluous or open_rivals(verdict, causes))
 
 
 def open_rivals(verdict: Verdict, causes) -> list[str]:
@@ -65,18 +66,26 @@ def named_causes(causes, verdicts) -> list:
 
 
 def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant], seed: int,
-                  stationary_f: np.ndarray | None = None) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+                  stationary_f: np.ndarray | None = None, alternatives: Mapping | None = None
+                  ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
     is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
     fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved.
-    ``stationary_f``: the stationary analysis' draws, given half the weight when the record names no cause
-    (module docstring)."""
+    When that round's candidate is superfluous, the members are instead the final model and the swap check's
+    models of the round (``alternatives[k]``: their draws and the weights of one stacking over them, every one
+    holding the later causes; :mod:`.rival_swaps`). ``stationary_f``: the stationary analysis' draws, given half
+    the weight when the record names no cause (module docstring)."""
     for k in unresolved_rounds(causes, verdicts)[:1]:
         verdict = verdicts[k]
-        left = open_rivals(verdict, causes)
-        fits = {r.fit.label: r.fit for r in rounds[k]}
-        draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
-        w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
+        if verdict.superfluous and alternatives and k in alternatives:
+            others, weights = alternatives[k]
+            draws = {final.label: final.f_effective} | dict(others)
+            w = {final.label: weights["reference"]} | {label: weights[label] for label in others}
+        else:
+            left = open_rivals(verdict, causes)
+            fits = {r.fit.label: r.fit for r in rounds[k]}
+            draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
+            w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
         if sum(w.values()) <= 0.0:
             w = {label: 1.0 for label in w}
         if not named_causes(causes, verdicts):

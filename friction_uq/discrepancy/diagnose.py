@@ -131,8 +131,9 @@ class Diagnosis:
     mixture_weights: dict[str, float] = field(default_factory=dict)
     #: for each mixture draw, the index (in mixture_weights' order) of the model it was drawn from
     mixture_source: np.ndarray | None = None
-    #: the candidates fitted in turn against the rivals their rounds left open, with the later causes in the model
-    #: (:mod:`.rival_swaps`; the verdicts' ``resolved`` holds the rivals ruled out)
+    #: the candidates fitted in turn against the rivals their rounds left open and against the model without them,
+    #: with the later causes in the model (:mod:`.rival_swaps`; the verdicts' ``resolved`` holds the rivals ruled out,
+    #: ``superfluous`` whether the candidate was needed)
     swaps: tuple[Swap, ...] = ()
 
     @property
@@ -143,7 +144,8 @@ class Diagnosis:
     def named_causes(self) -> tuple[Variant, ...]:
         """The causes the record names: each round's named cause, and a round's best candidate whose rivals
         later rounds named (they were second causes, not alternatives); not a candidate fitted in turn whose
-        rivals stay open (``causes`` holds every mechanism of the final model)."""
+        rivals stay open or that the later causes made superfluous (``causes`` holds every mechanism of the final
+        model)."""
         return tuple(named_causes(self.causes, self.verdicts))
 
     @property
@@ -157,6 +159,12 @@ class Diagnosis:
         v = self.verdicts[rounds[0]]
         by = {c.label: c.variant for c in v.candidates}
         return tuple(by[label] for label in (v.named, *open_rivals(v, self.causes)))
+
+    @property
+    def superfluous(self) -> tuple[str, ...]:
+        """The candidates fitted in turn that the later causes made superfluous (:mod:`.rival_swaps`; not named), as
+        their variants' labels."""
+        return tuple(self.causes[k].label for k, v in enumerate(self.verdicts[:len(self.causes)]) if v.superfluous)
 
     @property
     def cause(self) -> Variant | None:
@@ -228,9 +236,11 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     st = _search(dg, prep, _Search(base, base), max_causes=max_causes, workers=workers, seed=seed, say=say, t0=t0)
     final, causes, rounds, verdicts = st.reference, st.causes, st.rounds, st.verdicts
     swaps: tuple[Swap, ...] = ()
+    spare = {}
     if swap_jobs(causes, verdicts, rounds):
-        say("the candidates fitted in turn against their open rivals, with the later causes in the model")
-        verdicts, swaps = check_swaps(
+        say("the candidates fitted in turn against their open rivals and without them, with the later causes in the "
+            "model")
+        verdicts, swaps, spare = check_swaps(
             dg, final, causes, verdicts, rounds, rule=NAMING, workers=workers, seed=seed + len(rounds),
             flagged=lambda fit: misfit_detected(prep, dg.predictive(fit)))
     if st.not_sep and verdicts and 0 not in unresolved_rounds(causes, verdicts):
@@ -249,7 +259,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final, workers=workers)
         k, ess, method = ex.pareto_k, ex.ess, ex.method
-        mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f)
+        mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f, spare)
         if mix is None:  # the last round's weight on further mechanisms none of which it named
             mix, mix_w, mix_src = further_mixture(final, rounds, verdicts, causes, seed)
     return Diagnosis(baseline=st.base, rounds=tuple(rounds), misfits=tuple(st.misfits), causes=tuple(causes),

@@ -205,10 +205,11 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         found = [s for s in steps if s[0] in dg.named_causes]
         turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v not in dg.named_causes)
         rivals = ", ".join(dg.open_candidates)
+        spare = _superfluous(dg, turn)
         if found:
             lead = (f"Causes found, the one that moves f most first: "
-                    f"{'; '.join(f'{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}' for v, a, b in found)}{gauges}. A "
-                    f"further cause this record does not tell apart: {rivals} (fitted in turn: {turn}).")
+                    f"{'; '.join(f'{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}' for v, a, b in found)}{gauges}." +
+                    (spare or f" A further cause this record does not tell apart: {rivals} (fitted in turn: {turn})."))
         else:
             lead = ("Candidates, not a cause: this record does not tell apart "
                     f"{', '.join(dg.not_separable) or rivals}; fitted in turn: {named}.")
@@ -259,6 +260,24 @@ def _by_weight(dg: Diagnosis) -> str:
                    f"favour it most left out, and carries under 0.1 of the weight with the models that predict alike "
                    f"with it.")
     return "".join(out)
+
+
+def _superfluous(dg: Diagnosis, turn: str) -> str:
+    """' X was fitted in turn among the candidates of its round, but with Y in the model the record does not need it
+    (...): not named.' when the first round left open is one whose candidate the swap check found superfluous
+    (:mod:`.rival_swaps`); '' otherwise. ``turn``: the candidate in words, with f before and after it."""
+    rounds = unresolved_rounds(dg.causes, dg.verdicts)
+    k = rounds[0] if rounds else None
+    without = next((s for s in dg.swaps if s.round == k and s.rival not in
+                    {c.label for c in dg.verdicts[k].candidates}), None) if k is not None else None
+    if without is None or not dg.verdicts[k].superfluous:
+        return ""
+    others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
+    gap = f"the model without it is {without.delpd:.0f} +- {without.se:.0f} nats worse"
+    why = (f"{gap}, not decisive by the naming rule" if without.ruling is None else
+           f"{gap}, but within what two simulators of the same test differ by: the whole-record check does not flag it")
+    return (f" Fitted in turn among the candidates of its round: {turn}; with {others} in the model the record does "
+            f"not need it ({why}): not named.")
 
 
 def _swapped(dg: Diagnosis) -> str:

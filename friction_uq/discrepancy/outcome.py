@@ -76,6 +76,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "causes": [{"name": c.mechanism.name, "channel": c.channel} for c in dg.named_causes],
         "fitted_in_turn": [c.label for c in dg.causes],
         "open_candidates": list(dg.open_candidates),
+        # candidates fitted in turn the later causes made superfluous (the model without them not ruled out, or, where
+        # a rival stays open, not flagged by the whole-record check): not named
+        "superfluous": list(dg.superfluous),
         # the candidates fitted in turn against their rounds' open rivals, with the later causes in the model
         "swaps": [{"round": sw.round + 1, "rival": sw.rival, "model": sw.model, "delpd": sw.delpd, "se": sw.se,
                    "weight": sw.weight, "ruled_out": sw.ruling, "check_flags": sw.flagged} for sw in dg.swaps],
@@ -111,7 +114,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                 "nothing is named, with run); after a named cause the search goes on with it in the model; a candidate "
                 "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
                 "left open by the same rule, and the model without it, which the whole-record check must flag "
-                "(swaps)",
+                "(swaps; else it is superfluous, and f the stacking mixture of the final model and the swaps)",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "

@@ -29,12 +29,25 @@ Asked only of a round followed by a later cause: for the last cause's round the 
 comparison, already judged. The weight route is the naming rule's own, its 90 % guard included. A rival of the
 same group as another cause (a second friction law) cannot be swapped in and stays open; so does one the final
 model does not rule out.
+
+A round whose rivals later rounds all named has no rival to swap in, but its candidate must earn its place just the
+same: a rival named later may be what the candidate stood for. The model without it is then fitted alone and must
+be ruled out by the naming rule; the check's flag is recorded but not asked. With every rival in the model the round
+is a later round of its own, and later rounds name by evidence alone: on the bundled records of set-up B the third
+round's candidates are the plug friction and the velocity weakening, both there, and the fourth names the one not
+fitted in turn by its evidence alone; the one fitted in turn is 133-165 (+- 24-35) nats better than the model
+without it, which the check does not flag. Asking the gate of it alone would name one of two real causes and drop
+the other by the order they were fitted in. A candidate that fails its test is *superfluous*
+(``Verdict.superfluous``): not named, and f is the stacking mixture of the final model and the models of the check
+of its round (the model without it, the rivals swapped in), every one of which holds the later causes.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+
+import numpy as np
 
 from ..stats.trimmed import points_to_drop
 from .candidates_mixture import open_rivals
@@ -67,33 +80,42 @@ def swap_jobs(causes: list[Variant], verdicts: list[Verdict],
               rounds: list) -> list[tuple[int, str, tuple[Variant, ...]]]:
     """(round, rival label, the final model's variants with the round's candidate replaced by the rival) for each
     rival a round of candidates left open that can be swapped in, after (round, :data:`WITHOUT`, the variants
-    without the candidate) for each such round (module docstring)."""
+    without the candidate) for each such round, and for each round of candidates whose rivals later rounds all
+    named (module docstring)."""
     if len(causes) < 2:
         return []
     out = []
     for k, verdict in enumerate(verdicts[:len(causes) - 1]):  # the last cause's round has no later cause
+        if verdict.kind != "candidates":
+            continue
         fits = {r.fit.label: r.fit for r in rounds[k]}
         groups = {v.mechanism.group for j, v in enumerate(causes) if j != k and v.mechanism.group}
+        left = open_rivals(verdict, causes)
         swaps = []
-        for label in open_rivals(verdict, causes):
+        for label in left:
             rival = fits[label].variants[-1]
             if rival.mechanism.group is None or rival.mechanism.group not in groups:
                 swaps.append((k, label, tuple(causes[:k]) + (rival,) + tuple(causes[k + 1:])))
-        if swaps:
+        if swaps or not left:  # open rivals none of which can be swapped in keep the round open as it is
             out += [(k, WITHOUT, tuple(causes[:k]) + tuple(causes[k + 1:])), *swaps]
     return out
 
 
+#: For each superfluous round, the members of f's mixture besides the final model: the check's models of that
+#: round (label -> f_effective draws) and the stacking weights over the final model ("reference") and them.
+Alternatives = dict[int, tuple[dict[str, np.ndarray], dict[str, float]]]
+
+
 def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts: list[Verdict], rounds: list, *,
                 rule: NamingRule, flagged: Callable[[ModelFit], bool], workers: int,
-                seed: int) -> tuple[list[Verdict], tuple[Swap, ...]]:
-    """The verdicts with each round's rivals that the final model rules out against their swaps marked resolved,
-    and every swap's comparison (module docstring). ``flagged``: the whole-record check's decision on a fitted
-    model (True: a misfit beyond the tolerance), asked of a model without a candidate that the final model rules
-    out."""
+                seed: int) -> tuple[list[Verdict], tuple[Swap, ...], Alternatives]:
+    """The verdicts with each round's rivals that the final model rules out against their swaps marked resolved, or
+    the round marked superfluous, every swap's comparison, and the superfluous rounds' :data:`Alternatives` (module
+    docstring). ``flagged``: the whole-record check's decision on a fitted model (True: a misfit beyond the
+    tolerance), asked of a model without a candidate that the final model rules out."""
     jobs = swap_jobs(causes, verdicts, rounds)
     if not jobs:
-        return verdicts, ()
+        return verdicts, (), {}
     start = dict(final.fit.mode)
     fits = dg.fit_many([(variants, start, "+".join(v.label for v in variants)) for _, _, variants in jobs],
                        workers=workers)
@@ -101,17 +123,24 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
     behind = {"reference": 0.0} | {f.label: elpd_difference(final.elpd, f.elpd)[0] for f in fits}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
     how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits}, weights, behind, drop)
+    by_label = {f.label: f for f in fits}
     swaps = []
     for (k, label, _), f in zip(jobs, fits):
         d, se = elpd_difference(final.elpd, f.elpd)
         how = how_each[f.label]
         misfit = flagged(f) if label == WITHOUT and how is not None else None
         swaps.append(Swap(k, label, f.label, d, se, weights[f.label], how, misfit))
-    out = list(verdicts)
-    for k in {s.round for s in swaps}:
+    out, spare = list(verdicts), {}
+    for k in sorted({s.round for s in swaps}):
         mine = [s for s in swaps if s.round == k]
-        if any(s.rival == WITHOUT and not s.flagged for s in mine):
-            continue  # the candidate is not needed with the later causes in the model: nothing is resolved
+        without = next(s for s in mine if s.rival == WITHOUT)
+        if without.ruling is None or (len(mine) > 1 and not without.flagged):
+            # the candidate is not needed with the later causes in the model: nothing is resolved (the check's gate
+            # is asked only where an open rival could stand in its place; module docstring)
+            out[k] = replace(out[k], superfluous=True)
+            spare[k] = ({s.model: by_label[s.model].f_effective for s in mine},
+                        {"reference": weights["reference"]} | {s.model: s.weight for s in mine})
+            continue
         done = tuple(s.rival for s in mine if s.rival != WITHOUT and s.ruling is not None)
         out[k] = replace(out[k], resolved=out[k].resolved + done)
-    return out, tuple(swaps)
+    return out, tuple(swaps), spare
