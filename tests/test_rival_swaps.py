@@ -148,6 +148,7 @@ def test_a_model_without_the_candidate_within_the_check_s_tolerance_resolves_not
     out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
                              flagged=within)
     assert asked == ["clearance"]  # only the model without the candidate is checked
+    assert out[0].superfluous  # not needed beyond the tolerance: not named, its round open
     assert [(s.ruling, s.flagged) for s in swaps] == [("elpd", False), ("elpd", None), ("elpd", None)]
     assert out[0].resolved == () and unresolved_rounds(causes, out) == (0,)
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
@@ -186,41 +187,48 @@ def test_a_candidate_whose_rivals_later_rounds_all_named_must_still_earn_its_pla
     alone and must be ruled out by the naming rule (as a later round's cause is, by evidence alone: the check's flag
     is recorded, not asked), or the candidate is superfluous, not named, and f the mixture of the final model and the
     model without it."""
-    from friction_uq.discrepancy.candidates_mixture import rival_mixture
+    from friction_uq.discrepancy.candidates_mixture import open_rounds
+    from friction_uq.discrepancy.diagnose import _mixture_after_causes
 
     causes, verdicts, rounds, final = _record(first_rivals=("clearance",))
     assert [(k, label, tuple(v.label for v in variants)) for k, label, variants in
             swap_jobs(causes, verdicts, rounds)] == [(0, WITHOUT, ("clearance",))]
     good = np.asarray(final.elpd.pointwise)
     # needed: without it the model is 200 nats worse and the check flags it; both are named, as before the check
-    out, swaps, spare = check_swaps(_Fitter({"clearance": good - 1.0}), final, causes, verdicts, rounds,
-                                    rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
+    out, swaps, checked = check_swaps(_Fitter({"clearance": good - 1.0}), final, causes, verdicts, rounds,
+                                      rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
     assert [(s.rival, s.ruling, s.flagged) for s in swaps] == [(WITHOUT, "elpd", True)]
-    assert not out[0].superfluous and spare == {} and unresolved_rounds(causes, out) == ()
+    assert [m.label for m in checked] == ["clearance"]
+    assert not out[0].superfluous and unresolved_rounds(causes, out) == ()
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["dispersion", "clearance"]
     # 200 nats worse and within what two simulators differ by: named all the same, the check's answer recorded
-    out, swaps, spare = check_swaps(_Fitter({"clearance": good - 1.0}), final, causes, verdicts, rounds,
-                                    rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: False)
+    out, swaps, checked = check_swaps(_Fitter({"clearance": good - 1.0}), final, causes, verdicts, rounds,
+                                      rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: False)
     assert [(s.ruling, s.flagged) for s in swaps] == [("elpd", False)] and not out[0].superfluous
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["dispersion", "clearance"]
     # the model without it predicts as well: superfluous, and the check is not asked
     alike = good + np.random.default_rng(1).normal(0, 0.05, N)
-    out, swaps, spare = check_swaps(_Fitter({"clearance": alike}), final, causes, verdicts, rounds,
-                                    rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
+    out, swaps, checked = check_swaps(_Fitter({"clearance": alike}), final, causes, verdicts, rounds,
+                                      rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
     assert [(s.ruling, s.flagged) for s in swaps] == [(None, None)] and out[0].superfluous
-    assert unresolved_rounds(causes, out) == (0,) and [v.mechanism.name for v in named_causes(causes, out)] == [
-        "clearance"]
+    assert unresolved_rounds(causes, out) == (0,) and open_rounds(causes, out) == ()
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
     # f is then the stacking mixture of the final model and the model without the candidate, both with the clearance
-    members, weights = spare[0]
-    assert list(members) == ["clearance"] and set(weights) == {"reference", "clearance"}
-    assert abs(sum(weights.values()) - 1.0) < 1e-9
     final.f_effective = np.full(50, 0.04)  # the final model's f apart from the model without the candidate's 0.05
-    x, w, which = rival_mixture(final, rounds, out, causes, seed=0, alternatives=spare)
-    assert list(w) == [final.label, "clearance"] and abs(sum(w.values()) - 1.0) < 1e-9
+    x, w, _, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None)
+    assert kind == "superfluous" and list(w) == [final.label, "clearance"] and abs(sum(w.values()) - 1.0) < 1e-9
     assert set(np.unique(x)) <= {0.04, 0.05}  # drawn from these two models only, in their weights' shares
     assert abs(np.mean(x == 0.05) - w["clearance"]) <= 1.0 / len(x)
-    # a round of candidates with no later cause is not asked
-    assert swap_jobs(causes[:1], verdicts[:1], rounds[:1]) == []
+    # a round whose rival stays open gives f from that round's rivals, as before the check was asked of it
+    causes, verdicts, rounds, final = _record(first_rivals=("clearance", "bandwidth"))
+    out, swaps, checked = check_swaps(_Fitter({"clearance": alike, "bandwidth": good - 1.0}), final, causes,
+                                      verdicts, rounds, rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
+    assert out[0].superfluous and open_rounds(causes, out) == (0,)
+    assert _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None)[3] == "rivals"
+    # the last cause's round is not asked, whether its rivals were named or not
+    causes, verdicts, rounds, _ = _record(first_rivals=("clearance",))
+    last = [replace(verdicts[0], kind="named", rivals=()), replace(verdicts[1], kind="candidates", rivals=())]
+    assert swap_jobs(causes, last, rounds) == []
 
 
 def test_the_sentence_says_a_superfluous_candidate_is_not_named():
@@ -230,16 +238,52 @@ def test_the_sentence_says_a_superfluous_candidate_is_not_named():
     causes, verdicts, rounds, final = _record(first_rivals=("clearance",))
     good = np.asarray(final.elpd.pointwise)
     alike = good + np.random.default_rng(1).normal(0, 0.05, N)
-    out, swaps, _ = check_swaps(_Fitter({"clearance": alike}), final, causes, verdicts, rounds,
-                                rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: False)
-    dg = Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
-                   separate_by=None, final=final, verdicts=tuple(out), swaps=swaps)
+    out, swaps, checked = check_swaps(_Fitter({"clearance": alike}), final, causes, verdicts, rounds,
+                                      rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: False)
+    dg = Diagnosis(baseline=SimpleNamespace(f_effective=np.full(50, 0.06)), rounds=tuple(rounds), misfits=(),
+                   causes=tuple(causes), not_separable=("dispersion", "clearance"), separate_by=None, final=final,
+                   verdicts=tuple(out), swaps=swaps, swap_models=checked)
     assert dg.superfluous == ("dispersion",) and [v.label for v in dg.named_causes] == ["clearance"]
-    words = _superfluous(dg, "dispersion")
-    assert words == (" Fitted in turn among the candidates of its round: dispersion; with clearance in the model the "
-                     "record does not need it (the model without it is 1 +- 1 nats worse, not decisive by the naming "
-                     "rule): not named."), words
+    assert dg.open_candidates == ()  # nothing is left open: the candidate is not needed, its rival is named
+    words = _superfluous(dg)
+    assert words == (" Fitted in turn among the candidates of its round: wave dispersion in the bars (dispersion), f "
+                     "0.060 -> 0.050; with clearance in the model the record does not need it (the model without it "
+                     "is 1 +- 1 nats worse, not decisive by the naming rule): not named."), words
     # a candidate that earned its place: nothing said
     out, swaps, _ = check_swaps(_Fitter({"clearance": good - 0.5}), final, causes, verdicts, rounds,
                                 rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
-    assert _superfluous(replace(dg, verdicts=tuple(out), swaps=swaps), "dispersion") == ""
+    assert _superfluous(replace(dg, verdicts=tuple(out), swaps=swaps)) == ""
+
+
+def test_a_superfluous_candidate_in_the_sentence_the_f_to_quote_and_the_warning():
+    """The whole chain of words for a record whose candidate fitted in turn was not needed: the lead names only the
+    causes named, says the candidate was not needed, and f comes from the mixture of the final model and the model
+    without it, which the f's source and the warning say too."""
+    from friction_uq.discrepancy.diagnose import Diagnosis, _mixture_after_causes
+    from friction_uq.discrepancy.diagnosis_words import sentence
+    from friction_uq.report.quote import f_to_quote
+    from friction_uq.run.warnings import _next_step
+
+    causes, verdicts, rounds, final = _record(first_rivals=("clearance",))
+    good = np.asarray(final.elpd.pointwise)
+    alike = good + np.random.default_rng(1).normal(0, 0.05, N)
+    out, swaps, checked = check_swaps(_Fitter({"clearance": alike}), final, causes, verdicts, rounds,
+                                      rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: False)
+    final.f_effective, final.predicted = np.full(50, 0.04), {}
+    rounds = [tuple(SimpleNamespace(fit=r.fit, delpd=100.0, se=10.0) for r in rnd) for rnd in rounds]
+    mix, w, src, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None)
+    worst = SimpleNamespace(channel="tube_hoop", level=-5.0, relative_level=-0.06, phase="unloading")
+    dg = Diagnosis(baseline=SimpleNamespace(f_effective=np.full(50, 0.06), label="baseline", variants=()),
+                   rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(), separate_by=None,
+                   final=final, verdicts=tuple(out), swaps=swaps, swap_models=checked, mixture_f=mix,
+                   mixture_weights=w, mixture_source=src, mixture_of=kind,
+                   baseline_comparison=SimpleNamespace(figures=[worst]))
+    said = sentence(dg, {"q05": 0.055, "q50": 0.060, "q95": 0.065})
+    assert said.startswith("Causes found, the one that moves f most first: a radial gap between sample and tube "
+                           "(clearance), f 0.050 -> 0.040. Fitted in turn among the candidates of its round: wave "
+                           "dispersion in the bars (dispersion)"), said
+    assert "the same without the one not named, weighted by how well each predicts the record (the f to quote)" in said
+    source, _ = f_to_quote({"q05": 0.0, "q50": 0.0, "q95": 0.0}, dg)
+    assert "the causes diagnose named (clearance) with and without dispersion, fitted in turn and not needed" in source
+    assert "it names clearance; dispersion, fitted in turn, is not needed with them and not named" in _next_step(dg,
+                                                                                                               None)

@@ -23,13 +23,13 @@ the stationary analysis' draws for one half, the stacking mixture of the candida
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
 from ..stats.streams import stream
 from .extended import ModelFit, Variant
-from .verdict import Verdict, mixture_draws
+from .verdict import Verdict, mixture_draws, round_weights
 
 #: Draws of the stacking mixture that gives f when no single cause is named.
 MIXTURE_DRAWS = 1000
@@ -46,6 +46,11 @@ def unresolved_rounds(causes, verdicts) -> tuple[int, ...]:
     :mod:`.rival_swaps`). A rival that is the same mechanism on another gauge does not count (the mechanism is
     named, its gauge uncertain)."""
     return tuple(k for k, verdict in enumerate(verdicts) if verdict.superfluous or open_rivals(verdict, causes))
+
+
+def open_rounds(causes, verdicts) -> tuple[int, ...]:
+    """The rounds of candidates with a rival still open (:func:`open_rivals`): the record does not tell them apart."""
+    return tuple(k for k, verdict in enumerate(verdicts) if open_rivals(verdict, causes))
 
 
 def open_rivals(verdict: Verdict, causes) -> list[str]:
@@ -66,32 +71,40 @@ def named_causes(causes, verdicts) -> list:
 
 
 def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant], seed: int,
-                  stationary_f: np.ndarray | None = None, alternatives: Mapping | None = None
-                  ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+                  stationary_f: np.ndarray | None = None) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
     is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
     fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved.
-    When that round's candidate is superfluous, the members are instead the final model and the swap check's
-    models of the round (``alternatives[k]``: their draws and the weights of one stacking over them, every one
-    holding the later causes; :mod:`.rival_swaps`). ``stationary_f``: the stationary analysis' draws, given half
-    the weight when the record names no cause (module docstring)."""
-    for k in unresolved_rounds(causes, verdicts)[:1]:
+    ``stationary_f``: the stationary analysis' draws, given half the weight when the record names no cause
+    (module docstring)."""
+    for k in open_rounds(causes, verdicts)[:1]:
         verdict = verdicts[k]
-        if verdict.superfluous and alternatives and k in alternatives:
-            others, weights = alternatives[k]
-            draws = {final.label: final.f_effective} | dict(others)
-            w = {final.label: weights["reference"]} | {label: weights[label] for label in others}
-        else:
-            left = open_rivals(verdict, causes)
-            fits = {r.fit.label: r.fit for r in rounds[k]}
-            draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
-            w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
+        left = open_rivals(verdict, causes)
+        fits = {r.fit.label: r.fit for r in rounds[k]}
+        draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
+        w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
         if sum(w.values()) <= 0.0:
             w = {label: 1.0 for label in w}
         if not named_causes(causes, verdicts):
             draws, w = _with_stationary(draws, w, stationary_f)
         return _draw_mixture(draws, w, seed)
     return None, {}, None
+
+
+def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int
+                        ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+    """When a candidate fitted in turn is superfluous (:mod:`.rival_swaps`) and no round leaves a rival open: f's
+    draws from the stacking mixture of the final model and ``checked``, the swap check's models of that round (the
+    final model without the candidate, and the rivals swapped in), every one holding the later causes, weighted by
+    one stacking over them; (None, {}, None) without them."""
+    if not checked:
+        return None, {}, None
+    weights = round_weights(final, list(checked), seed)
+    draws = {final.label: final.f_effective} | {f.label: f.f_effective for f in checked}
+    w = {final.label: weights["reference"]} | {f.label: weights[f.label] for f in checked}
+    if sum(w.values()) <= 0.0:
+        w = {label: 1.0 for label in w}
+    return _draw_mixture(draws, w, seed)
 
 
 def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],

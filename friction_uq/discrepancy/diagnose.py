@@ -37,7 +37,8 @@ from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide, misfit_detected
-from .candidates_mixture import further_mixture, mixture, named_causes, open_rivals, rival_mixture, unresolved_rounds
+from .candidates_mixture import (further_mixture, mixture, named_causes, open_rivals, open_rounds, rival_mixture,
+                                 superfluous_mixture)
 from .rival_swaps import Swap, check_swaps, swap_jobs
 from .verdict import NamingRule, Verdict
 from .whole_record import WholeRecord, compare_whole_record
@@ -135,6 +136,12 @@ class Diagnosis:
     #: with the later causes in the model (:mod:`.rival_swaps`; the verdicts' ``resolved`` holds the rivals ruled out,
     #: ``superfluous`` whether the candidate was needed)
     swaps: tuple[Swap, ...] = ()
+    #: each swap's fitted model, in ``swaps``' order (members of f's mixture when a candidate is superfluous)
+    swap_models: tuple[ModelFit, ...] = ()
+    #: which mixture gives f: "candidates" (the first round names none), "rivals" (a round's rivals left open),
+    #: "further" (the last round's weight on further mechanisms), "superfluous" (a candidate fitted in turn not
+    #: needed: the final model and the swap check's models of its round), or None (f is the final model's)
+    mixture_of: str | None = None
 
     @property
     def verdict(self) -> Verdict | None:
@@ -153,7 +160,7 @@ class Diagnosis:
         """The mechanisms (a gain with its gauge: ``gauge_gain[input_bar]``) of the first round of candidates no
         later round told apart, the one fitted in turn first, then its open rivals (not named in a later round nor
         ruled out by the swap check), whose stacking mixture gives f; () when none."""
-        rounds = unresolved_rounds(self.causes, self.verdicts)
+        rounds = open_rounds(self.causes, self.verdicts)
         if not rounds:
             return ()
         v = self.verdicts[rounds[0]]
@@ -236,14 +243,14 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     st = _search(dg, prep, _Search(base, base), max_causes=max_causes, workers=workers, seed=seed, say=say, t0=t0)
     final, causes, rounds, verdicts = st.reference, st.causes, st.rounds, st.verdicts
     swaps: tuple[Swap, ...] = ()
-    spare = {}
+    checked: tuple[ModelFit, ...] = ()
     if swap_jobs(causes, verdicts, rounds):
         say("the candidates fitted in turn against their open rivals and without them, with the later causes in the "
             "model")
-        verdicts, swaps, spare = check_swaps(
+        verdicts, swaps, checked = check_swaps(
             dg, final, causes, verdicts, rounds, rule=NAMING, workers=workers, seed=seed + len(rounds),
             flagged=lambda fit: misfit_detected(prep, dg.predictive(fit)))
-    if st.not_sep and verdicts and 0 not in unresolved_rounds(causes, verdicts):
+    if st.not_sep and verdicts and 0 not in open_rounds(causes, verdicts):
         # the rivals of round 1 were second causes, named in later rounds, or ruled out with them in the model
         st.not_sep, st.separate_by = (), None
     say("posterior predictive of the final model")
@@ -255,19 +262,36 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     method = None
     mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else \
         mixture(st.base, rounds[0], verdicts[0], seed, stationary_f)
+    mixture_of = "candidates" if mix is not None else None
     if causes:
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final, workers=workers)
         k, ess, method = ex.pareto_k, ex.ess, ex.method
-        mix, mix_w, mix_src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f, spare)
-        if mix is None:  # the last round's weight on further mechanisms none of which it named
-            mix, mix_w, mix_src = further_mixture(final, rounds, verdicts, causes, seed)
+        mix, mix_w, mix_src, mixture_of = _mixture_after_causes(final, rounds, verdicts, causes, swaps, checked,
+                                                                seed, stationary_f)
     return Diagnosis(baseline=st.base, rounds=tuple(rounds), misfits=tuple(st.misfits), causes=tuple(causes),
                      not_separable=st.not_sep, channels_not_separable=st.other_channels, separate_by=st.separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
                      posterior_method=method, context=dg.context, seed=seed, verdicts=tuple(verdicts),
-                     mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src, swaps=swaps)
+                     mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src, swaps=swaps,
+                     swap_models=checked, mixture_of=mixture_of)
+
+
+def _mixture_after_causes(final: ModelFit, rounds: list, verdicts: list, causes: list, swaps: tuple, checked: tuple,
+                          seed: int, stationary_f: np.ndarray | None) -> tuple:
+    """f's mixture once causes were fitted, and which: a round's open rivals first, else the last round's further
+    mechanisms, else a superfluous candidate's round (:mod:`.candidates_mixture`); (None, {}, None, None): f is the
+    final model's."""
+    mix, w, src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f)
+    if mix is not None:
+        return mix, w, src, "rivals"
+    mix, w, src = further_mixture(final, rounds, verdicts, causes, seed)
+    if mix is not None:
+        return mix, w, src, "further"
+    k = next((j for j, v in enumerate(verdicts[:len(causes)]) if v.superfluous), None)
+    mix, w, src = superfluous_mixture(final, [m for s, m in zip(swaps, checked) if s.round == k], seed)
+    return mix, w, src, ("superfluous" if mix is not None else None)
 
 
 def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, workers: int, seed: int,

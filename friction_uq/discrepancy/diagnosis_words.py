@@ -10,10 +10,11 @@ import numpy as np
 
 from ..models.parameters import Parameter
 from ..quoted import OUTPUT_BARS, folded_sd, quoted_summary
-from .candidates_mixture import STATIONARY, unresolved_rounds
+from .candidates_mixture import STATIONARY, open_rounds
 from .diagnose import Diagnosis
 from .extended import Variant
 from .record_likelihood import GAIN_SD
+from .rival_swaps import WITHOUT
 from .whole_record import CHANNEL_LABELS
 
 #: Mechanisms that fit an output bar's own calibration (its gauge's gain; the bars' moduli): a model with one reads
@@ -41,14 +42,14 @@ def unresolved(dg: Diagnosis) -> bool:
     """A round of candidates whose rivals no later round named: the candidate fitted in turn is not named
     (``Diagnosis.named_causes`` holds the causes that are), and f is the mixture of the candidates
     (``Diagnosis.mixture_f``, ``Diagnosis.open_candidates``)."""
-    return bool(unresolved_rounds(dg.causes, dg.verdicts))
+    return bool(open_rounds(dg.causes, dg.verdicts))
 
 
 def further(dg: Diagnosis) -> dict[str, str]:
     """The further mechanisms the last round's stacking mixture gives f with, beside the model with the causes,
     none of which it named (:func:`~.candidates_mixture.further_mixture`): each member's label -> the mechanism it
     adds to the model with the causes (``gauge_gain[external_output_bar]``); {} when f is that model's alone."""
-    if not dg.causes or dg.mixture_f is None or unresolved(dg):
+    if not dg.causes or dg.mixture_f is None or unresolved(dg) or dg.mixture_of == "superfluous":
         return {}
     added = {r.fit.label: r.fit.variants[-1].label for r in dg.rounds[-1]}
     return {k: added.get(k, k) for k in dg.mixture_weights if k != dg.final.label}
@@ -71,7 +72,7 @@ def member_variants(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
     its calibration budget and its prior of f_effective are read from."""
     if label in ("reference", STATIONARY):
         return ()
-    fits = [dg.final, dg.baseline] + [r.fit for rnd in dg.rounds for r in rnd]
+    fits = [dg.final, dg.baseline] + [r.fit for rnd in dg.rounds for r in rnd] + list(dg.swap_models)
     return next((m.variants for m in fits if m.label == label), ())
 
 
@@ -194,7 +195,9 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
                 f"nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
                 f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     steps = sorted(f_steps(dg), key=lambda s: -abs(s[2] - s[1]))
-    named = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
+    fitted = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
+    named = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in dg.named_causes)
+    spare = _superfluous(dg)
     gauges = ""  # the first round's cause, a gain, about as good on another gauge
     if dg.channels_not_separable and dg.cause is dg.causes[0]:
         alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
@@ -202,22 +205,20 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     first = _evidence_of(dg, dg.cause) if dg.cause is not None else dg.ranking[0]
     if unresolved(dg):  # candidates no later round told apart: the one fitted in turn is no more the cause than
         # its rivals, and f is their mixture
-        found = [s for s in steps if s[0] in dg.named_causes]
-        turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v not in dg.named_causes)
+        open_ = {dg.causes[k] for k in open_rounds(dg.causes, dg.verdicts)[:1]}
+        turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in open_)
         rivals = ", ".join(dg.open_candidates)
-        spare = _superfluous(dg, turn)
-        if found:
-            lead = (f"Causes found, the one that moves f most first: "
-                    f"{'; '.join(f'{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}' for v, a, b in found)}{gauges}." +
-                    (spare or f" A further cause this record does not tell apart: {rivals} (fitted in turn: {turn})."))
+        if named:
+            lead = (f"Causes found, the one that moves f most first: {named}{gauges}. A further cause this record "
+                    f"does not tell apart: {rivals} (fitted in turn: {turn}).{spare}")
         else:
             lead = ("Candidates, not a cause: this record does not tell apart "
-                    f"{', '.join(dg.not_separable) or rivals}; fitted in turn: {named}.")
+                    f"{', '.join(dg.not_separable) or rivals}; fitted in turn: {fitted}.{spare}")
         quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
-        evidence = "first cause" if found else "strongest candidate"
+        evidence = "first cause" if named else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     elif more := further(dg):  # the last round's weight lies on further mechanisms it did not name: their mixture
-        lead = f"Causes found, the one that moves f most first: {named}{gauges}."
+        lead = f"Causes found, the one that moves f most first: {named}{gauges}.{spare}"
         shares = ", ".join(f"{'them' if k == dg.final.label else '+ ' + more[k]} {100 * w:.0f} %"
                            for k, w in dg.mixture_weights.items())
         with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
@@ -227,8 +228,10 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
     else:
-        lead = f"Causes found, the one that moves f most first: {named}{gauges}."
-        quote = "with them (the f to quote)"
+        lead = f"Causes found, the one that moves f most first: {named}{gauges}.{spare}"
+        quote = "with them (the f to quote)" if dg.mixture_of != "superfluous" else (
+            f"from the {mixture_label(dg)}: the model with every mechanism fitted and the same without the one not "
+            "named, weighted by how well each predicts the record (the f to quote)")
         evidence = "first cause"
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
@@ -262,22 +265,26 @@ def _by_weight(dg: Diagnosis) -> str:
     return "".join(out)
 
 
-def _superfluous(dg: Diagnosis, turn: str) -> str:
-    """' X was fitted in turn among the candidates of its round, but with Y in the model the record does not need it
-    (...): not named.' when the first round left open is one whose candidate the swap check found superfluous
-    (:mod:`.rival_swaps`); '' otherwise. ``turn``: the candidate in words, with f before and after it."""
-    rounds = unresolved_rounds(dg.causes, dg.verdicts)
-    k = rounds[0] if rounds else None
-    without = next((s for s in dg.swaps if s.round == k and s.rival not in
-                    {c.label for c in dg.verdicts[k].candidates}), None) if k is not None else None
-    if without is None or not dg.verdicts[k].superfluous:
-        return ""
-    others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
-    gap = f"the model without it is {without.delpd:.0f} +- {without.se:.0f} nats worse"
-    why = (f"{gap}, not decisive by the naming rule" if without.ruling is None else
-           f"{gap}, but within what two simulators of the same test differ by: the whole-record check does not flag it")
-    return (f" Fitted in turn among the candidates of its round: {turn}; with {others} in the model the record does "
-            f"not need it ({why}): not named.")
+def _superfluous(dg: Diagnosis) -> str:
+    """' Fitted in turn among the candidates of its round: X; with Y in the model the record does not need it (...):
+    not named.' for each candidate fitted in turn that the swap check found superfluous (:mod:`.rival_swaps`); ''
+    when none."""
+    out = []
+    steps = f_steps(dg)  # in the causes' order
+    for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
+        without = next((s for s in dg.swaps if s.round == k and s.rival == WITHOUT), None)
+        if not v.superfluous or without is None:
+            continue
+        cause, a, b = steps[k]
+        others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
+        d = without.delpd
+        gap = f"the model without it is {abs(d):.0f} +- {without.se:.0f} nats {'worse' if d >= 0 else 'better'}"
+        why = (f"{gap}, not decisive by the naming rule" if without.ruling is None else
+               f"{gap}, but within what two simulators of the same test differ by: the whole-record check does not "
+               f"flag it")
+        out.append(f" Fitted in turn among the candidates of its round: {cause_words(cause, dg)}, f {a:.3f} -> "
+                   f"{b:.3f}; with {others} in the model the record does not need it ({why}): not named.")
+    return "".join(out)
 
 
 def _swapped(dg: Diagnosis) -> str:
@@ -294,8 +301,9 @@ def _swapped(dg: Diagnosis) -> str:
         worse = ", ".join(f"{by[s.rival]} {s.delpd:.0f} +- {s.se:.0f} nats" + (" (by the weight)" if s.ruling == "weight"
                                                                                else "") for s in done)
         alone = next((f"; without it, {s.delpd:.0f} +- {s.se:.0f} nats worse"
-                      f"{' (by the weight)' if s.ruling == 'weight' else ''}, and a misfit the whole-record check "
-                      f"flags" for s in dg.swaps if s.round == k and s.rival not in by), "")
+                      f"{' (by the weight)' if s.ruling == 'weight' else ''}"
+                      f"{', and a misfit the whole-record check flags' if s.flagged else ''}"
+                      for s in dg.swaps if s.round == k and s.rival == WITHOUT), "")
         out.append(f" {dg.causes[k].mechanism.name} was one of the candidates of its round; with {others} in the model, "
                    f"each of its rivals explains the record worse ({worse}{alone}).")
     return "".join(out)

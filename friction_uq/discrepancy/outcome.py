@@ -77,7 +77,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "fitted_in_turn": [c.label for c in dg.causes],
         "open_candidates": list(dg.open_candidates),
         # candidates fitted in turn the later causes made superfluous (the model without them not ruled out, or, where
-        # a rival stays open, not flagged by the whole-record check): not named
+        # their round left a rival open, not flagged by the whole-record check): not named
         "superfluous": list(dg.superfluous),
         # the candidates fitted in turn against their rounds' open rivals, with the later causes in the model
         "swaps": [{"round": sw.round + 1, "rival": sw.rival, "model": sw.model, "delpd": sw.delpd, "se": sw.se,
@@ -113,8 +113,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                 "(in equal parts with the stationary analysis' f when "
                 "nothing is named, with run); after a named cause the search goes on with it in the model; a candidate "
                 "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
-                "left open by the same rule, and the model without it, which the whole-record check must flag "
-                "(swaps; else it is superfluous, and f the stacking mixture of the final model and the swaps)",
+                "left open by the same rule, and the model without it, which the whole-record check must then flag "
+                "(where its round left no rival open, by the rule alone; swaps); else it is superfluous and not "
+                "named",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "

@@ -38,16 +38,15 @@ round's candidates are the plug friction and the velocity weakening, both there,
 fitted in turn by its evidence alone; the one fitted in turn is 133-165 (+- 24-35) nats better than the model
 without it, which the check does not flag. Asking the gate of it alone would name one of two real causes and drop
 the other by the order they were fitted in. A candidate that fails its test is *superfluous*
-(``Verdict.superfluous``): not named, and f is the stacking mixture of the final model and the models of the check
-of its round (the model without it, the rivals swapped in), every one of which holds the later causes.
+(``Verdict.superfluous``): not named. Where no round leaves a rival open, f is then the stacking mixture of the
+final model and the check's models of its round (the model without it, the rivals swapped in), every one of which
+holds the later causes (:func:`~.candidates_mixture.superfluous_mixture`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-
-import numpy as np
 
 from ..stats.trimmed import points_to_drop
 from .candidates_mixture import open_rivals
@@ -101,21 +100,16 @@ def swap_jobs(causes: list[Variant], verdicts: list[Verdict],
     return out
 
 
-#: For each superfluous round, the members of f's mixture besides the final model: the check's models of that
-#: round (label -> f_effective draws) and the stacking weights over the final model ("reference") and them.
-Alternatives = dict[int, tuple[dict[str, np.ndarray], dict[str, float]]]
-
-
 def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts: list[Verdict], rounds: list, *,
                 rule: NamingRule, flagged: Callable[[ModelFit], bool], workers: int,
-                seed: int) -> tuple[list[Verdict], tuple[Swap, ...], Alternatives]:
+                seed: int) -> tuple[list[Verdict], tuple[Swap, ...], tuple[ModelFit, ...]]:
     """The verdicts with each round's rivals that the final model rules out against their swaps marked resolved, or
-    the round marked superfluous, every swap's comparison, and the superfluous rounds' :data:`Alternatives` (module
+    the round marked superfluous, every swap's comparison and each swap's fitted model, in the same order (module
     docstring). ``flagged``: the whole-record check's decision on a fitted model (True: a misfit beyond the
     tolerance), asked of a model without a candidate that the final model rules out."""
     jobs = swap_jobs(causes, verdicts, rounds)
     if not jobs:
-        return verdicts, (), {}
+        return verdicts, (), ()
     start = dict(final.fit.mode)
     fits = dg.fit_many([(variants, start, "+".join(v.label for v in variants)) for _, _, variants in jobs],
                        workers=workers)
@@ -123,24 +117,21 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
     behind = {"reference": 0.0} | {f.label: elpd_difference(final.elpd, f.elpd)[0] for f in fits}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
     how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits}, weights, behind, drop)
-    by_label = {f.label: f for f in fits}
     swaps = []
     for (k, label, _), f in zip(jobs, fits):
         d, se = elpd_difference(final.elpd, f.elpd)
         how = how_each[f.label]
         misfit = flagged(f) if label == WITHOUT and how is not None else None
         swaps.append(Swap(k, label, f.label, d, se, weights[f.label], how, misfit))
-    out, spare = list(verdicts), {}
+    out = list(verdicts)
     for k in sorted({s.round for s in swaps}):
         mine = [s for s in swaps if s.round == k]
         without = next(s for s in mine if s.rival == WITHOUT)
         if without.ruling is None or (len(mine) > 1 and not without.flagged):
             # the candidate is not needed with the later causes in the model: nothing is resolved (the check's gate
-            # is asked only where an open rival could stand in its place; module docstring)
+            # is asked only where its round left a rival open that could stand in its place; module docstring)
             out[k] = replace(out[k], superfluous=True)
-            spare[k] = ({s.model: by_label[s.model].f_effective for s in mine},
-                        {"reference": weights["reference"]} | {s.model: s.weight for s in mine})
             continue
         done = tuple(s.rival for s in mine if s.rival != WITHOUT and s.ruling is not None)
         out[k] = replace(out[k], resolved=out[k].resolved + done)
-    return out, tuple(swaps), spare
+    return out, tuple(swaps), tuple(fits)

@@ -107,8 +107,9 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
                   "none explains is unexplained (f then from the stacking mixture, "
                   "half of it the stationary analysis' f when nothing is named); "
                   "after a named cause the search goes on with it in the model; a candidate fitted in turn is "
-                  "named when, with the later causes in the model, it rules out so each rival of its round and the "
-                  "model without it, which the whole-record check must flag."]
+                  "named when, with the later causes in the model, it rules out so each rival of its round left "
+                  "open and the model without it, which the whole-record check must then flag (where no rival was "
+                  "left open, by the rule alone); else it is superfluous and not named."]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")

@@ -27,6 +27,11 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
                                for k, w in diagnosis.mixture_weights.items())
             return (f"the causes diagnose named ({named}) mixed with the further causes the record leans to "
                     f"without naming one ({shares})", fx)
+        if diagnosis.mixture_of == "superfluous":  # a candidate fitted in turn the later causes did not need
+            named = ", ".join(v.label for v in diagnosis.named_causes)
+            said = (f"the {label}: the causes diagnose named ({named}) with and without "
+                    f"{', '.join(diagnosis.superfluous)}, fitted in turn and not needed")
+            return said, fx
         if diagnosis.mixture_f is not None:  # unexplained, or candidates the record does not tell apart
             named = ", ".join(v.label for v in diagnosis.named_causes)
             if named:  # a cause named, a later round's candidates left open

@@ -88,7 +88,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
         listed = f" ({', '.join(open_)})" if open_ else ""
         if not diagnosis.causes and diagnosis.verdict.kind == "unexplained":
             what = "no single cause explains it"
-        elif named and diagnosis.superfluous:
+        elif named and diagnosis.mixture_of == "superfluous":
             what = (f"it names {named}; {', '.join(diagnosis.superfluous)}, fitted in turn, is not needed with them "
                     "and not named")
         elif named:
