@@ -65,7 +65,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "round_verdicts": [r.kind for r in dg.verdicts],
         "stacking_weights": dict(v.weights) if v is not None else {},
         "mixture": None if dg.mixture_f is None else {"weights": dict(dg.mixture_weights),
-                                                      "f": summarize_draws(dg.mixture_f)},
+                                                      "f": summarize_draws(dg.mixture_f), "of": dg.mixture_of},
         "cause": cause.mechanism.name if cause else None,
         "cause_channel": cause.channel if cause else None,
         # a measurement-chain fault fitted on every gauge: the gauge whose parameter departs most from reading right
