@@ -165,7 +165,8 @@ def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
 
     causes, verdicts, rounds, final = _record()
     good = np.asarray(final.elpd.pointwise)
-    out, swaps, _ = check_swaps(_Fitter({"clearance": good - 0.5, "channel_timing": good - 1.0, "bandwidth": good - 1.0}),
+    fitter = _Fitter({"clearance": good - 0.5, "channel_timing": good - 1.0, "bandwidth": good - 1.0})
+    out, swaps, _ = check_swaps(fitter,
                              final, causes,
                              verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
                                   flagged=lambda fit: True)
