@@ -288,3 +288,18 @@ def test_a_superfluous_candidate_in_the_sentence_the_f_to_quote_and_the_warning(
     assert "the causes diagnose named (clearance) with and without dispersion, fitted in turn and not needed" in source
     assert "it names clearance; dispersion, fitted in turn, is not needed with them and not named" in _next_step(dg,
                                                                                                                None)
+
+    # with a rival of its round left open, f is that round's mixture and the sentence says both
+    causes, verdicts, rounds, final = _record(first_rivals=("clearance", "bandwidth"))
+    good = np.asarray(final.elpd.pointwise)
+    out, swaps, checked = check_swaps(_Fitter({"clearance": alike, "bandwidth": good - 1.0}), final, causes, verdicts,
+                                      rounds, rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
+    final.f_effective, final.predicted = np.full(50, 0.04), {}
+    rounds = [tuple(SimpleNamespace(fit=r.fit, delpd=100.0, se=10.0) for r in rnd) for rnd in rounds]
+    mix, w, src, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None)
+    dg = replace(dg, rounds=tuple(rounds), causes=tuple(causes), final=final, verdicts=tuple(out), swaps=swaps,
+                 swap_models=checked, mixture_f=mix, mixture_weights=w, mixture_source=src, mixture_of=kind)
+    said = sentence(dg, {"q05": 0.055, "q50": 0.060, "q95": 0.065})
+    assert kind == "rivals" and dg.open_candidates == ("dispersion", "bandwidth"), (kind, dg.open_candidates)
+    assert "A further cause this record does not tell apart: dispersion, bandwidth (fitted in turn: wave dispersion" \
+        in said and "with clearance in the model the record does not need it" in said, said

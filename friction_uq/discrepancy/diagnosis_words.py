@@ -205,7 +205,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     first = _evidence_of(dg, dg.cause) if dg.cause is not None else dg.ranking[0]
     if unresolved(dg):  # candidates no later round told apart: the one fitted in turn is no more the cause than
         # its rivals, and f is their mixture
-        open_ = {dg.causes[k] for k in open_rounds(dg.causes, dg.verdicts)[:1]}
+        open_ = [dg.causes[k] for k in open_rounds(dg.causes, dg.verdicts)[:1]]  # a Variant holds dicts: no set
         turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in open_)
         rivals = ", ".join(dg.open_candidates)
         if named:
