@@ -519,7 +519,7 @@ def test_the_words_of_a_further_mixture_name_the_further_causes():
                    misfits=(), causes=(clearance,), not_separable=(), separate_by=None, final=fin,
                    verdicts=(_verdict("named", "clearance"), _verdict("none", labels=(extra.label,))),
                    mixture_f=x, mixture_weights={"clearance": 0.6, extra.label: 0.4},
-                   mixture_source=np.r_[np.zeros(600, int), np.ones(400, int)])
+                   mixture_source=np.r_[np.zeros(600, int), np.ones(400, int)], mixture_of="further")
     assert not unresolved(dg) and further(dg) == {extra.label: "gauge_gain[external_output_bar]"}
     source, fx = f_to_quote({"q05": 0.0, "q50": 0.0, "q95": 0.0}, dg)
     assert source.startswith("the causes diagnose named (clearance) mixed with the further causes"), source

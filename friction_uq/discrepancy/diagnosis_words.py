@@ -49,7 +49,7 @@ def further(dg: Diagnosis) -> dict[str, str]:
     """The further mechanisms the last round's stacking mixture gives f with, beside the model with the causes,
     none of which it named (:func:`~.candidates_mixture.further_mixture`): each member's label -> the mechanism it
     adds to the model with the causes (``gauge_gain[external_output_bar]``); {} when f is that model's alone."""
-    if not dg.causes or dg.mixture_f is None or unresolved(dg) or dg.mixture_of == "superfluous":
+    if dg.mixture_of != "further":  # diagnose says which mixture gives f
         return {}
     added = {r.fit.label: r.fit.variants[-1].label for r in dg.rounds[-1]}
     return {k: added.get(k, k) for k in dg.mixture_weights if k != dg.final.label}
@@ -276,7 +276,7 @@ def _superfluous(dg: Diagnosis) -> str:
         if not v.superfluous or without is None:
             continue
         cause, a, b = steps[k]
-        others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
+        others = _other_causes(dg, k)
         d = without.delpd
         gap = f"the model without it is {abs(d):.0f} +- {without.se:.0f} nats {'worse' if d >= 0 else 'better'}"
         why = (f"{gap}, not decisive by the naming rule" if without.ruling is None else
@@ -285,6 +285,11 @@ def _superfluous(dg: Diagnosis) -> str:
         out.append(f" Fitted in turn among the candidates of its round: {cause_words(cause, dg)}, f {a:.3f} -> "
                    f"{b:.3f}; with {others} in the model the record does not need it ({why}): not named.")
     return "".join(out)
+
+
+def _other_causes(dg: Diagnosis, k: int) -> str:
+    """'clearance, plug_friction': the mechanisms of the final model besides round ``k``'s candidate fitted in turn."""
+    return ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
 
 
 def _swapped(dg: Diagnosis) -> str:
@@ -297,7 +302,7 @@ def _swapped(dg: Diagnosis) -> str:
         if not done or dg.causes[k] not in dg.named_causes:
             continue
         by = {c.label: c.variant for c in v.candidates}
-        others = ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
+        others = _other_causes(dg, k)
         worse = ", ".join(f"{by[s.rival]} {s.delpd:.0f} +- {s.se:.0f} nats" + (" (by the weight)" if s.ruling == "weight"
                                                                                else "") for s in done)
         alone = next((f"; without it, {s.delpd:.0f} +- {s.se:.0f} nats worse"

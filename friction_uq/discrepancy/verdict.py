@@ -99,7 +99,8 @@ class Verdict:
     #: labels of rivals a later check ruled out with the later causes in the model (:mod:`.rival_swaps`)
     resolved: tuple[str, ...] = ()
     #: the candidate fitted in turn is not needed with the later causes in the model: the model without it is not
-    #: ruled out, or the whole-record check does not flag it (:mod:`.rival_swaps`); it is then not named
+    #: ruled out, or, where its round left a rival open, the whole-record check does not flag it
+    #: (:mod:`.rival_swaps`); it is then not named
     superfluous: bool = False
 
     @property
