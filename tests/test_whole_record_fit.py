@@ -148,7 +148,7 @@ def test_the_hoop_gauge_is_weighed_with_the_likelihoods_own_tolerance(clean_reco
 def _hoop_unloading_reads_high(rec, by: float):
     """The record with its hoop gauge reading up to ``by`` more than it did, rising linearly over the hoop's
     unloading (a shape of the tube's strain the 1-D model does not make; the window's level unchanged)."""
-    i0, i1, i2, i3 = channel_spans(prepare(rec), ("tube_hoop",))["tube_hoop"]
+    _, _, i2, i3 = channel_spans(prepare(rec), ("tube_hoop",))["tube_hoop"]
     h = rec.channels["tube_hoop"]
     ramp = np.clip((np.arange(len(h.strain)) - i2) / (i3 - i2), 0.0, 1.0)
     channels = dict(rec.channels) | {"tube_hoop": dataclasses.replace(h, strain=h.strain * (1.0 + by * ramp))}
