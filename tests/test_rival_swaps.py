@@ -47,10 +47,12 @@ def test_each_open_rival_is_swapped_in_for_the_candidate_with_the_later_cause_ke
         (0, "channel_timing", ("channel_timing", "clearance")), (0, "bandwidth", ("bandwidth", "clearance"))]
     # without a later cause the swap is the round's own comparison: nothing to ask
     assert swap_jobs(causes[:1], verdicts[:1], rounds[:1]) == []
-    # a second friction law cannot join the model beside a named one: the rival stays open
+    # a second friction law cannot join the model beside the one named later: it stands in for the candidate and
+    # that law together
     causes, verdicts, rounds, _ = _record(first_rivals=("velocity_friction",), first="clearance",
                                           second="pressure_friction")
-    assert swap_jobs(causes, verdicts, rounds) == []
+    assert [(k, label, tuple(v.label for v in variants)) for k, label, variants in swap_jobs(causes, verdicts, rounds)
+            ] == [(0, WITHOUT, ("pressure_friction",)), (0, "velocity_friction", ("velocity_friction",))]
     # the last cause's round: its swaps would be its own comparison again, with no later cause in the model
     causes, verdicts, rounds, final = _record()
     rival = _fit("dispersion+bandwidth", final.elpd.pointwise)
@@ -63,16 +65,24 @@ def test_each_open_rival_is_swapped_in_for_the_candidate_with_the_later_cause_ke
         1, WITHOUT)
 
 
-def test_a_rival_that_cannot_be_swapped_in_keeps_its_round_open_whatever_the_others_do():
+def test_a_second_friction_law_stands_in_for_the_candidate_and_the_later_law_and_keeps_the_round_open_if_it_can():
+    """Round 1: clearance fitted in turn, the velocity law and a bandwidth open; round 2: the pressure law named. The
+    velocity law is swapped in for the clearance and the pressure law at once. Ruled out, the round is resolved and
+    the clearance named (before, such a rival could not be asked and kept the round open); not ruled out, it keeps
+    the round open whatever the bandwidth does."""
     causes, verdicts, rounds, final = _record(first_rivals=("velocity_friction", "bandwidth"), first="clearance",
                                               second="pressure_friction")
     good = np.asarray(final.elpd.pointwise)
-    fitter = _Fitter({"pressure_friction": good - 1.0, "bandwidth": good - 1.0})
-    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
-                             flagged=lambda fit: True)
-    assert [s.rival for s in swaps] == [WITHOUT, "bandwidth"]
-    assert out[0].resolved == ("bandwidth",) and unresolved_rounds(causes, out) == (0,)
-    assert [v.mechanism.name for v in named_causes(causes, out)] == ["pressure_friction"]
+    for law, resolved, open_rounds in ((good - 1.0, ("velocity_friction", "bandwidth"), ()),
+                                       (good, ("bandwidth",), (0,))):
+        fitter = _Fitter({"pressure_friction": good - 1.0, "bandwidth": good - 1.0, "velocity_friction": law})
+        out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                                    flagged=lambda fit: True)
+        assert fitter.asked == ["pressure_friction", "velocity_friction", "bandwidth+pressure_friction"]
+        assert [s.rival for s in swaps] == [WITHOUT, "velocity_friction", "bandwidth"]
+        assert out[0].resolved == resolved and unresolved_rounds(causes, out) == open_rounds
+        named = [v.mechanism.name for v in named_causes(causes, out)]
+        assert named == (["clearance", "pressure_friction"] if not open_rounds else ["pressure_friction"])
 
 
 def test_the_weight_never_rules_out_a_model_among_those_that_carry_90_percent_of_it():
@@ -180,6 +190,22 @@ def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
     # without the swaps, nothing is said
     assert _swapped(Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(),
                               separate_by=None, final=final, verdicts=tuple(verdicts))) == ""
+
+
+def test_the_sentence_says_when_a_rival_stood_in_for_a_later_cause_too():
+    from friction_uq.discrepancy.diagnose import Diagnosis
+    from friction_uq.discrepancy.diagnosis_words import _swapped
+
+    causes, verdicts, rounds, final = _record(first_rivals=("velocity_friction",), first="clearance",
+                                              second="pressure_friction")
+    good = np.asarray(final.elpd.pointwise)
+    fitter = _Fitter({"pressure_friction": good - 1.0, "velocity_friction": good - 1.0})
+    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                                flagged=lambda fit: True)
+    words = _swapped(Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes),
+                               not_separable=(), separate_by=None, final=final, verdicts=tuple(out), swaps=swaps))
+    assert ("with pressure_friction in the model, each of its rivals explains the record worse (velocity_friction "
+            "(in place of it and pressure_friction) 200 +- 0 nats; without it") in words, words
 
 
 def test_a_candidate_whose_rivals_later_rounds_all_named_must_still_earn_its_place():

@@ -303,8 +303,8 @@ def _swapped(dg: Diagnosis) -> str:
             continue
         by = {c.label: c.variant for c in v.candidates}
         others = _other_causes(dg, k)
-        worse = ", ".join(f"{by[s.rival]} {s.delpd:.0f} +- {s.se:.0f} nats" + (" (by the weight)" if s.ruling == "weight"
-                                                                               else "") for s in done)
+        worse = ", ".join(f"{by[s.rival]}{_standing_in(dg, k, s)} {s.delpd:.0f} +- {s.se:.0f} nats"
+                          + (" (by the weight)" if s.ruling == "weight" else "") for s in done)
         alone = next((f"; without it, {s.delpd:.0f} +- {s.se:.0f} nats worse"
                       f"{' (by the weight)' if s.ruling == 'weight' else ''}"
                       f"{', and a misfit the whole-record check flags' if s.flagged else ''}"
@@ -312,6 +312,14 @@ def _swapped(dg: Diagnosis) -> str:
         out.append(f" {dg.causes[k].mechanism.name} was one of the candidates of its round; with {others} in the model, "
                    f"each of its rivals explains the record worse ({worse}{alone}).")
     return "".join(out)
+
+
+def _standing_in(dg: Diagnosis, k: int, s) -> str:
+    """' (in place of it and Y)' when the swap took out a later cause of the rival's group too (a second friction
+    law: :func:`~.rival_swaps.swapped`); '' otherwise."""
+    kept = set(s.model.split("+"))
+    gone = [c.label for j, c in enumerate(dg.causes) if j != k and c.label not in kept]
+    return f" (in place of it and {', '.join(gone)})" if gone else ""
 
 
 def _remaining(dg: Diagnosis) -> str:

@@ -27,8 +27,10 @@ check's tolerance forgives.
 
 Asked only of a round followed by a later cause: for the last cause's round the swap is the round's own
 comparison, already judged. The weight route is the naming rule's own, its 90 % guard included. A rival of the
-same group as another cause (a second friction law) cannot be swapped in and stays open; so does one the final
-model does not rule out.
+same group as a later cause (a second friction law) cannot join the model beside it: it is swapped in for the
+candidate *and* that cause, and must stand in for both (on the bundled B-02, the slip law, a rival of the first
+round's dispersion, against the velocity law named later). Before, such a rival could not be asked and kept its
+round open. A rival the final model does not rule out stays open.
 
 A round whose rivals later rounds all named has no rival to swap in, but its candidate must earn its place just the
 same: a rival named later may be what the candidate stood for. The model without it is then fitted alone and must
@@ -77,10 +79,9 @@ class Swap:
 
 def swap_jobs(causes: list[Variant], verdicts: list[Verdict],
               rounds: list) -> list[tuple[int, str, tuple[Variant, ...]]]:
-    """(round, rival label, the final model's variants with the round's candidate replaced by the rival) for each
-    rival a round of candidates left open that can be swapped in, after (round, :data:`WITHOUT`, the variants
-    without the candidate) for each such round, and for each round of candidates whose rivals later rounds all
-    named (module docstring)."""
+    """(round, rival label, the final model's variants with the round's candidate replaced by the rival:
+    :func:`swapped`) for each rival a round of candidates left open, after (round, :data:`WITHOUT`, the variants
+    without the candidate) for each round of candidates followed by a later cause (module docstring)."""
     if len(causes) < 2:
         return []
     out = []
@@ -88,16 +89,17 @@ def swap_jobs(causes: list[Variant], verdicts: list[Verdict],
         if verdict.kind != "candidates":
             continue
         fits = {r.fit.label: r.fit for r in rounds[k]}
-        groups = {v.mechanism.group for j, v in enumerate(causes) if j != k and v.mechanism.group}
-        left = open_rivals(verdict, causes)
-        swaps = []
-        for label in left:
-            rival = fits[label].variants[-1]
-            if rival.mechanism.group is None or rival.mechanism.group not in groups:
-                swaps.append((k, label, tuple(causes[:k]) + (rival,) + tuple(causes[k + 1:])))
-        if swaps or not left:  # open rivals none of which can be swapped in keep the round open as it is
-            out += [(k, WITHOUT, tuple(causes[:k]) + tuple(causes[k + 1:])), *swaps]
+        swaps = [(k, label, swapped(causes, k, fits[label].variants[-1])) for label in open_rivals(verdict, causes)]
+        out += [(k, WITHOUT, tuple(causes[:k]) + tuple(causes[k + 1:])), *swaps]
     return out
+
+
+def swapped(causes: list[Variant], k: int, rival: Variant) -> tuple[Variant, ...]:
+    """The causes with the k-th replaced by ``rival``; a later cause of the rival's group (a second friction law)
+    leaves with it, since one model holds one law of a group: the rival must then stand in for both."""
+    group = rival.mechanism.group
+    return tuple(rival if j == k else v for j, v in enumerate(causes)
+                 if j == k or group is None or v.mechanism.group != group)
 
 
 def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts: list[Verdict], rounds: list, *,
