@@ -74,18 +74,22 @@ def study(n: int, seed: int, tolerances: list[float], one_d: bool) -> dict[tuple
                 make_record(c, path, int(rng.integers(2**31)), None, rng)  # both made: the same records either way
                 if label == "1-D" and not one_d:
                     continue
+                rows = {}
                 for tol in tolerances:
                     record_likelihood.LIKELIHOOD_TOLERANCE["tube_hoop"] = tol
                     t = time.perf_counter()
                     try:
                         r = baseline_f(path, f)
-                    except FrictionUQError as exc:
+                    except FrictionUQError as exc:  # a record refused is left out under every tolerance
                         print(f"{k:3d} {label}: refused ({exc})", flush=True)
+                        rows = {}
                         break
-                    out.setdefault((label, tol), []).append(r)
+                    rows[tol] = r
                     print(f"{k:3d} {label:<12} f {f:.3f} nu {nu:.3f} hoop tolerance {tol:.2f}: f error "
                           f"{100 * r['error']:+6.1f} % (sd {100 * r['sd']:4.1f} %), covered {bool(r['covered'])}, nu "
                           f"{r['nu']:.3f}, hoop factor {r['hoop']:.3f} ({time.perf_counter() - t:.0f} s)", flush=True)
+                for tol, r in rows.items():
+                    out.setdefault((label, tol), []).append(r)
     return out
 
 

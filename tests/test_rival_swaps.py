@@ -10,7 +10,7 @@ from friction_uq.discrepancy.candidates_mixture import named_causes, unresolved_
 from friction_uq.discrepancy.elpd import Elpd
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
-from friction_uq.discrepancy.rival_swaps import WITHOUT, check_swaps, swap_jobs
+from friction_uq.discrepancy.rival_swaps import WITHOUT, check_swaps, swap_jobs, swap_start
 from friction_uq.discrepancy.verdict import Candidate, NamingRule, Verdict
 
 N = 200
@@ -83,6 +83,27 @@ def test_a_second_friction_law_stands_in_for_the_candidate_and_the_later_law_and
         assert out[0].resolved == resolved and unresolved_rounds(causes, out) == open_rounds
         named = [v.mechanism.name for v in named_causes(causes, out)]
         assert named == (["clearance", "pressure_friction"] if not open_rounds else ["pressure_friction"])
+
+
+def test_a_law_swapped_in_for_another_starts_from_its_own_fit_and_its_round_may_be_superfluous():
+    """f and a law's parameters mean other things under another law: the velocity law swapped in for the clearance and
+    the pressure law starts from its own round-1 fit; other swaps from the final model's mode. And where the model
+    without the candidate is ruled out but not flagged by the check, with a rival left open that could stand in, the
+    candidate is superfluous (the gate of rounds with an open rival)."""
+    causes, verdicts, rounds, final = _record(first_rivals=("velocity_friction", "bandwidth"), first="clearance",
+                                              second="pressure_friction")
+    rounds[0][1].fit.fit = SimpleNamespace(mode={"f": 0.07, "nu": 0.41, "f_s": 0.09, "v_c": 3.0})
+    final.fit = SimpleNamespace(mode={"f": 0.05, "nu": 0.4, "gap": 1e-6, "p0": 1e8})
+    jobs = swap_jobs(causes, verdicts, rounds)
+    starts = {label: swap_start(final, rounds, causes, k, label, v) for k, label, v in jobs}
+    assert starts[WITHOUT] == starts["bandwidth"] == final.fit.mode
+    assert starts["velocity_friction"] == {"f": 0.07, "nu": 0.4, "gap": 1e-6, "p0": 1e8, "f_s": 0.09, "v_c": 3.0}
+    good = np.asarray(final.elpd.pointwise)
+    fitter = _Fitter({"pressure_friction": good - 1.0, "bandwidth": good, "velocity_friction": good})
+    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                                flagged=lambda fit: False)
+    assert swaps[0].ruling == "elpd" and swaps[0].flagged is False and out[0].superfluous and out[0].resolved == ()
+    assert [v.mechanism.name for v in named_causes(causes, out)] == ["pressure_friction"]
 
 
 def test_the_weight_never_rules_out_a_model_among_those_that_carry_90_percent_of_it():
@@ -204,8 +225,9 @@ def test_the_sentence_says_when_a_rival_stood_in_for_a_later_cause_too():
                                 flagged=lambda fit: True)
     words = _swapped(Diagnosis(baseline=None, rounds=tuple(rounds), misfits=(), causes=tuple(causes),
                                not_separable=(), separate_by=None, final=final, verdicts=tuple(out), swaps=swaps))
-    assert ("with pressure_friction in the model, each of its rivals explains the record worse (velocity_friction "
-            "(in place of it and pressure_friction) 200 +- 0 nats; without it") in words, words
+    assert ("with pressure_friction in the model, each of its rivals explains the record worse (velocity_friction"
+            ", which replaces pressure_friction too (one law of a group at a time), 200 +- 0 nats; without it"
+            ) in words, words
 
 
 def test_a_candidate_whose_rivals_later_rounds_all_named_must_still_earn_its_place():

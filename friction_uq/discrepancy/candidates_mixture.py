@@ -95,8 +95,8 @@ def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int
                         ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """When a candidate fitted in turn is superfluous (:mod:`.rival_swaps`) and no round leaves a rival open: f's
     draws from the stacking mixture of the final model and ``checked``, the swap check's models of that round (the
-    final model without the candidate, and the rivals swapped in), every one holding the later causes, weighted by
-    one stacking over them; (None, {}, None) without them."""
+    final model without the candidate, and the rivals swapped in), holding the later causes (a rival of a later
+    cause's group replaces that cause too), weighted by one stacking over them; (None, {}, None) without them."""
     if not checked:
         return None, {}, None
     weights = round_weights(final, list(checked), seed)

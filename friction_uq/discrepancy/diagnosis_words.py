@@ -315,11 +315,11 @@ def _swapped(dg: Diagnosis) -> str:
 
 
 def _standing_in(dg: Diagnosis, k: int, s) -> str:
-    """' (in place of it and Y)' when the swap took out a later cause of the rival's group too (a second friction
-    law: :func:`~.rival_swaps.swapped`); '' otherwise."""
+    """', which replaces Y too (one law of a group at a time),' when the swap took out a later cause of the rival's
+    group as well (a second friction law: :func:`~.rival_swaps.swapped`); '' otherwise."""
     kept = set(s.model.split("+"))
     gone = [c.label for j, c in enumerate(dg.causes) if j != k and c.label not in kept]
-    return f" (in place of it and {', '.join(gone)})" if gone else ""
+    return f", which replaces {', '.join(gone)} too (one law of a group at a time)," if gone else ""
 
 
 def _remaining(dg: Diagnosis) -> str:

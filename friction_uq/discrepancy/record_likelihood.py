@@ -44,7 +44,7 @@ HOOP_GAIN_SD = 0.05
 #: (f = kappa (1 - nu)/nu) mostly through the hoop gauge; on records of the axisymmetric simulation the hoop's
 #: shape departs from the 1-D model's by more than the check's 3 %, and a fit that trusts it bends nu low and the
 #: sample's modulus high to follow it (hoop factor up to 1.48, f up to 57 % high; f's 90 % interval held the truth
-#: on 25 of 36 clean records). The smallest of 3, 5, 7, 10 and 15 % under which diagnose's baseline f holds the
+#: on 22 of 32 clean records). The smallest of 3, 5, 7, 10 and 15 % under which diagnose's baseline f holds the
 #: truth on at least 90 % of 32 clean axisymmetric records (``benchmarks/bench_likelihood_tolerance.py``, seeds 53
 #: and 59; docs/trust.md). The check keeps its own tolerance: it asks whether the model misses, not how far a
 #: shape it cannot follow may pull the parameters.

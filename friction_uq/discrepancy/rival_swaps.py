@@ -7,9 +7,9 @@ timing and an amplifier's bandwidth explain the first misfit about alike, since 
 at the same fronts; with the clearance in the model, the candidates part.
 
 For each rival a round left open, :func:`check_swaps` fits the final model with the candidate fitted in turn
-replaced by the rival (the other causes kept) and asks the naming rule's question of the final model against
-each such swap (:meth:`.verdict.NamingRule.ruling`: decisively better, or by the weight route, the stacking weights
-taken over the final model and its swaps). A rival ruled out is resolved (``Verdict.resolved``); when every open
+replaced by the rival (the other causes kept, but a later cause of the rival's group: below) and asks the
+naming rule's question of the final model against each such swap (:meth:`.verdict.NamingRule.ruling`: decisively
+better, or by the weight route, the stacking weights taken over the final model and its swaps). A rival ruled out is resolved (``Verdict.resolved``); when every open
 rival of a round is, the candidate fitted in turn is named (``Diagnosis.named_causes``).
 
 The candidate must also still earn its place: the final model without it (:data:`WITHOUT`, the other causes
@@ -102,6 +102,19 @@ def swapped(causes: list[Variant], k: int, rival: Variant) -> tuple[Variant, ...
                  if j == k or group is None or v.mechanism.group != group)
 
 
+def swap_start(final: ModelFit, rounds: list, causes: list[Variant], k: int, label: str,
+               variants: tuple[Variant, ...]) -> dict[str, float]:
+    """Where a swap's mode search starts: the final model's mode; where the swap took out a cause of the rival's group
+    (one friction law for another: f and the law's parameters mean other things), f and the rival's parameters from
+    the rival's own fit in round k."""
+    start = dict(final.fit.mode)
+    if label == WITHOUT or len(variants) == len(causes):
+        return start
+    own = next(r.fit for r in rounds[k] if r.fit.label == label)
+    names = ("f", *(p.name for p in own.variants[-1].mechanism.parameters))
+    return start | {n: own.fit.mode[n] for n in names if n in own.fit.mode}
+
+
 def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts: list[Verdict], rounds: list, *,
                 rule: NamingRule, flagged: Callable[[ModelFit], bool], workers: int,
                 seed: int) -> tuple[list[Verdict], tuple[Swap, ...], tuple[ModelFit, ...]]:
@@ -112,9 +125,8 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
     jobs = swap_jobs(causes, verdicts, rounds)
     if not jobs:
         return verdicts, (), ()
-    start = dict(final.fit.mode)
-    fits = dg.fit_many([(variants, start, "+".join(v.label for v in variants)) for _, _, variants in jobs],
-                       workers=workers)
+    fits = dg.fit_many([(variants, swap_start(final, rounds, causes, k, label, variants),
+                         "+".join(v.label for v in variants)) for k, label, variants in jobs], workers=workers)
     weights = round_weights(final, fits, seed)
     behind = {"reference": 0.0} | {f.label: elpd_difference(final.elpd, f.elpd)[0] for f in fits}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)

@@ -43,7 +43,8 @@ LEAD = 10e-6
 #: Model tolerance per channel, relative to the signal: a bar gauge's calibration and the bar's E
 #: and c are rarely better than 1 %; the tube's influence function is fitted to 2.4 % of its peak
 #: (docs/physics.md section 6). The misfit decision forgives residuals within it; the whole-record
-#: likelihood adds it to the noise.
+#: likelihood adds it to the noise, but on the hoop gauge its own, wider one
+#: (:data:`~.record_likelihood.LIKELIHOOD_TOLERANCE`).
 TOLERANCE = {"input_bar": 0.01, "internal_output_bar": 0.01, "external_output_bar": 0.01, "tube_hoop": 0.03}
 #: Timing tolerance (s): a wave's arrival is known to about a sample (the bars' wave speeds to
 #: ~0.05 %, the plug's impact on the incident front's curvature); it forgives tau |dm/dt| on fronts.
