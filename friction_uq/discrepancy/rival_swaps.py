@@ -9,8 +9,9 @@ at the same fronts; with the clearance in the model, the candidates part.
 For each rival a round left open, :func:`check_swaps` fits the final model with the candidate fitted in turn
 replaced by the rival (the other causes kept, but a later cause of the rival's group: below) and asks the
 naming rule's question of the final model against each such swap (:meth:`.verdict.NamingRule.ruling`: decisively
-better, or by the weight route, the stacking weights taken over the final model and its swaps). A rival ruled out is resolved (``Verdict.resolved``); when every open
-rival of a round is, the candidate fitted in turn is named (``Diagnosis.named_causes``).
+better, or by the weight route, the stacking weights taken over the final model and its swaps). A rival ruled out
+is resolved (``Verdict.resolved``); when every open rival of a round is, the candidate fitted in turn is named
+(``Diagnosis.named_causes``).
 
 The candidate must also still earn its place: the final model without it (:data:`WITHOUT`, the other causes
 kept) must be ruled out the same way, or no rival of its round is resolved. On an axisymmetric record with a slip
