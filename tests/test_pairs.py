@@ -95,11 +95,13 @@ def test_a_candidate_fitted_in_turn_is_named_when_the_later_cause_separates_it_f
     assert "dispersion was one of the candidates of its round" in doc["sentence"], doc["sentence"]
 
 
-def test_a_candidate_the_whole_record_check_does_not_need_is_not_named(tmp_path):
-    from friction_uq.discrepancy.rival_swaps import WITHOUT
-
+def test_a_drift_that_stood_for_the_cells_hoop_shape_is_neither_fitted_nor_named(tmp_path):
+    """axi-3 of the study (a slip law with plug friction, axisymmetric cell): with the check's 3 % tolerance on the
+    hoop gauge in the likelihood, a zero drift on the hoop was fitted in turn among the first round's candidates,
+    absorbing where the cell's hoop strain departs from the 1-D model's, and only the swap check's gate kept it
+    unnamed (125 +- 33 nats, not flagged). With the likelihood's own 10 % (LIKELIHOOD_TOLERANCE) the hoop's shape no
+    longer pulls a mechanism in: both causes that are there are named in rounds of their own and the drift is not
+    in the model at all. The gate itself is tested on its own (tests/test_rival_swaps.py)."""
     _, _, dg = _study_record("axisymmetric", 3, tmp_path)
-    assert "zero_drift" in {v.mechanism.name for v in dg.causes}  # fitted in turn
     assert {v.mechanism.name for v in dg.named_causes} == {"slip_friction", "plug_friction"}
-    without = [sw for sw in dg.swaps if sw.rival == WITHOUT]
-    assert without and all(not sw.flagged for sw in without), dg.swaps
+    assert "zero_drift" not in {v.mechanism.name for v in dg.causes}, [v.label for v in dg.causes]

@@ -132,17 +132,21 @@ def clean_record(tmp_path_factory):
 
 
 def test_the_hoop_gauge_is_weighed_with_the_likelihoods_own_tolerance(clean_record):
-    """The hoop's samples are widened by LIKELIHOOD_TOLERANCE's 10 % of its signal, the bar gauges' by the check's
-    TOLERANCE (1 %): s_t = sqrt(sd^2 + tol_t^2), weight sd / s_t."""
+    """The hoop's samples are widened by LIKELIHOOD_TOLERANCE's 10 % of its signal over its window and unloading and
+    by the check's 3 % over its rise, the bar gauges' by the check's TOLERANCE (1 %): s_t = sqrt(sd^2 + tol_t^2),
+    weight sd / s_t."""
     rec = clean_record
     prep = prepare(rec)
     lik = WholeRecordLikelihood(prep, SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), hoop=True))
     for c in lik.channels:
-        i0, _, _, i3 = lik.bounds[c]
-        rel = LIKELIHOOD_TOLERANCE.get(c, TOLERANCE[c])
-        tol = tolerance_sd(lik.measured[c], c, sample_rate=rec.sample_rate, relative=rel)[i0:i3]
-        assert np.allclose(lik.weight[c], lik.noise[c].sd / np.hypot(lik.noise[c].sd, tol), rtol=1e-12), c
-    assert LIKELIHOOD_TOLERANCE["tube_hoop"] > TOLERANCE["tube_hoop"]
+        i0, i1, i2, i3 = lik.bounds[c]
+        for phase, (a, b) in zip(("rise", "stationary", "unloading"), ((i0, i1), (i1, i2), (i2, i3))):
+            rel = LIKELIHOOD_TOLERANCE.get((c, phase), TOLERANCE[c])
+            tol = tolerance_sd(lik.measured[c], c, sample_rate=rec.sample_rate, relative=rel)[a:b]
+            w = lik.noise[c].sd / np.hypot(lik.noise[c].sd, tol)
+            assert np.allclose(lik.weight[c][a - i0:b - i0], w, rtol=1e-12), (c, phase)
+    assert LIKELIHOOD_TOLERANCE[("tube_hoop", "unloading")] > TOLERANCE["tube_hoop"]
+    assert LIKELIHOOD_TOLERANCE[("tube_hoop", "stationary")] > TOLERANCE["tube_hoop"]
 
 
 def _hoop_unloading_reads_high(rec, by: float):
@@ -170,6 +174,7 @@ def test_a_hoop_shape_the_model_does_not_make_moves_nu_within_its_posterior(clea
     nu0, sd = fitted_nu(clean)
     shift = abs(fitted_nu(bent)[0] - nu0)
     assert shift < sd
-    monkeypatch.setitem(LIKELIHOOD_TOLERANCE, "tube_hoop", TOLERANCE["tube_hoop"])
+    for phase in ("stationary", "unloading"):
+        monkeypatch.setitem(LIKELIHOOD_TOLERANCE, ("tube_hoop", phase), TOLERANCE["tube_hoop"])
     shift_check = abs(fitted_nu(bent)[0] - fitted_nu(clean)[0])
     assert shift_check > sd and shift_check > 2.0 * shift
