@@ -95,13 +95,20 @@ def test_a_candidate_fitted_in_turn_is_named_when_the_later_cause_separates_it_f
     assert "dispersion was one of the candidates of its round" in doc["sentence"], doc["sentence"]
 
 
-def test_a_drift_that_stood_for_the_cells_hoop_shape_is_neither_fitted_nor_named(tmp_path):
-    """axi-3 of the study (a slip law with plug friction, axisymmetric cell): with the check's 3 % tolerance on the
-    hoop gauge in the likelihood, a zero drift on the hoop was fitted in turn among the first round's candidates,
-    absorbing where the cell's hoop strain departs from the 1-D model's, and only the swap check's gate kept it
-    unnamed (125 +- 33 nats, not flagged). With the likelihood's own 10 % (LIKELIHOOD_TOLERANCE) the hoop's shape no
-    longer pulls a mechanism in: both causes that are there are named in rounds of their own and the drift is not
-    in the model at all. The gate itself is tested on its own (tests/test_rival_swaps.py)."""
-    _, _, dg = _study_record("axisymmetric", 3, tmp_path)
-    assert {v.mechanism.name for v in dg.named_causes} == {"slip_friction", "plug_friction"}
-    assert "zero_drift" not in {v.mechanism.name for v in dg.causes}, [v.label for v in dg.causes]
+def test_a_drift_that_stood_for_the_cells_hoop_shape_is_not_named_and_f_holds_the_truth(tmp_path):
+    """axi-3 of the study (a slip law with plug friction, axisymmetric cell). With the check's 3 % tolerance on the
+    hoop gauge in the likelihood, a zero drift on the hoop was fitted in turn, absorbing where the cell's hoop strain
+    departs from the 1-D model's; only the swap check's gate kept it unnamed, and f under the two causes named
+    missed the truth (0.054 [0.051, 0.059] against 0.0497). With the likelihood's own 10 % over the hoop's window
+    and unloading (LIKELIHOOD_TOLERANCE), the slip law is named, the plug friction stays among the candidates the
+    record does not tell apart from the drift (nothing wrong is named), and f, their mixture, holds the truth."""
+    from bench_diagnose import true_f
+
+    from friction_uq.discrepancy.diagnosis_words import quoted_of
+
+    cfg, prep, dg = _study_record("axisymmetric", 3, tmp_path)
+    named = {v.mechanism.name for v in dg.named_causes}
+    assert "slip_friction" in named and named <= {"slip_friction", "plug_friction"}, named
+    assert "plug_friction" in named | set(dg.open_candidates), (named, dg.open_candidates)
+    fx, truth = quoted_of(dg), true_f(cfg, prep)
+    assert fx["q05"] <= truth <= fx["q95"], (fx, truth)
