@@ -178,3 +178,31 @@ def test_a_hoop_shape_the_model_does_not_make_moves_nu_within_its_posterior(clea
         monkeypatch.setitem(LIKELIHOOD_TOLERANCE, ("tube_hoop", phase), TOLERANCE["tube_hoop"])
     shift_check = abs(fitted_nu(bent)[0] - fitted_nu(clean)[0])
     assert shift_check > sd and shift_check > 2.0 * shift
+
+
+def test_the_whole_record_check_fits_with_the_channels_own_tolerance(clean_record, monkeypatch):
+    """The check's decision (its tolerance table, its thresholds) was calibrated on fits with the channels' own
+    tolerance; its fit keeps it (phase_tolerance={}: the hoop at 3 % everywhere), while diagnose's models take
+    LIKELIHOOD_TOLERANCE."""
+    from friction_uq.discrepancy import check
+
+    prep = prepare(clean_record)
+    model = SimulatorModel(clean_record.apparatus, measured_loading(clean_record, prep.forces), hoop=True)
+    own = WholeRecordLikelihood(prep, model, phase_tolerance={})
+    for c in own.channels:
+        i0, _, _, i3 = own.bounds[c]
+        tol = tolerance_sd(own.measured[c], c, sample_rate=clean_record.sample_rate)[i0:i3]
+        assert np.allclose(own.weight[c], own.noise[c].sd / np.hypot(own.noise[c].sd, tol), rtol=1e-12), c
+    made = []
+
+    class Stop(Exception):
+        pass
+
+    def recording(*args, **kwargs):
+        made.append(kwargs)
+        raise Stop
+
+    monkeypatch.setattr(check, "WholeRecordLikelihood", recording)
+    with pytest.raises(Stop):
+        check.check_whole_record(prep, lambda v: 0.0, {"f": 0.06, "nu": 0.4}, hoop=True, seed=1)
+    assert made == [{"phase_tolerance": {}}]

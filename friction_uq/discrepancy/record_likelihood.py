@@ -57,8 +57,13 @@ LIKELIHOOD_TOLERANCE: dict[tuple[str, str], float] = {("tube_hoop", "stationary"
 class WholeRecordLikelihood:
     """log p(record | parameters) over every gauge's span (module docstring)."""
 
-    def __init__(self, prep: Prepared, model: SimulatorModel, *, hoop_gain_sd: float = HOOP_GAIN_SD) -> None:
+    def __init__(self, prep: Prepared, model: SimulatorModel, *, hoop_gain_sd: float = HOOP_GAIN_SD,
+                 phase_tolerance: Mapping[tuple[str, str], float] | None = None) -> None:
+        """``phase_tolerance``: the relative tolerance of a (channel, phase) where it is not the channel's
+        (:data:`~.whole_record.TOLERANCE`); None: :data:`LIKELIHOOD_TOLERANCE`, {}: the channel's everywhere (the
+        whole-record check's fit, as its decision was calibrated)."""
         rec = prep.record
+        self.phase_tolerance = LIKELIHOOD_TOLERANCE if phase_tolerance is None else phase_tolerance
         self.model = model
         self.channels = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or model.hoop))
         #: relative sd of each marginalised gain error, by channel
@@ -80,11 +85,11 @@ class WholeRecordLikelihood:
 
     def _tolerance(self, c: str, sample_rate: float) -> np.ndarray:
         """The channel's tolerated model error over its span: the check's (:func:`~.whole_record.tolerance_sd`), but
-        where :data:`LIKELIHOOD_TOLERANCE` gives a phase its own relative part."""
+        where ``phase_tolerance`` gives a phase its own relative part."""
         i0, i1, i2, i3 = self.bounds[c]
         tol = tolerance_sd(self.measured[c], c, sample_rate=sample_rate)[i0:i3]
         for phase, (a, b) in zip(PHASES, ((i0, i1), (i1, i2), (i2, i3))):
-            rel = LIKELIHOOD_TOLERANCE.get((c, phase))
+            rel = self.phase_tolerance.get((c, phase))
             if rel is not None:
                 tol[a - i0:b - i0] = tolerance_sd(self.measured[c], c, sample_rate=sample_rate, relative=rel)[a:b]
         return tol
