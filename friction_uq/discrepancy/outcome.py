@@ -79,8 +79,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         # candidates fitted in turn the later causes made superfluous (the model without them not ruled out, or, where
         # their round left a rival open, not flagged by the whole-record check): not named
         "superfluous": list(dg.superfluous),
-        # the candidates fitted in turn against their rounds' open rivals, with the later causes in the model (a rival of a
-        # later cause's group replaces that cause too)
+        # the candidates fitted in turn against their rounds' open rivals, with the later causes in the model (a rival
+        # of a later cause's group replaces that cause too)
         "swaps": [{"round": sw.round + 1, "rival": sw.rival, "model": sw.model, "delpd": sw.delpd, "se": sw.se,
                    "weight": sw.weight, "ruled_out": sw.ruling, "check_flags": sw.flagged} for sw in dg.swaps],
         "not_separable": list(dg.not_separable),

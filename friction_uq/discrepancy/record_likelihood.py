@@ -11,8 +11,8 @@ tolerated model error (:func:`~.whole_record.tolerance_sd`: 1-2 % of the signal 
 3 % on the hoop gauge's rise and 10 % over the rest of its span (:data:`LIKELIHOOD_TOLERANCE`), and a timing
 tolerance of 0.2 us times the local slope), and the residual scaled by sd / s_t is AR(1) with the gauge's
 coefficient. Without it the 0.1 %-level differences between any two simulators of the test (time step, mesh, a
-rounded constant) would read as physics on the high-signal channels. Each channel's offset error (the pre-pulse mean is uncertain), each
-output bar gauge's gain error (its calibration, 1 %: an error correlated over the whole record,
+rounded constant) would read as physics on the high-signal channels. Each channel's offset error (the pre-pulse
+mean is uncertain), each output bar gauge's gain error (its calibration, 1 %: an error correlated over the whole record,
 which the per-sample tolerance alone would treat as averaging out) and the hoop gauge's calibration
 factor (5 %, as the default prior file's ``hoop_gain``) enter linearly with Gaussian priors and
 are marginalised: least squares on the whitened residuals with one pseudo-residual per nuisance
