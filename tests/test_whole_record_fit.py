@@ -131,22 +131,30 @@ def clean_record(tmp_path_factory):
     return read_record(path)
 
 
-def test_the_hoop_gauge_is_weighed_with_the_likelihoods_own_tolerance(clean_record):
-    """The hoop's samples are widened by LIKELIHOOD_TOLERANCE's 10 % of its signal over its window and unloading and
-    by the check's 3 % over its rise, the bar gauges' by the check's TOLERANCE (1 %): s_t = sqrt(sd^2 + tol_t^2),
-    weight sd / s_t."""
+#: The per-phase tolerance measured (docs/trust.md) and not applied: the hoop at 10 % over its window and unloading.
+HOOP_WIDE = {("tube_hoop", "stationary"): 0.10, ("tube_hoop", "unloading"): 0.10}
+
+
+def test_a_phase_is_weighed_with_its_own_tolerance_where_one_is_given(clean_record):
+    """With a per-phase table the hoop's samples are widened by its 10 % over its window and unloading and by the
+    channel's 3 % over its rise, the bar gauges' by TOLERANCE (1 %): s_t = sqrt(sd^2 + tol_t^2), weight sd / s_t;
+    without one (the package's LIKELIHOOD_TOLERANCE, empty) every phase has the channel's."""
     rec = clean_record
     prep = prepare(rec)
-    lik = WholeRecordLikelihood(prep, SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), hoop=True))
+    model = SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), hoop=True)
+    lik = WholeRecordLikelihood(prep, model, phase_tolerance=HOOP_WIDE)
     for c in lik.channels:
         i0, i1, i2, i3 = lik.bounds[c]
         for phase, (a, b) in zip(("rise", "stationary", "unloading"), ((i0, i1), (i1, i2), (i2, i3))):
-            rel = LIKELIHOOD_TOLERANCE.get((c, phase), TOLERANCE[c])
+            rel = HOOP_WIDE.get((c, phase), TOLERANCE[c])
             tol = tolerance_sd(lik.measured[c], c, sample_rate=rec.sample_rate, relative=rel)[a:b]
             w = lik.noise[c].sd / np.hypot(lik.noise[c].sd, tol)
             assert np.allclose(lik.weight[c][a - i0:b - i0], w, rtol=1e-12), (c, phase)
-    assert LIKELIHOOD_TOLERANCE[("tube_hoop", "unloading")] > TOLERANCE["tube_hoop"]
-    assert LIKELIHOOD_TOLERANCE[("tube_hoop", "stationary")] > TOLERANCE["tube_hoop"]
+    default = WholeRecordLikelihood(prep, model)
+    assert LIKELIHOOD_TOLERANCE == {} and not np.allclose(default.weight["tube_hoop"], lik.weight["tube_hoop"])
+    for c in lik.channels:
+        tol = tolerance_sd(lik.measured[c], c, sample_rate=rec.sample_rate)[lik.bounds[c][0]:lik.bounds[c][3]]
+        assert np.allclose(default.weight[c], lik.noise[c].sd / np.hypot(lik.noise[c].sd, tol), rtol=1e-12), c
 
 
 def _hoop_unloading_reads_high(rec, by: float):
@@ -160,9 +168,10 @@ def _hoop_unloading_reads_high(rec, by: float):
 
 
 def test_a_hoop_shape_the_model_does_not_make_moves_nu_within_its_posterior(clean_record, monkeypatch):
-    """An 8 % departure of the hoop's unloading (within the likelihood's tolerance) moves the baseline's nu by less
-    than its posterior sd; with the check's 3 % tolerance in the likelihood it drags nu more than twice as far
-    (f = kappa (1 - nu)/nu follows nu: on records of the axisymmetric simulation that drag made f up to 57 % high)."""
+    """An 8 % departure of the hoop's unloading, within a 10 % tolerance there (the table measured, not applied),
+    moves the baseline's nu by less than its posterior sd; with the channel's 3 % (as applied) it drags nu more than
+    its sd and twice as far (f = kappa (1 - nu)/nu follows nu: on records of the axisymmetric simulation that drag
+    made f up to 57 % high). The measurement's own machinery, tested."""
     def log_prior(v):
         return float(stats.halfnorm(scale=0.3).logpdf(v["f"]) + stats.norm(0.4, 0.03).logpdf(v["nu"]))
 
@@ -170,12 +179,14 @@ def test_a_hoop_shape_the_model_does_not_make_moves_nu_within_its_posterior(clea
         m = Diagnoser(prep, log_prior, hoop=True, seed=1).fit((), {"f": 0.06, "nu": 0.4}, "baseline")
         return float(np.median(m.fit.draws["nu"])), float(np.std(m.fit.draws["nu"]))
 
+    for key, value in HOOP_WIDE.items():
+        monkeypatch.setitem(LIKELIHOOD_TOLERANCE, key, value)
     clean, bent = prepare(clean_record), _hoop_unloading_reads_high(clean_record, 0.08)
     nu0, sd = fitted_nu(clean)
     shift = abs(fitted_nu(bent)[0] - nu0)
     assert shift < sd
-    for phase in ("stationary", "unloading"):
-        monkeypatch.setitem(LIKELIHOOD_TOLERANCE, ("tube_hoop", phase), TOLERANCE["tube_hoop"])
+    for key in HOOP_WIDE:
+        monkeypatch.delitem(LIKELIHOOD_TOLERANCE, key)
     shift_check = abs(fitted_nu(bent)[0] - fitted_nu(clean)[0])
     assert shift_check > sd and shift_check > 2.0 * shift
 
