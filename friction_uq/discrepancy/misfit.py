@@ -71,7 +71,7 @@ import numpy as np
 from ..stats.ar1 import ar1_mean_sd
 from .whole_record import (
     CHANNEL_LABELS,
-    PHASES,
+    phases_of,
     WholeRecord,
     compare_whole_record,
     tolerance_sd,
@@ -239,7 +239,7 @@ def phase_spans(wr: WholeRecord, channel: str) -> list[tuple[str, int, int]]:
     """(phase, first sample, end) of each phase of ``channel`` long enough to test (>= 10 samples); the rise of a
     channel of :data:`SPLIT_RISE` as its two halves in time, "early rise" and "late rise"."""
     i0, iw0, iw1, i3 = wr.phase_bounds[channel]
-    spans = [(p, a, b) for p, (a, b) in zip(PHASES, ((i0, iw0), (iw0, iw1), (iw1, i3))) if b - a >= 10]
+    spans = [(p, a, b) for p, a, b in phases_of(wr.phase_bounds[channel]) if b - a >= 10]
     if channel in SPLIT_RISE and iw0 - i0 >= 20:
         mid = (i0 + iw0) // 2
         spans = [("early rise", i0, mid), ("late rise", mid, iw0)] + [s for s in spans if s[0] != "rise"]

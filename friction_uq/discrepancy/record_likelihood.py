@@ -30,7 +30,7 @@ import numpy as np
 
 from ..analysis import Prepared
 from ..models.simulator import SimulatorModel
-from .whole_record import CHANNEL_LABELS, PHASES, channel_noise, channel_spans, tolerance_sd, whiten
+from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, phases_of, tolerance_sd, whiten
 
 #: Calibration errors of the output bar gauges marginalised in the whole-record likelihood (relative sd):
 #: a bar gauge's calibration and the bar's E and c are known to about 1 % (the level part of
@@ -81,9 +81,9 @@ class WholeRecordLikelihood:
     def _tolerance(self, c: str, sample_rate: float) -> np.ndarray:
         """The channel's tolerated model error over its span: the check's (:func:`~.whole_record.tolerance_sd`), but
         where ``phase_tolerance`` gives a phase its own relative part."""
-        i0, i1, i2, i3 = self.bounds[c]
+        i0, i3 = self.bounds[c][0], self.bounds[c][3]
         tol = tolerance_sd(self.measured[c], c, sample_rate=sample_rate)[i0:i3]
-        for phase, (a, b) in zip(PHASES, ((i0, i1), (i1, i2), (i2, i3))):
+        for phase, a, b in phases_of(self.bounds[c]):
             rel = self.phase_tolerance.get((c, phase))
             if rel is not None:
                 tol[a - i0:b - i0] = tolerance_sd(self.measured[c], c, sample_rate=sample_rate, relative=rel)[a:b]

@@ -166,6 +166,13 @@ def phase_figures(resid: np.ndarray, measured: np.ndarray, noise: ChannelNoise, 
                         longest_run=longest_sign_run(w), mean_residual=m, mean_measured=float(np.mean(measured)))
 
 
+def phases_of(bounds: tuple[int, int, int, int]) -> tuple[tuple[str, int, int], ...]:
+    """(phase, first sample, end) of the rise, the stationary window and the unloading of a channel's span
+    (start, window start, window end, end: :func:`channel_spans`)."""
+    i0, i1, i2, i3 = bounds
+    return tuple(zip(PHASES, (i0, i1, i2), (i1, i2, i3)))
+
+
 def channel_spans(prep: Prepared, channels: tuple[str, ...]) -> dict[str, tuple[int, int, int, int]]:
     """Per channel: sample indices (start, window start, window end, end) at its gauge (module docstring)."""
     rec, forces = prep.record, prep.forces
