@@ -157,6 +157,16 @@ def test_a_phase_is_weighed_with_its_own_tolerance_where_one_is_given(clean_reco
         assert np.allclose(default.weight[c], lik.noise[c].sd / np.hypot(lik.noise[c].sd, tol), rtol=1e-12), c
 
 
+def test_a_misspelt_phase_is_refused_not_ignored(clean_record):
+    """A table key naming no (channel, phase) would leave that phase at the channel's tolerance without a word
+    (the window is "stationary", not "window")."""
+    prep = prepare(clean_record)
+    model = SimulatorModel(clean_record.apparatus, measured_loading(clean_record, prep.forces), hoop=True)
+    for key in (("tube_hoop", "window"), ("hoop", "unloading")):
+        with pytest.raises(ValueError, match="unknown"):
+            WholeRecordLikelihood(prep, model, phase_tolerance={key: 0.1})
+
+
 def _hoop_unloading_reads_high(rec, by: float):
     """The record with its hoop gauge reading up to ``by`` more than it did, rising linearly over the hoop's
     unloading (a shape of the tube's strain the 1-D model does not make; the window's level unchanged)."""

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..analysis import Prepared
 from ..models.simulator import SimulatorModel
-from .whole_record import CHANNEL_LABELS, channel_noise, channel_spans, phases_of, tolerance_sd, whiten
+from .whole_record import CHANNEL_LABELS, PHASES, channel_noise, channel_spans, phases_of, tolerance_sd, whiten
 
 #: Calibration errors of the output bar gauges marginalised in the whole-record likelihood (relative sd):
 #: a bar gauge's calibration and the bar's E and c are known to about 1 % (the level part of
@@ -59,6 +59,9 @@ class WholeRecordLikelihood:
         whole-record check's fit, as its decision was calibrated)."""
         rec = prep.record
         self.phase_tolerance = LIKELIHOOD_TOLERANCE if phase_tolerance is None else phase_tolerance
+        unknown = [k for k in self.phase_tolerance if k[0] not in CHANNEL_LABELS or k[1] not in PHASES]
+        if unknown:  # a misspelt key would leave that phase at the channel's tolerance without a word
+            raise ValueError(f"phase tolerance for unknown (channel, phase) {unknown}: phases are {PHASES}")
         self.model = model
         self.channels = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or model.hoop))
         #: relative sd of each marginalised gain error, by channel
