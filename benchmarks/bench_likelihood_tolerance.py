@@ -64,18 +64,24 @@ def baseline_f(path: str, f_true: float) -> dict[str, float]:
             "nu": float(np.median(final.fit.draws["nu"]))}
 
 
-def configurations(tolerances: list[float], rise_kept: bool) -> dict[str, dict[tuple[str, str], float]]:
-    """The hoop's per-phase tolerances to try, by name: each value over the whole span, and with ``rise_kept`` each
-    with the rise at the check's (absent from the table)."""
-    out = {}
+Table = dict[tuple[str, str], float]
+
+
+def configurations(tolerances: list[float], rise_kept: bool, shapes: list[float]) -> dict[str, tuple[Table, Table]]:
+    """The hoop's per-phase tolerances and shape terms to try, by name: (LIKELIHOOD_TOLERANCE, SHAPE_SD). Each
+    tolerance over the whole span, with ``rise_kept`` each with the rise at the check's (absent from the table);
+    each shape sd over the window and the unloading, the tolerance the channel's."""
+    out: dict[str, tuple[Table, Table]] = {}
     for tol in tolerances:
-        out[f"{tol:.2f}"] = {("tube_hoop", p): tol for p in ("rise", "stationary", "unloading")}
+        out[f"{tol:.2f}"] = ({("tube_hoop", p): tol for p in ("rise", "stationary", "unloading")}, {})
         if rise_kept:
-            out[f"{tol:.2f}, rise 0.03"] = {("tube_hoop", p): tol for p in ("stationary", "unloading")}
+            out[f"{tol:.2f}, rise 0.03"] = ({("tube_hoop", p): tol for p in ("stationary", "unloading")}, {})
+    for sd in shapes:
+        out[f"shape {sd:.2f}"] = ({}, {("tube_hoop", p): sd for p in ("stationary", "unloading")})
     return out
 
 
-def study(n: int, seed: int, configs: dict[str, dict[tuple[str, str], float]],
+def study(n: int, seed: int, configs: dict[str, tuple[Table, Table]],
           one_d: bool) -> dict[tuple[str, str], list[dict]]:
     rng = np.random.default_rng(seed)
     out: dict[tuple[str, str], list[dict]] = {}
@@ -89,9 +95,11 @@ def study(n: int, seed: int, configs: dict[str, dict[tuple[str, str], float]],
                 if label == "1-D" and not one_d:
                     continue
                 rows = {}
-                for tol, table in configs.items():
+                for tol, (table, shape) in configs.items():
                     record_likelihood.LIKELIHOOD_TOLERANCE.clear()
                     record_likelihood.LIKELIHOOD_TOLERANCE.update(table)
+                    record_likelihood.SHAPE_SD.clear()
+                    record_likelihood.SHAPE_SD.update(shape)
                     t = time.perf_counter()
                     try:
                         r = baseline_f(path, f)
@@ -115,8 +123,10 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--tolerances", default="0.03,0.05,0.07,0.1,0.15")
     ap.add_argument("--rise-kept", action="store_true", help="also each value with the hoop's rise at 3 %%")
     ap.add_argument("--one-d", action="store_true", help="the 1-D simulation's records too")
+    ap.add_argument("--shapes", default="", help="shape terms' relative sds on the hoop's window and unloading")
     a = ap.parse_args(argv)
-    configs = configurations([float(x) for x in a.tolerances.split(",")], a.rise_kept)
+    configs = configurations([float(x) for x in a.tolerances.split(",") if x],
+                             a.rise_kept, [float(x) for x in a.shapes.split(",") if x])
     t0 = time.perf_counter()
     res = study(a.n, a.seed, configs, a.one_d)
     print(f"\n{'simulation':<13} {'hoop tol':>16} {'records':>7} {'f covered':>9} {'median error':>12} {'rms error':>9} "

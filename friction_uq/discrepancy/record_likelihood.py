@@ -47,21 +47,37 @@ HOOP_GAIN_SD = 0.05
 #: simulation's own record; a clean axisymmetric record's round of candidates) and three pairs lost a second cause.
 #: ``benchmarks/bench_likelihood_tolerance.py`` fills this table per configuration.
 LIKELIHOOD_TOLERANCE: dict[tuple[str, str], float] = {}
+#: Smooth departures of a (channel, phase) from the model's shape, marginalised like the calibration errors: Legendre
+#: polynomials over the phase (degrees :data:`SHAPE_DEGREES`) times the gauge's level over its window, each
+#: coefficient with a Gaussian prior of this relative sd. Unlike a wider per-sample tolerance it forgives only a
+#: slow bend of the phase (what separates two simulators' hoop strains around the window), not its fronts.
+SHAPE_SD: dict[tuple[str, str], float] = {}
+#: Degrees of the shape terms per phase: none of degree 0 over the window, whose level is the calibration factor's.
+SHAPE_DEGREES = {"rise": (0, 1, 2), "stationary": (1, 2), "unloading": (0, 1, 2)}
+
+
+def _refuse_unknown(table: Mapping[tuple[str, str], float], what: str) -> None:
+    """A key naming no (channel, phase) would leave that phase as it was without a word."""
+    unknown = [k for k in table if k[0] not in CHANNEL_LABELS or k[1] not in PHASES]
+    if unknown:
+        raise ValueError(f"{what} for unknown (channel, phase) {unknown}: phases are {PHASES}")
 
 
 class WholeRecordLikelihood:
     """log p(record | parameters) over every gauge's span (module docstring)."""
 
     def __init__(self, prep: Prepared, model: SimulatorModel, *, hoop_gain_sd: float = HOOP_GAIN_SD,
-                 phase_tolerance: Mapping[tuple[str, str], float] | None = None) -> None:
+                 phase_tolerance: Mapping[tuple[str, str], float] | None = None,
+                 shape_sd: Mapping[tuple[str, str], float] | None = None) -> None:
         """``phase_tolerance``: the relative tolerance of a (channel, phase) where it is not the channel's
         (:data:`~.whole_record.TOLERANCE`); None: :data:`LIKELIHOOD_TOLERANCE`, {}: the channel's everywhere (the
-        whole-record check's fit, as its decision was calibrated)."""
+        whole-record check's fit, as its decision was calibrated). ``shape_sd``: the phases with smooth shape terms
+        (:data:`SHAPE_SD`, the default when None; {}: none)."""
         rec = prep.record
         self.phase_tolerance = LIKELIHOOD_TOLERANCE if phase_tolerance is None else phase_tolerance
-        unknown = [k for k in self.phase_tolerance if k[0] not in CHANNEL_LABELS or k[1] not in PHASES]
-        if unknown:  # a misspelt key would leave that phase at the channel's tolerance without a word
-            raise ValueError(f"phase tolerance for unknown (channel, phase) {unknown}: phases are {PHASES}")
+        self.shape_sd = SHAPE_SD if shape_sd is None else shape_sd
+        _refuse_unknown(self.phase_tolerance, "phase tolerance")
+        _refuse_unknown(self.shape_sd, "shape terms")
         self.model = model
         self.channels = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or model.hoop))
         #: relative sd of each marginalised gain error, by channel
@@ -74,6 +90,7 @@ class WholeRecordLikelihood:
         for c in self.channels:
             nz = self.noise[c]
             self.weight[c] = nz.sd / np.hypot(nz.sd, self._tolerance(c, rec.sample_rate))
+        self.shape = {c: self._shape_basis(c) for c in self.channels}
         self._log_weight = sum(float(np.sum(np.log(w))) for w in self.weight.values())
         # the Gaussian constants (the nuisances' log determinant depends on the prediction: per call)
         self._const = 0.0
@@ -92,6 +109,25 @@ class WholeRecordLikelihood:
                 tol[a - i0:b - i0] = tolerance_sd(self.measured[c], c, sample_rate=sample_rate, relative=rel)[a:b]
         return tol
 
+    def _shape_basis(self, c: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The channel's shape terms (:data:`SHAPE_SD`): raw (scaled) columns over its span, whitened, prior sds."""
+        i0, i1, i2, i3 = self.bounds[c]
+        level = float(np.median(np.abs(self.measured[c][i1:i2]))) if i2 > i1 else 0.0
+        cols, sds = [], []
+        for phase, a, b in phases_of(self.bounds[c]):
+            rel = self.shape_sd.get((c, phase))
+            if rel is None or b - a < 2 or level <= 0.0:
+                continue
+            x = np.linspace(-1.0, 1.0, b - a)
+            for deg in SHAPE_DEGREES[phase]:
+                col = np.zeros(i3 - i0)
+                col[a - i0:b - i0] = np.polynomial.legendre.Legendre.basis(deg)(x) * self.weight[c][a - i0:b - i0]
+                cols.append(col)
+                sds.append(rel)
+        R = np.stack(cols, axis=1) if cols else np.zeros((i3 - i0, 0))
+        nz = self.noise[c]  # a coefficient's sd: rel times the window's level
+        return R, whiten(R, sd=nz.sd, rho=nz.rho_long_run), np.array(sds) * level
+
     def _raw_scaled(self, c: str, pred: np.ndarray) -> np.ndarray:
         sl = self._span(c)
         return (self.measured[c][sl] - pred[sl]) * self.weight[c]
@@ -101,7 +137,7 @@ class WholeRecordLikelihood:
 
         A constant offset error (the pre-pulse mean is uncertain: sd ``offset_sd``) and, on the output bar
         gauges and the hoop gauge, a gain error (their calibration: sd ``gain_sd``), whose direction is the
-        prediction."""
+        prediction; then the phase's shape terms (:data:`SHAPE_SD`)."""
         nz, sl, w = self.noise[c], self._span(c), self.weight[c]
         raw, sds = [], []
         if nz.offset_sd > 0.0:
@@ -110,10 +146,10 @@ class WholeRecordLikelihood:
         if c in self.gain_sd:
             raw.append(pred[sl] * w)
             sds.append(self.gain_sd[c])
-        if not raw:
-            return np.zeros((len(w), 0)), np.zeros((len(w), 0)), np.zeros(0)
-        R = np.stack(raw, axis=1)
-        return R, whiten(R, sd=nz.sd, rho=nz.rho_long_run), np.array(sds)  # whitened along time, per column
+        shape, shape_white, shape_sds = self.shape[c]
+        R = np.concatenate([np.stack(raw, axis=1) if raw else np.zeros((len(w), 0)), shape], axis=1)
+        V = np.concatenate([whiten(R[:, :len(raw)], sd=nz.sd, rho=nz.rho_long_run), shape_white], axis=1)
+        return R, V, np.concatenate([np.array(sds, float), shape_sds])  # V: whitened along time, per column
 
     def _nuisances(self, c: str, pred: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                                            np.ndarray, float]:
@@ -197,7 +233,8 @@ class WholeRecordLikelihood:
     @property
     def n_pseudo(self) -> int:
         """Pseudo-residuals (nuisance / its prior sd) at the end of :meth:`whitened`: one per nuisance."""
-        return sum(int(self.noise[c].offset_sd > 0.0) + int(c in self.gain_sd) for c in self.channels)
+        return sum(int(self.noise[c].offset_sd > 0.0) + int(c in self.gain_sd) + len(self.shape[c][2])
+                   for c in self.channels)
 
     def whitened_from(self, pred: Mapping[str, np.ndarray]) -> np.ndarray:
         return self._whitened_logdet(pred)[0]
