@@ -18,7 +18,10 @@ f's 90 % interval (the posterior's own, without the bars' calibration) holds the
 root mean square, the median posterior sd, the largest error and the median hoop factor.
 
     python benchmarks/bench_likelihood_tolerance.py [--n 16] [--seed 53] [--tolerances 0.03,0.05,0.07,0.1,0.15]
-        [--rise-kept] [--one-d]
+        [--rise-kept] [--one-d] [--shapes 0.05,0.1] [--shape-phases stationary,unloading]
+
+``--shapes`` tries shape terms instead (``SHAPE_SD``: smooth Legendre departures of the hoop's phases, marginalised),
+the hoop's tolerance left at the channel's.
 """
 
 from __future__ import annotations
@@ -67,17 +70,19 @@ def baseline_f(path: str, f_true: float) -> dict[str, float]:
 Table = dict[tuple[str, str], float]
 
 
-def configurations(tolerances: list[float], rise_kept: bool, shapes: list[float]) -> dict[str, tuple[Table, Table]]:
+def configurations(tolerances: list[float], rise_kept: bool, shapes: list[float],
+                   shape_phases: tuple[str, ...] = ("stationary", "unloading")) -> dict[str, tuple[Table, Table]]:
     """The hoop's per-phase tolerances and shape terms to try, by name: (LIKELIHOOD_TOLERANCE, SHAPE_SD). Each
     tolerance over the whole span, with ``rise_kept`` each with the rise at the check's (absent from the table);
-    each shape sd over the window and the unloading, the tolerance the channel's."""
+    each shape sd over ``shape_phases``, the tolerance the channel's."""
     out: dict[str, tuple[Table, Table]] = {}
     for tol in tolerances:
         out[f"{tol:.2f}"] = ({("tube_hoop", p): tol for p in ("rise", "stationary", "unloading")}, {})
         if rise_kept:
             out[f"{tol:.2f}, rise 0.03"] = ({("tube_hoop", p): tol for p in ("stationary", "unloading")}, {})
     for sd in shapes:
-        out[f"shape {sd:.2f}"] = ({}, {("tube_hoop", p): sd for p in ("stationary", "unloading")})
+        out[f"shape {sd:.2f} {'+'.join(p[:4] for p in shape_phases)}"] = ({}, {("tube_hoop", p): sd
+                                                                              for p in shape_phases})
     return out
 
 
@@ -123,10 +128,12 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--tolerances", default="0.03,0.05,0.07,0.1,0.15")
     ap.add_argument("--rise-kept", action="store_true", help="also each value with the hoop's rise at 3 %%")
     ap.add_argument("--one-d", action="store_true", help="the 1-D simulation's records too")
-    ap.add_argument("--shapes", default="", help="shape terms' relative sds on the hoop's window and unloading")
+    ap.add_argument("--shapes", default="", help="shape terms' relative sds on the hoop's phases below")
+    ap.add_argument("--shape-phases", default="stationary,unloading", help="the hoop's phases with shape terms")
     a = ap.parse_args(argv)
     configs = configurations([float(x) for x in a.tolerances.split(",") if x],
-                             a.rise_kept, [float(x) for x in a.shapes.split(",") if x])
+                             a.rise_kept, [float(x) for x in a.shapes.split(",") if x],
+                             tuple(a.shape_phases.split(",")))
     t0 = time.perf_counter()
     res = study(a.n, a.seed, configs, a.one_d)
     print(f"\n{'simulation':<13} {'hoop tol':>16} {'records':>7} {'f covered':>9} {'median error':>12} {'rms error':>9} "
