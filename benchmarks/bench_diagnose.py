@@ -39,7 +39,7 @@ from bench_misfit import clean_config, with_gain  # noqa: E402
 
 from friction_uq.analysis import prepare  # noqa: E402
 from friction_uq.discrepancy.diagnose import diagnose  # noqa: E402
-from friction_uq.discrepancy.diagnosis_words import quoted_of  # noqa: E402
+from friction_uq.discrepancy.diagnosed_f import quoted_of  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.likelihood import Likelihood  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402

@@ -29,7 +29,7 @@ from verdict_records import make, write  # noqa: E402
 
 import friction_uq as fu  # noqa: E402
 from friction_uq.discrepancy.candidates_mixture import STATIONARY  # noqa: E402
-from friction_uq.discrepancy.diagnosis_words import _folded, f_draws_to_quote  # noqa: E402
+from friction_uq.discrepancy.diagnosed_f import _folded, f_draws_to_quote  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.quoted import folded_sd, quoted_summary  # noqa: E402
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from friction_uq.analysis import prepare
-from friction_uq.discrepancy import diagnosis_words, outcome
+from friction_uq.discrepancy import diagnosed_f, diagnosis_words, outcome
 from friction_uq.discrepancy.diagnose import candidates, diagnose
 from friction_uq.discrepancy.mechanisms import MECHANISMS, Mechanism, register
 from friction_uq.models.parameters import F, HOOP_GAIN, NU
@@ -253,7 +253,7 @@ def test_plug_friction_is_named_and_f_recovered(tmp_path):
     # (Var(XG) >= E[G]^2 Var(X) >= Var(X) for an independent factor G of median 1), not in each quantile: the exact
     # quantiles of XG smooth the draws' empirical ones, and on a draw set with a sparse lower tail (this record with
     # the packages of 2026-11-27) q05 moved up by 0.3e-3 and the 90 % interval narrowed by 0.4e-3 with a 2 % factor
-    fq = diagnosis_words.headline(dg)[1]
+    fq = diagnosed_f.headline(dg)[1]
     assert fq["sd"] > fx["sd"], (fq, fx)
     assert fq["q05"] <= 0.05 <= fq["q95"], (fq, fx)
     assert f"f = {fq['q50']:.3f} [{fq['q05']:.3f}, {fq['q95']:.3f}] with them (the f to quote)" in doc["sentence"]
@@ -268,7 +268,7 @@ def test_an_external_gauge_gain_the_check_cannot_see_is_not_named(tmp_path):
         white=1e-6, ar1=1e-6, ar1_coef=0.6, gain=1.12)}), seed=23)
     assert not dg.misfits[0].detected
     assert dg.cause is None and dg.verdict.kind == "none" and dg.mixture_f is None
-    assert diagnosis_words.headline(dg) is None
+    assert diagnosed_f.headline(dg) is None
 
 
 def test_clearance_is_named_and_the_gap_measured(tmp_path):
@@ -304,7 +304,7 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
     assert not dg.misfits[0].detected
     assert dg.cause is None and dg.verdict.kind == "unconfirmed" and dg.verdict.named == "end_friction", \
         [(r.fit.label, r.delpd, r.se) for r in dg.ranking]
-    label, fx = diagnosis_words.headline(dg)
+    label, fx = diagnosed_f.headline(dg)
     assert label.startswith("mixture of") and "end_friction" in dg.mixture_weights
     assert fx["q05"] <= 0.05 <= fx["q95"], fx
     fe = next(r.fit for r in dg.ranking if r.fit.label == "end_friction").fit.draws["f_e"]
@@ -505,7 +505,7 @@ def test_the_words_of_a_further_mixture_name_the_further_causes():
     from types import SimpleNamespace
 
     from friction_uq.discrepancy.diagnose import Diagnosis
-    from friction_uq.discrepancy.diagnosis_words import further, headline, unresolved
+    from friction_uq.discrepancy.diagnosed_f import further, headline, unresolved
     from friction_uq.discrepancy.extended import Variant
     from friction_uq.report.quote import f_to_quote
     from friction_uq.run.warnings import _next_step
@@ -540,7 +540,8 @@ def test_with_no_cause_named_the_f_to_quote_is_half_the_stationary_analysis():
 
     from friction_uq.discrepancy.candidates_mixture import MIXTURE_DRAWS, STATIONARY, STATIONARY_SHARE, mixture
     from friction_uq.discrepancy.diagnose import Diagnosis
-    from friction_uq.discrepancy.diagnosis_words import _folded, folded_sd_of, headline, mixture_label, sentence
+    from friction_uq.discrepancy.diagnosed_f import _folded, folded_sd_of, headline, mixture_label
+    from friction_uq.discrepancy.diagnosis_words import sentence
     from friction_uq.quoted import folded_sd
     from friction_uq.run.warnings import _next_step
 

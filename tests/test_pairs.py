@@ -40,7 +40,7 @@ pytestmark = pytest.mark.slow
 def test_both_causes_are_named_the_second_by_the_stacking_weight_and_f_holds_the_truth(tmp_path):
     from bench_diagnose import true_f
 
-    from friction_uq.discrepancy.diagnosis_words import quoted_of
+    from friction_uq.discrepancy.diagnosed_f import quoted_of
 
     rng = np.random.default_rng(29)  # the study's stream: record 0 of the 1-D pairs
     cfg, edit, header, note = make_pair(PAIRS_1D[0], False, 0, rng)

@@ -95,7 +95,7 @@ def test_what_a_model_carries_is_not_folded_in_again():
     model's, found by the draw's source index in the weights' order; a label not found, the whole-record fits'."""
     from types import SimpleNamespace
 
-    from friction_uq.discrepancy.diagnosis_words import folded_sd_of, headline
+    from friction_uq.discrepancy.diagnosed_f import folded_sd_of, headline
     from friction_uq.discrepancy.extended import Variant
     from friction_uq.discrepancy.mechanisms import MECHANISMS
 

@@ -1,7 +1,7 @@
 """What ``diagnose`` says in words: the sentence for the terminal and the summary page, each cause in an
-experimentalist's words (a measurement-chain fault with its gauge and how much), the headline's f (the named
-model's or the candidates' stacking mixture), and the hoop gauge's calibration finding. The JSON and the
-DataTree groups: :mod:`.outcome`."""
+experimentalist's words (a measurement-chain fault with its gauge and how much), and the hoop gauge's calibration
+finding. The f it quotes (the named model's or the candidates' stacking mixture): :mod:`.diagnosed_f`, whose names
+are re-exported here for the words' callers. The JSON and the DataTree groups: :mod:`.outcome`."""
 
 from __future__ import annotations
 
@@ -9,107 +9,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..models.parameters import Parameter
-from ..quoted import OUTPUT_BARS, folded_sd, quoted_summary
 from .candidates_mixture import STATIONARY, open_rounds
 from .diagnose import Diagnosis
+from .diagnosed_f import further, headline, member_name, mixture_label, unresolved
 from .extended import Variant
-from .record_likelihood import GAIN_SD
 from .rival_swaps import WITHOUT
 from .whole_record import CHANNEL_LABELS
 
-#: Mechanisms that fit an output bar's own calibration (its gauge's gain; the bars' moduli): a model with one reads
-#: f partly against the input bar's force (:func:`folded_sd_of`).
-BAR_CALIBRATION_FAULTS = ("gauge_gain", "bar_modulus")
 #: A hoop gain this far from 1 (its most probable value under its 5 % prior) is reported as a calibration finding
 #: (clean records: see benchmarks/bench_misfit.py for how often a right gauge reads this far off).
 HOOP_GAIN_FINDING = 0.02
-
-
-def member_name(label: str) -> str:
-    """A mixture member's label as printed: "reference" (the whole-record model without causes) is "no cause",
-    :data:`~.candidates_mixture.STATIONARY` "stationary analysis", a model its label."""
-    return {"reference": "no cause", STATIONARY: "stationary analysis"}.get(label, label)
-
-
-def mixture_label(dg: Diagnosis) -> str:
-    """'mixture of clearance (0.61), dispersion (0.33)': the models whose stacking mixture gives f, with their
-    weights (:func:`member_name`)."""
-    parts = [f"{member_name(k)} ({w:.2f})" for k, w in dg.mixture_weights.items()]
-    return "mixture of " + ", ".join(parts)
-
-
-def unresolved(dg: Diagnosis) -> bool:
-    """A round of candidates whose rivals no later round named: the candidate fitted in turn is not named
-    (``Diagnosis.named_causes`` holds the causes that are), and f is the mixture of the candidates
-    (``Diagnosis.mixture_f``, ``Diagnosis.open_candidates``)."""
-    return bool(open_rounds(dg.causes, dg.verdicts))
-
-
-def further(dg: Diagnosis) -> dict[str, str]:
-    """The further mechanisms the last round's stacking mixture gives f with, beside the model with the causes,
-    none of which it named (:func:`~.candidates_mixture.further_mixture`): each member's label -> the mechanism it
-    adds to the model with the causes (``gauge_gain[external_output_bar]``); {} when f is that model's alone."""
-    if dg.mixture_of != "further":  # diagnose says which mixture gives f
-        return {}
-    added = {r.fit.label: r.fit.variants[-1].label for r in dg.rounds[-1]}
-    return {k: added.get(k, k) for k in dg.mixture_weights if k != dg.final.label}
-
-
-def folded_sd_of(variants) -> float:
-    """The calibration sd folded into the f of a whole-record model with these causes (:mod:`friction_uq.quoted`):
-    its likelihood carries a gain of :data:`~.record_likelihood.GAIN_SD` on each output gauge (2.0 % left). With
-    one of :data:`BAR_CALIBRATION_FAULTS` fitted on an output bar, f is read partly against the input bar's force
-    through the equilibrium, whose calibration no model carries: the whole budget is folded in (2.45 %, more than
-    that bar's term swapped for the input bar's, 2.24 %)."""
-    if any(v.mechanism.name == "bar_modulus" or (v.mechanism.name in BAR_CALIBRATION_FAULTS and v.channel in OUTPUT_BARS)
-           for v in variants):
-        return folded_sd()
-    return folded_sd(GAIN_SD)
-
-
-def member_variants(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
-    """The causes of the model ``label`` (a mixture's member; "reference" and the stationary analysis: none): what
-    its calibration budget and its prior of f_effective are read from."""
-    if label in ("reference", STATIONARY):
-        return ()
-    fits = [dg.final, dg.baseline] + [r.fit for rnd in dg.rounds for r in rnd] + list(dg.swap_models)
-    return next((m.variants for m in fits if m.label == label), ())
-
-
-def _folded(dg: Diagnosis) -> float | np.ndarray:
-    """The sd folded into the f to quote: the final model's, or per draw of the mixture its model's."""
-    if dg.mixture_f is None:
-        return folded_sd_of(dg.final.variants)
-    sds = np.array([folded_sd() if k == STATIONARY else folded_sd_of(member_variants(dg, k)) for k in dg.mixture_weights])
-    return sds[np.asarray(dg.mixture_source, int)] if dg.mixture_source is not None else float(sds.max())
-
-
-def f_draws_to_quote(dg: Diagnosis) -> np.ndarray:
-    """The draws the diagnosed f to quote comes from: the stacking mixture's, else the final model's (given the
-    bars' header values)."""
-    return dg.mixture_f if dg.mixture_f is not None else dg.final.f_effective
-
-
-def quoted_of(dg: Diagnosis) -> dict[str, float]:
-    """The diagnosed f to quote (:func:`f_draws_to_quote`) with the output bars' calibration."""
-    return quoted_summary(f_draws_to_quote(dg), _folded(dg))
-
-
-def folded_of(dg: Diagnosis) -> float:
-    """The sd :func:`quoted_of` folded in (the largest over a mixture's models)."""
-    return float(np.max(_folded(dg)))
-
-
-def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
-    """The headline f of a diagnosed record: the final model's label and its f when a cause was named; the
-    stacking mixture's when the record named candidates or an unexplained misfit (:mod:`.verdict`); None when
-    nothing needed explaining (the headline is then the stationary analysis' f). The f's summary carries the output
-    bars' calibration (:mod:`friction_uq.quoted`), as the JSON's ``f`` does."""
-    if dg.mixture_f is not None:
-        return mixture_label(dg), quoted_of(dg)
-    if dg.causes:
-        return dg.final.label, quoted_of(dg)
-    return None
 
 
 #: Each mechanism in an experimentalist's words (docs/glossary.md has the longer entries).

@@ -10,8 +10,8 @@ from ..stats import khat_threshold
 from ..stats.streams import stream
 from .candidates_mixture import STATIONARY
 from .diagnose import Diagnosis, ModelFit, Ranked
-from .diagnosis_words import (baseline_hoop_gain, chain_gauge, hoop_gain_off, member_variants, mixture_label,
-                              sentence)
+from .diagnosed_f import member_variants, mixture_label
+from .diagnosis_words import baseline_hoop_gain, chain_gauge, hoop_gain_off, sentence
 from .effective_prior import log_prior_f_effective
 from .extended import IMPORTANCE_DRAWS
 

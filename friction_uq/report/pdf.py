@@ -17,7 +17,7 @@ from .._atomic import write_bytes
 from ..analysis import Identification, Prepared
 from ..discrepancy.candidates_mixture import STATIONARY
 from ..discrepancy.check import WholeRecordCheck
-from ..discrepancy.diagnosis_words import headline as outcome_headline
+from ..discrepancy.diagnosed_f import headline as outcome_headline
 from .quote import quote_line
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..quoted import quoted_summary

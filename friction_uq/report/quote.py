@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..discrepancy.candidates_mixture import STATIONARY
-from ..discrepancy.diagnosis_words import further, headline
+from ..discrepancy.diagnosed_f import further, headline
 
 
 def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool = True) -> tuple[str, Mapping[str, float]]:

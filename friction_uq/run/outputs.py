@@ -70,7 +70,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     the bars' header values (``given_bar_headers``, the posterior's own); where it comes from a fitted model or a
     stacking mixture, how its draws were obtained and the Pareto k of the final model's importance step. ``f_stationary``: the stationary f to quote,
     ``f_stationary_posterior`` its posterior summary."""
-    from ..discrepancy.diagnosis_words import f_draws_to_quote, folded_of, headline
+    from ..discrepancy.diagnosed_f import f_draws_to_quote, folded_of, headline
     from ..physics.bars import FORCE_RATIO_CALIBRATION_SD
     from ..quoted import folded_sd
     from ..report.quote import f_to_quote

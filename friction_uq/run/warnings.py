@@ -71,7 +71,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     if diagnosis is None:
         return "`friction-uq diagnose` names the cause and gives f under it."
     from ..discrepancy.candidates_mixture import STATIONARY
-    from ..discrepancy.diagnosis_words import further, headline
+    from ..discrepancy.diagnosed_f import further, headline
 
     if more := further(diagnosis):  # causes named, and further ones the record leans to without naming one
         fm = headline(diagnosis)[1]
