@@ -35,7 +35,7 @@ from bench_misfit import clean_config  # noqa: E402
 from verdict_records import CHAIN_FAULTS, _axisymmetric, write  # noqa: E402
 
 from friction_uq.discrepancy.diagnose import MAX_CAUSES  # noqa: E402
-from friction_uq.discrepancy.diagnosed_f import quoted_of
+from friction_uq.discrepancy.diagnosed_f import quoted_of  # noqa: E402
 from friction_uq.discrepancy.diagnosis_words import sentence  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402

@@ -158,13 +158,17 @@ def test_a_phase_is_weighed_with_its_own_tolerance_where_one_is_given(clean_reco
 
 
 def test_a_misspelt_phase_is_refused_not_ignored(clean_record):
-    """A table key naming no (channel, phase) would leave that phase at the channel's tolerance without a word
-    (the window is "stationary", not "window")."""
+    """A table key naming no (channel, phase) would leave that phase at the channel's tolerance (or without shape
+    terms) without a word (the window is "stationary", not "window"); a value not above zero is refused too."""
     prep = prepare(clean_record)
     model = SimulatorModel(clean_record.apparatus, measured_loading(clean_record, prep.forces), hoop=True)
     for key in (("tube_hoop", "window"), ("hoop", "unloading")):
-        with pytest.raises(ValueError, match="unknown"):
-            WholeRecordLikelihood(prep, model, phase_tolerance={key: 0.1})
+        for table in ("phase_tolerance", "shape_sd"):
+            with pytest.raises(ValueError, match="unknown"):
+                WholeRecordLikelihood(prep, model, **{table: {key: 0.1}})
+    for value in (0.0, -0.1, float("nan")):  # a zero prior sd: a NaN likelihood
+        with pytest.raises(ValueError, match="above zero"):
+            WholeRecordLikelihood(prep, model, shape_sd={("tube_hoop", "unloading"): value})
 
 
 def _hoop_unloading_reads_high(rec, by: float):
@@ -232,8 +236,8 @@ def test_a_hoop_shape_the_model_does_not_make_moves_nu_within_its_posterior(clea
 
 def test_the_whole_record_check_fits_with_the_channels_own_tolerance(clean_record, monkeypatch):
     """The check's decision (its tolerance table, its thresholds) was calibrated on fits with the channels' own
-    tolerance; its fit keeps it (phase_tolerance={}: the hoop at 3 % everywhere; shape_sd={}: no shape terms), while
-    diagnose's models take LIKELIHOOD_TOLERANCE and SHAPE_SD."""
+    tolerance; its fit asks for it (phase_tolerance={}: the hoop at 3 % everywhere; shape_sd={}: no shape terms),
+    whatever LIKELIHOOD_TOLERANCE and SHAPE_SD hold."""
     from friction_uq.discrepancy import check
 
     prep = prepare(clean_record)

@@ -1,7 +1,7 @@
 """What ``diagnose`` says in words: the sentence for the terminal and the summary page, each cause in an
 experimentalist's words (a measurement-chain fault with its gauge and how much), and the hoop gauge's calibration
-finding. The f it quotes (the named model's or the candidates' stacking mixture): :mod:`.diagnosed_f`, whose names
-are re-exported here for the words' callers. The JSON and the DataTree groups: :mod:`.outcome`."""
+finding. The f it quotes (the named model's or the candidates' stacking mixture): :mod:`.diagnosed_f`. The JSON
+and the DataTree groups: :mod:`.outcome`."""
 
 from __future__ import annotations
 

@@ -51,7 +51,8 @@ LIKELIHOOD_TOLERANCE: dict[tuple[str, str], float] = {}
 #: Smooth departures of a (channel, phase) from the model's shape, marginalised like the calibration errors: Legendre
 #: polynomials over the phase (degrees :data:`SHAPE_DEGREES`), each coefficient with a Gaussian prior of this sd
 #: relative to the gauge's level over its window. Unlike a wider per-sample tolerance it forgives only a slow bend
-#: of the phase (what separates two simulators' hoop strains around the window), not its fronts. None: measured,
+#: of the phase (what separates two simulators' hoop strains around the window), not a front inside it; the terms
+#: of two phases are not tied where they meet, so a step at a phase's boundary is forgiven. None: measured,
 #: not applied (docs/trust.md): 10 % on the hoop's window and unloading held f's truth on 30 of 32 clean records of
 #: the axisymmetric simulation it was set on (22 without) but on 12 of 16 held out (13 without), and cost names.
 SHAPE_SD: dict[tuple[str, str], float] = {}
@@ -60,10 +61,14 @@ SHAPE_DEGREES = {"rise": (0, 1, 2), "stationary": (1, 2), "unloading": (0, 1, 2)
 
 
 def _refuse_unknown(table: Mapping[tuple[str, str], float], what: str) -> None:
-    """A key naming no (channel, phase) would leave that phase as it was without a word."""
+    """A key naming no (channel, phase) would leave that phase as it was without a word; a value not above zero
+    would make the likelihood NaN (a zero prior sd) or its log determinant undefined."""
     unknown = [k for k in table if k[0] not in CHANNEL_LABELS or k[1] not in PHASES]
     if unknown:
         raise ValueError(f"{what} for unknown (channel, phase) {unknown}: phases are {PHASES}")
+    bad = {k: v for k, v in table.items() if not (math.isfinite(v) and v > 0.0)}
+    if bad:
+        raise ValueError(f"{what} must be finite and above zero: {bad}")
 
 
 class WholeRecordLikelihood:
@@ -170,8 +175,9 @@ class WholeRecordLikelihood:
 
     def scaled_residual(self, c: str, pred: np.ndarray) -> np.ndarray:
         """(measured - predicted - nuisances) sd / s_t over the channel's span: AR(1) with the gauge's sd
-        and effective coefficient. The offset error (the pre-pulse mean is uncertain) and an output bar
-        gauge's or the hoop gauge's gain error are set to their most probable values."""
+        and effective coefficient. The offset error (the pre-pulse mean is uncertain), an output bar
+        gauge's or the hoop gauge's gain error and the phase's shape terms (:data:`SHAPE_SD`) are set to their
+        most probable values."""
         nz = self.noise[c]
         u = self._raw_scaled(c, pred)
         d, R, _, _, _ = self._nuisances(c, pred, whiten(u, sd=nz.sd, rho=nz.rho_long_run))
@@ -183,14 +189,14 @@ class WholeRecordLikelihood:
 
     def hoop_gain(self, predicted_unit: np.ndarray) -> float:
         """The hoop gauge's calibration factor given a prediction at factor 1: its most probable value under
-        its prior (jointly with the channel's offset error)."""
+        its prior (jointly with the channel's offset error and shape terms)."""
         if "tube_hoop" not in self.gain_sd:
             return 1.0
         return 1.0 + self.gain_posterior("tube_hoop", predicted_unit)[0]
 
     def gain_posterior(self, c: str, predicted_unit: np.ndarray) -> tuple[float, float]:
         """Posterior mean and variance of channel ``c``'s gain error (its calibration included, jointly with
-        the channel's offset error) given a prediction at factor 1."""
+        the channel's offset error and shape terms) given a prediction at factor 1."""
         nz = self.noise[c]
         w = whiten(self._raw_scaled(c, predicted_unit), sd=nz.sd, rho=nz.rho_long_run)
         d, _, V, sds, _ = self._nuisances(c, predicted_unit, w)
