@@ -59,8 +59,8 @@ def check_whole_record(prep: Prepared, log_prior: Callable[[Mapping[str, float]]
                            dispersion=disp,
                            dispersive_loading=measured_loading(rec, prep.forces, dispersion=True) if disp else None)
     # the check's fit keeps the channels' own tolerance, with which its decision's tolerance table and thresholds were
-    # calibrated, whatever LIKELIHOOD_TOLERANCE and SHAPE_SD hold: with 10 % on the hoop in its fit it flagged 11 of 80 clean
-    # axisymmetric records (4 before; docs/trust.md)
+    # calibrated, whatever LIKELIHOOD_TOLERANCE and SHAPE_SD hold: with 10 % on the hoop in its fit it flagged 11 of
+    # 80 clean axisymmetric records (4 before; docs/trust.md)
     lik = WholeRecordLikelihood(prep, model, phase_tolerance={}, shape_sd={})
     rng = stream(seed, "whole-record check")
     fit = fit_whole_record(lik, log_prior, {"f": start["f"], "nu": start["nu"]}, n_draws=n_draws, rng=rng,
