@@ -379,8 +379,10 @@ def test_bundled_set_up_b_gets_its_plug_friction_and_its_hoop_calibration_named(
         assert head["posterior_method"].startswith("stacking mixture") and head["pareto_k"] == dd["pareto_k"]
     assert head["pareto_k_model"] == dd["model"]
     assert 0.0 < dd["pareto_k_threshold"] <= 0.7 and dd["importance_ess"] >= 1.0
-    # the headline's draws are its exact posterior: importance-weighted when k allows, else sampled
-    if dd["pareto_k"] <= dd["pareto_k_threshold"]:
+    # the headline's draws are its exact posterior: importance-weighted when k and the effective size allow, else
+    # sampled; either way with the effective size the interval's tails need, or a warning
+    assert dd["importance_ess"] >= 119 or not dd["posterior_converged"]
+    if dd["pareto_k"] <= dd["pareto_k_threshold"] and dd["importance_ess"] >= 119:
         assert dd["posterior_method"] == "importance"
     else:
         assert dd["posterior_method"] in ("importance (second proposal)", "emcee")

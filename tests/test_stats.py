@@ -109,3 +109,41 @@ def test_a_pool_sharing_the_evaluations_gives_the_same_bits(wrong):
         shared = exact_draws(NORMAL.logpdf, mode, cov, cov, map_rows=pool.map, **kw)
     assert shared.method == alone.method and (alone.method == "emcee") is wrong
     assert np.array_equal(shared.z_adjusted, alone.z_adjusted)
+
+
+def test_a_wide_proposal_whose_k_passes_draws_on_until_the_tails_have_their_effective_size():
+    """A robust covariance 16 times the posterior's (a model that misses, by far): k passes, but 200 draws keep an
+    effective size of a few dozen; more are drawn (or the second proposal) until it reaches the floor, and the
+    mean and sd are the target's within their Monte Carlo error at that size."""
+    from friction_uq.stats.exact import ess_floor
+
+    for seed in (1, 2, 3):
+        ex = exact_draws(NORMAL.logpdf, MU, S, 16.0 * S, rng=np.random.default_rng(seed), n_out=4000)
+        assert ex.method.startswith("importance") and ex.converged
+        assert ex.ess >= ess_floor() == 119 and ex.log_post_calls > 200
+        se = np.sqrt(np.diag(S) / ex.ess)
+        assert np.all(np.abs(ex.z.mean(axis=0) - MU) < 4 * se)
+        np.testing.assert_allclose(ex.z.std(axis=0), np.sqrt(np.diag(S)), rtol=4 / np.sqrt(2 * ex.ess))
+
+
+def test_a_right_proposal_keeps_its_first_two_hundred_draws():
+    """When the first 200 draws already have the floor's effective size, nothing more is drawn (the same bits as
+    before the floor existed)."""
+    ex = exact_draws(NORMAL.logpdf, MU, S, S, rng=np.random.default_rng(1), n_out=1000)
+    assert ex.method == "importance" and ex.log_post_calls == 200 and ex.ess >= 119
+
+
+def test_emcee_runs_its_chain_until_it_is_long_enough_and_reports_the_chain_s_effective_size():
+    """A proposal far off (both importance stages refused): emcee's first 40 steps underestimate the
+    autocorrelation time; the chain runs on to 50 of those times, or stops at the cap and says it did not converge.
+    The ESS reported is the chain's, not the number of draws resampled from it (2000)."""
+    wrong = MU + np.array([1.2, 1.8])
+    short = exact_draws(NORMAL.logpdf, wrong, S / 100, S / 100, rng=np.random.default_rng(4), n_out=2000,
+                        emcee_steps=40, emcee_burn=10)
+    assert short.method == "emcee" and short.ess < 2000
+    assert not short.converged  # 160 steps at most: short of 50 autocorrelation times (~15 steps each)
+    long = exact_draws(NORMAL.logpdf, wrong, S / 100, S / 100, rng=np.random.default_rng(4), n_out=2000,
+                       emcee_steps=400, emcee_burn=100)
+    assert long.method == "emcee" and long.converged and long.ess >= 119
+    se = np.sqrt(np.diag(S) / long.ess)
+    assert np.all(np.abs(long.z.mean(axis=0) - MU) < 4 * se)

@@ -112,11 +112,13 @@ class Diagnosis:
     #: the misfit decision judges), when ``run`` made the check
     check_hoop_gain: float | None = None
     #: the final model's normal approximation against its exact posterior (Diagnoser.exact_posterior), when a
-    #: cause was named: Pareto k, the importance weights' effective sample size, and how the exact draws were
-    #: obtained (friction_uq.stats.exact: "importance", "importance (second proposal)" or "emcee")
+    #: cause was named: Pareto k, the kept draws' effective sample size, how the exact draws were obtained
+    #: (friction_uq.stats.exact: "importance", "importance (second proposal)" or "emcee") and whether they reached
+    #: the floor on their effective sample size (emcee's chain its length too) within the caps
     pareto_k: float = float("nan")
     importance_ess: float = float("nan")
     posterior_method: str | None = None
+    posterior_converged: bool = True
     #: the stationary window's means the mechanisms' f_effective is stated at, and the seed: what the prior of
     #: f_effective (:mod:`.effective_prior`) is computed from when the draws are written
     context: Context | None = None
@@ -259,22 +261,22 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     a = compare_whole_record(prep, st.base.predicted)
     b = compare_whole_record(prep, final.predicted)
     k = ess = float("nan")
-    method = None
+    method, converged = None, True
     mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else \
         mixture(st.base, rounds[0], verdicts[0], seed, stationary_f)
     mixture_of = "candidates" if mix is not None else None
     if causes:
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final, workers=workers)
-        k, ess, method = ex.pareto_k, ex.ess, ex.method
+        k, ess, method, converged = ex.pareto_k, ex.ess, ex.method, ex.converged
         mix, mix_w, mix_src, mixture_of = _mixture_after_causes(final, rounds, verdicts, causes, swaps, checked,
                                                                 seed, stationary_f)
     return Diagnosis(baseline=st.base, rounds=tuple(rounds), misfits=tuple(st.misfits), causes=tuple(causes),
                      not_separable=st.not_sep, channels_not_separable=st.other_channels, separate_by=st.separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
-                     posterior_method=method, context=dg.context, seed=seed, verdicts=tuple(verdicts),
-                     mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src, swaps=swaps,
+                     posterior_method=method, posterior_converged=converged, context=dg.context, seed=seed,
+                     verdicts=tuple(verdicts), mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src, swaps=swaps,
                      swap_models=checked, mixture_of=mixture_of)
 
 

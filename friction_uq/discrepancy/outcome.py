@@ -18,8 +18,12 @@ from .extended import IMPORTANCE_DRAWS
 #: How the named model's posterior is obtained (the JSON's ``posterior_method`` says which route was taken).
 POSTERIOR_NOTE = ("exact posterior of the model with the named causes: 200 draws of its normal approximation (robust "
                   "covariance) importance-weighted by the whole-record posterior (Pareto-smoothed; pareto_k judges the "
-                  "normal); when k > 0.7 a Student-t proposal, then emcee; the exact draws then mapped to the robust "
-                  "(sandwich) covariance, keeping their shape (open-faced sandwich adjustment, Shaby 2014)")
+                  "normal), more of them while the weights' effective sample size is under 119 (the 90 % interval's "
+                  "tails to 0.02); when k is over its limit or the effective size stays short, a Student-t proposal, "
+                  "then emcee, run on until its chain is 50 autocorrelation times long with 119 effective draws "
+                  "(posterior_converged: false if not within 4 times its first length); the exact draws then mapped "
+                  "to the robust (sandwich) covariance, keeping their shape (open-faced sandwich adjustment, Shaby "
+                  "2014)")
 
 
 def _ess(log_weights: np.ndarray) -> float:
@@ -95,6 +99,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "pareto_k": dg.pareto_k,
         "pareto_k_threshold": khat_threshold(IMPORTANCE_DRAWS),
         "importance_ess": dg.importance_ess,
+        "posterior_converged": dg.posterior_converged,
         "f_baseline_stationary": f_without,
         "f_baseline_whole_record": dg.baseline.f_summary(),
         "nu_extended": summarize_draws(dg.final.fit.draws["nu"]),

@@ -31,6 +31,7 @@ from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from ..prior_sensitivity import PriorDataConflict
+from ..stats.exact import ess_floor
 
 #: Least fraction of the window where the smoothed ratio lies in its 90 % noise band (about 0.9 on a
 #: record the model describes; its sd over records is ~0.06, so 0.5 is more than six sd below).
@@ -156,6 +157,18 @@ def convergence_warning(conv: Convergence) -> str | None:
             "with another --seed and compare.")
 
 
+def exact_posterior_warning(diagnosis) -> str | None:
+    """The exact posterior of the model with the named causes fell short of its effective sample size's floor (or
+    emcee's chain of its length) within the caps (:mod:`friction_uq.stats.exact`): its interval's tails rest on too
+    few independent draws."""
+    if diagnosis is None or not diagnosis.causes or diagnosis.posterior_converged:
+        return None
+    return (f"The exact posterior under the named causes ({diagnosis.posterior_method}) kept only "
+            f"{diagnosis.importance_ess:.0f} effective draws, short of the {ess_floor()} that the 90 % interval's tails "
+            "need, or its chain did not run long enough: the interval of f under them is not reliable; run `diagnose` "
+            "again with another --seed and compare.")
+
+
 def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
     if conflict is None or not conflict.flagged:
         return None
@@ -171,6 +184,6 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
     found: Sequence[str | None] = (
         gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f),
         stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f, diagnosis),
-        convergence_warning(conv), conflict_warning(conflict),
+        convergence_warning(conv), exact_posterior_warning(diagnosis), conflict_warning(conflict),
     )
     return [w for w in found if w]

@@ -12,6 +12,20 @@ coordinates) is checked and corrected in two steps:
    freedom) with the weighted draws' mean and 1.5 times their covariance, is tried; if its k too is
    above the limit, the posterior is sampled with emcee (affine-invariant ensemble, walkers started
    from the best-weighted draws).
+
+   **Enough draws for the interval's tails.** A k under the limit says the weights are reliable, not
+   that there are enough of them: 200 draws of a proposal twice as wide as the posterior in a few
+   directions keep an effective sample size (ESS, 1 / sum w^2) of a few dozen, and the 5 % and 95 %
+   quantiles of the 90 % interval are then read from a handful of draws. A stage is kept only when
+   its ESS reaches :func:`ess_floor` (119: the tail probability 0.05 estimated to a Monte Carlo
+   standard error of 0.02, sqrt(p (1 - p) / ESS)); short of it, more draws of the same proposal are
+   added (its k computed again over all of them, against the first batch's limit), up to
+   :data:`MAX_IMPORTANCE_FACTOR` times the first batch, before the next stage is tried. emcee's chain
+   is run on, by its own length again, until its ESS (walkers x kept steps / the integrated
+   autocorrelation time, burn-in 3 of those times) reaches the floor and the chain is
+   :data:`CHAIN_TAUS` of those times long (a shorter chain underestimates the time), or the chain is
+   :data:`MAX_EMCEE_FACTOR` times its first length; ``converged`` says which. The ESS reported is
+   the chain's, never the number of draws resampled from it.
 2. **Robust spread.** A likelihood that misses the record is too sure of itself: its curvature
    understates how far the best-fitting parameters move from record to record (Huber 1967; White
    1982). The exact draws are mapped by the open-faced sandwich adjustment (Shaby 2014, J. Comput.
@@ -34,6 +48,7 @@ from .laplace import importance_weights, sym_cholesky
 from .psis import khat_threshold
 from .streams import legacy_state
 
+
 @dataclass(frozen=True)
 class ExactDraws:
     """Equal-weight draws of the exact posterior (``z``), the same after the sandwich adjustment
@@ -44,8 +59,9 @@ class ExactDraws:
     method: str  # "importance", "importance (second proposal)" or "emcee"
     pareto_k: float  # of the first proposal (the normal approximation against the exact posterior)
     pareto_k_used: float  # of the stage whose draws are kept (nan for emcee)
-    ess: float
+    ess: float  # of the kept draws: the weights' 1 / sum w^2, or emcee's chain's (module docstring)
     log_post_calls: int
+    converged: bool = True  # False: the floor on the ESS (or emcee's chain length) not reached within the caps
 
 
 def sandwich_map(mode: np.ndarray, cov_laplace: np.ndarray, cov_robust: np.ndarray) -> np.ndarray:
@@ -53,10 +69,70 @@ def sandwich_map(mode: np.ndarray, cov_laplace: np.ndarray, cov_robust: np.ndarr
     return sym_cholesky(cov_robust) @ np.linalg.inv(sym_cholesky(cov_laplace))
 
 
-def _weighted(log_post_rows: Callable[[np.ndarray], np.ndarray], dist, n: int, rng: np.random.Generator):
+#: The tail probability of the 90 % interval and the Monte Carlo standard error allowed on it (module docstring).
+TAIL_PROBABILITY, TAIL_MCSE = 0.05, 0.02
+#: An importance stage whose k passes may draw up to this many times its first batch to reach the ESS floor.
+MAX_IMPORTANCE_FACTOR = 5
+#: emcee's chain may run up to this many times its first length to reach the ESS floor.
+MAX_EMCEE_FACTOR = 4
+#: A chain this many integrated autocorrelation times long has a trustworthy estimate of that time (emcee's
+#: documentation: shorter chains underestimate it, and so overstate their ESS).
+CHAIN_TAUS = 50
+
+
+def ess_floor(tail: float = TAIL_PROBABILITY, mcse: float = TAIL_MCSE) -> int:
+    """Effective sample size at which a tail probability ``tail`` is estimated to a Monte Carlo standard error
+    ``mcse``: p (1 - p) / mcse^2 (119 for the 90 % interval's tails to 0.02).
+
+    >>> ess_floor()
+    119
+    """
+    return math.ceil(tail * (1.0 - tail) / mcse ** 2)
+
+
+@dataclass
+class _Stage:
+    """An importance stage's draws of one proposal, their log target and log proposal densities, and the
+    smoothed weights over all of them."""
+
+    z: np.ndarray
+    log_target: np.ndarray
+    log_proposal: np.ndarray
+    first_batch: int
+    log_weights: np.ndarray = None  # type: ignore[assignment]
+    k: float = math.nan
+    ess: float = 0.0
+
+    def weigh(self) -> "_Stage":
+        res = importance_weights(self.log_target, self.log_proposal)
+        self.log_weights, self.k, self.ess = res.log_weights, float(res.pareto_k), float(res.ess)
+        return self
+
+    @property
+    def k_ok(self) -> bool:
+        """k within the limit for the first batch's draws (the limit the JSON states; more draws allow a higher
+        one, not taken)."""
+        return bool(self.k <= khat_threshold(self.first_batch))
+
+
+def _draw(log_post_rows: Callable[[np.ndarray], np.ndarray], dist, n: int, rng: np.random.Generator):
     z = np.atleast_2d(dist.rvs(size=n, random_state=rng)).reshape(n, -1)
-    res = importance_weights(np.asarray(log_post_rows(z), float), dist.logpdf(z))
-    return z, res.log_weights, float(res.pareto_k), float(res.ess)
+    return z, np.asarray(log_post_rows(z), float), np.asarray(dist.logpdf(z), float).reshape(n)
+
+
+def _importance(log_post_rows: Callable[[np.ndarray], np.ndarray], dist, n: int, rng: np.random.Generator,
+                floor: int) -> _Stage:
+    """One proposal's stage: ``n`` draws, then more of the same (k weighed again over all) while k passes and
+    the ESS is under ``floor``, up to :data:`MAX_IMPORTANCE_FACTOR` x ``n`` draws (module docstring)."""
+    st = _Stage(*_draw(log_post_rows, dist, n, rng), n).weigh()
+    cap = MAX_IMPORTANCE_FACTOR * n
+    while st.k_ok and st.ess < floor and len(st.z) < cap:
+        per_draw = max(st.ess / len(st.z), 1.0 / cap)
+        extra = int(min(cap - len(st.z), max(n // 2, math.ceil(1.2 * floor / per_draw) - len(st.z))))
+        z, lt, lq = _draw(log_post_rows, dist, extra, rng)
+        st = _Stage(np.concatenate([st.z, z]), np.concatenate([st.log_target, lt]),
+                    np.concatenate([st.log_proposal, lq]), n).weigh()
+    return st
 
 
 def _resample(z: np.ndarray, log_w: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -65,7 +141,10 @@ def _resample(z: np.ndarray, log_w: np.ndarray, n: int, rng: np.random.Generator
 
 
 def _emcee(log_post_rows: Callable[[np.ndarray], np.ndarray], z: np.ndarray, log_w: np.ndarray, n: int,
-           rng: np.random.Generator, *, steps: int, burn: int) -> np.ndarray:
+           rng: np.random.Generator, *, steps: int, burn: int, floor: int) -> tuple[np.ndarray, float, int, bool]:
+    """emcee's draws (``n``, resampled from the kept chain), the chain's ESS, the density's evaluations and whether
+    the chain converged: run on by ``steps`` at a time until it is :data:`CHAIN_TAUS` autocorrelation times long
+    with an ESS of ``floor``, or :data:`MAX_EMCEE_FACTOR` x ``steps`` long (module docstring)."""
     import emcee
 
     ndim = z.shape[1]
@@ -75,8 +154,18 @@ def _emcee(log_post_rows: Callable[[np.ndarray], np.ndarray], z: np.ndarray, log
     rs = legacy_state(rng)  # emcee's own stream, seeded from ours
     sampler = emcee.EnsembleSampler(nwalkers, ndim, log_post_rows, vectorize=True)
     sampler.run_mcmc(emcee.State(start, random_state=rs.get_state()), steps, progress=False)
-    chain = sampler.get_chain(discard=burn, flat=True)
-    return chain[rng.choice(len(chain), size=n, replace=len(chain) < n)]
+    while True:
+        chain = sampler.get_chain()
+        total = len(chain)
+        tau = float(np.max(emcee.autocorr.integrated_time(chain[min(burn, total // 2):], tol=0, quiet=True)))
+        cut = min(max(burn, math.ceil(3.0 * tau)), total // 2)
+        ess = nwalkers * (total - cut) / max(tau, 1.0)
+        converged = total >= CHAIN_TAUS * tau and ess >= floor
+        if converged or total >= MAX_EMCEE_FACTOR * steps:
+            break
+        sampler.run_mcmc(None, steps, progress=False)
+    flat = chain[cut:].reshape(-1, ndim)
+    return flat[rng.choice(len(flat), size=n, replace=len(flat) < n)], float(ess), nwalkers * total, converged
 
 
 def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_laplace: np.ndarray,
@@ -92,30 +181,29 @@ def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_l
     """
     mode = np.asarray(mode, float)
     mapped = map_rows or (lambda rows: [log_post(r) for r in rows])
+    floor = ess_floor()
 
     def log_post_rows(z: np.ndarray) -> np.ndarray:
         return np.asarray(mapped(np.atleast_2d(z)), float)
 
-    z, lw, k1, ess = _weighted(log_post_rows, stats.multivariate_normal(mode, cov_robust, allow_singular=True),
-                               n_importance, rng)
-    calls, method, k_used = n_importance, "importance", k1
-    k_max = khat_threshold(n_importance)
-    if not k1 <= k_max:
-        w = np.exp(lw - np.max(lw))
-        w /= w.sum()
-        mean = w @ z
-        cov = np.atleast_2d(np.cov(z, rowvar=False, aweights=w)) * 1.5 + 1e-12 * np.eye(len(mode))
-        z2, lw2, k2, ess2 = _weighted(log_post_rows, stats.multivariate_t(mean, cov, df=5, allow_singular=True),
-                                      n_importance, rng)
-        calls += n_importance
-        if k2 <= k_max:
-            z, lw, k_used, ess, method = z2, lw2, k2, ess2, "importance (second proposal)"
-        else:
-            zz, ll = np.concatenate([z, z2]), np.concatenate([lw, lw2])
-            out = _emcee(log_post_rows, zz, ll, n_out, rng, steps=emcee_steps, burn=emcee_burn)
-            calls += max(16, 4 * len(mode)) * emcee_steps
-            omega = sandwich_map(mode, cov_laplace, cov_robust)
-            return ExactDraws(out, mode + (out - mode) @ omega.T, "emcee", k1, math.nan, float(len(out)), calls)
-    out = _resample(z, lw, n_out, rng)
+    first = _importance(log_post_rows, stats.multivariate_normal(mode, cov_robust, allow_singular=True),
+                        n_importance, rng, floor)
+    calls, st, method = len(first.z), first, "importance"
     omega = sandwich_map(mode, cov_laplace, cov_robust)
-    return ExactDraws(out, mode + (out - mode) @ omega.T, method, k1, k_used, ess, calls)
+    if not (first.k_ok and first.ess >= floor):
+        w = np.exp(first.log_weights - np.max(first.log_weights))
+        w /= w.sum()
+        mean = w @ first.z
+        cov = np.atleast_2d(np.cov(first.z, rowvar=False, aweights=w)) * 1.5 + 1e-12 * np.eye(len(mode))
+        st = _importance(log_post_rows, stats.multivariate_t(mean, cov, df=5, allow_singular=True),
+                         n_importance, rng, floor)
+        calls += len(st.z)
+        method = "importance (second proposal)"
+        if not (st.k_ok and st.ess >= floor):
+            zz, ll = np.concatenate([first.z, st.z]), np.concatenate([first.log_weights, st.log_weights])
+            out, ess, n_calls, ok = _emcee(log_post_rows, zz, ll, n_out, rng, steps=emcee_steps, burn=emcee_burn,
+                                           floor=floor)
+            return ExactDraws(out, mode + (out - mode) @ omega.T, "emcee", first.k, math.nan, ess,
+                              calls + n_calls, ok)
+    out = _resample(st.z, st.log_weights, n_out, rng)
+    return ExactDraws(out, mode + (out - mode) @ omega.T, method, first.k, st.k, st.ess, calls)
