@@ -12,8 +12,10 @@ named model's, or the stacking mixture's; the baseline's when nothing needed exp
 (the wall's coefficient at the window's mean sliding speed, pressure and slip), and the time. The table:
 per simulator, how often both effects were named (as the JSON's ``causes`` says: a candidate fitted in turn
 whose rivals no later round named is not named), one, a wrong cause named, both among the named causes and the
-candidates listed, f covered by the 90 % interval of the f to quote (the output bars' calibration included) and
-by the posterior's own (given the bars' header values), and the first round's verdicts.
+candidates listed, f covered by the 90 % interval of the f to quote (the output bars' calibration and the
+whole-record models' form included), by the same without the form, and by the posterior's own (given the bars'
+header values), and the first round's verdicts. Each record's line says how the exact posterior of the model
+with the causes was obtained and its effective sample size.
 
     python benchmarks/bench_pairs.py [--seed 29] [--only 1d,axisymmetric] [--first 0] [--count 8]
 """
@@ -97,6 +99,7 @@ def score(pair: tuple[str, str], dg, cfg, prep) -> dict:
     # the diagnosed f with the output bars' calibration (friction_uq.quoted): the JSON's f when a cause or candidates
     # were found (when nothing needed explaining the JSON quotes the stationary f; this is the whole-record baseline's)
     fx = quoted_of(dg)
+    f_calibration_only = quoted_of(dg, model_form=0.0)  # before the whole-record models' form was folded in
     draws = dg.mixture_f if dg.mixture_f is not None else dg.final.f_effective
     given = np.quantile(draws, [0.05, 0.95])  # the posterior's own interval, given the bars' header values
     truth = true_f(cfg, prep)
@@ -105,6 +108,9 @@ def score(pair: tuple[str, str], dg, cfg, prep) -> dict:
             "wrong": bool(set(named) - set(pair)), "kind": dg.verdicts[0].kind if dg.verdicts else "none",
             "both_among": set(pair) <= among, "candidates": candidates_of(dg),
             "covered": fx["q05"] <= truth <= fx["q95"], "covered_given_headers": bool(given[0] <= truth <= given[1]),
+            "covered_calibration_only": f_calibration_only["q05"] <= truth <= f_calibration_only["q95"],
+            "route": (f"{dg.posterior_method}, ESS {dg.importance_ess:.0f}"
+                      f"{'' if dg.posterior_converged else ', short of its floor'}") if dg.causes else "-",
             "named": named, "f": fx, "truth": truth,
             "rounds": [v.kind for v in dg.verdicts]}
 
@@ -141,24 +147,27 @@ def main() -> None:
                 continue
             secs.append(time.perf_counter() - t)
             s = score(pair, dg, cfg, prep)
-            for key in ("both", "one", "wrong", "covered", "covered_given_headers", "both_among"):
+            for key in ("both", "one", "wrong", "covered", "covered_given_headers", "covered_calibration_only",
+                        "both_among"):
                 c[key] += s[key]
             c[f"first:{s['kind']}"] += 1
             fx = s["f"]
             print(f"{sim}-{k} ({note}): rounds {s['rounds']}, named {s['named']}, candidates {s['candidates']}; "
                   f"f {fx['q50']:.4f} "
-                  f"[{fx['q05']:.4f}, {fx['q95']:.4f}] truth {s['truth']:.4f}; {secs[-1]:.0f} s", flush=True)
+                  f"[{fx['q05']:.4f}, {fx['q95']:.4f}] truth {s['truth']:.4f}; exact posterior: {s['route']}; "
+                  f"{secs[-1]:.0f} s", flush=True)
             if a.sentences:
                 print("    " + sentence(dg, dg.baseline.f_summary()), flush=True)
             os.remove(path)
     print(f"\n{'simulator':<13} {'n':>3} {'both':>5} {'one':>4} {'wrong':>6} {'both among':>10} {'f covered':>9} "
-          f"{'given headers':>13} {'refused':>7}  first round's verdict")
+          f"{'calibration only':>16} {'given headers':>13} {'refused':>7}  first round's verdict")
     for sim, c in tally.items():
         kinds = ", ".join(f"{k.split(':', 1)[1]} {v}" for k, v in sorted(c.items()) if k.startswith("first:"))
         print(f"{sim:<13} {c['n']:>3} {c['both']:>5} {c['one']:>4} {c['wrong']:>6} {c['both_among']:>10} "
-              f"{c['covered']:>9} {c['covered_given_headers']:>13} {c['refused']:>7}  {kinds}")
-    print("f covered: the f to quote (the JSON's, the output bars' calibration included); given headers: the "
-          "posterior's own 90 % interval")
+              f"{c['covered']:>9} {c['covered_calibration_only']:>16} {c['covered_given_headers']:>13} "
+              f"{c['refused']:>7}  {kinds}")
+    print("f covered: the f to quote (the JSON's: the output bars' calibration and the whole-record models' form "
+          "included); calibration only: without the form; given headers: the posterior's own 90 % interval")
     if secs:
         print(f"time per record: median {np.median(secs):.0f} s, range {min(secs):.0f}-{max(secs):.0f} s")
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -100,11 +102,15 @@ def test_what_a_model_carries_is_not_folded_in_again():
     from friction_uq.discrepancy.mechanisms import MECHANISMS
 
     assert folded_sd() == pytest.approx(FORCE_RATIO_CALIBRATION_SD)
-    assert folded_sd_of(()) == pytest.approx(0.0200, abs=1e-4)
+    # the calibration alone (model_form=0), then with the whole-record models' form (2.5 %) in quadrature
+    assert folded_sd_of((), model_form=0.0) == pytest.approx(0.0200, abs=1e-4)
+    assert folded_sd_of(()) == pytest.approx(math.hypot(folded_sd_of((), model_form=0.0), 0.025), rel=1e-12)
     clearance = Variant(MECHANISMS["clearance"])
     gain = Variant(MECHANISMS["gauge_gain"], "internal_output_bar")
     assert folded_sd_of((clearance,)) == folded_sd_of(())
-    assert folded_sd_of((clearance, gain)) == folded_sd_of((Variant(MECHANISMS["bar_modulus"]),)) == folded_sd()
+    whole = math.hypot(folded_sd(), 0.025)  # the whole budget (3.50 %)
+    assert folded_sd_of((clearance, gain)) == folded_sd_of((Variant(MECHANISMS["bar_modulus"]),)) == whole
+    assert folded_sd_of((clearance, gain), model_form=0.0) == folded_sd()
     assert folded_sd_of((Variant(MECHANISMS["gauge_gain"], "input_bar"),)) == folded_sd_of(())
     x = _lognormal_grid(np.log(0.05), 0.02, 4001)
     fits = [SimpleNamespace(label="clearance", variants=(clearance,)),
@@ -116,6 +122,6 @@ def test_what_a_model_carries_is_not_folded_in_again():
                          rounds=[[SimpleNamespace(fit=f) for f in fits]])
     label, fx = headline(dg)
     assert label == "mixture of clearance (0.50), gauge_gain[internal_output_bar] (0.30), unknown (0.20)"
-    per_draw = np.repeat([folded_sd_of(()), folded_sd(), folded_sd_of(())], x.size)
+    per_draw = np.repeat([folded_sd_of(()), whole, folded_sd_of(())], x.size)
     assert fx == times_lognormal_factor(dg.mixture_f, per_draw)
     assert fx != times_lognormal_factor(dg.mixture_f, folded_sd_of(()))  # the gain model's draws fold in more

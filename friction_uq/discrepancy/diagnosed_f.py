@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..quoted import OUTPUT_BARS, folded_sd, quoted_summary
+from ..quoted import OUTPUT_BARS, WHOLE_RECORD_MODEL_FORM, folded_sd, quoted_summary
 from .candidates_mixture import STATIONARY, open_rounds
 from .diagnose import Diagnosis
 from .extended import Variant
@@ -47,16 +47,18 @@ def further(dg: Diagnosis) -> dict[str, str]:
     return {k: added.get(k, k) for k in dg.mixture_weights if k != dg.final.label}
 
 
-def folded_sd_of(variants) -> float:
-    """The calibration sd folded into the f of a whole-record model with these causes (:mod:`friction_uq.quoted`):
-    its likelihood carries a gain of :data:`~.record_likelihood.GAIN_SD` on each output gauge (2.0 % left). With
-    one of :data:`BAR_CALIBRATION_FAULTS` fitted on an output bar, f is read partly against the input bar's force
-    through the equilibrium, whose calibration no model carries: the whole budget is folded in (2.45 %, more than
-    that bar's term swapped for the input bar's, 2.24 %)."""
+def folded_sd_of(variants, model_form: float = WHOLE_RECORD_MODEL_FORM) -> float:
+    """The sd folded into the f of a whole-record model with these causes (:mod:`friction_uq.quoted`): the
+    calibration its likelihood does not carry, and ``model_form`` beside it (the 1-D simulation's form, which its
+    likelihood does not carry either: 2.5 %). Its likelihood carries a gain of :data:`~.record_likelihood.GAIN_SD`
+    on each output gauge (2.0 % of calibration left). With one of :data:`BAR_CALIBRATION_FAULTS` fitted on an
+    output bar, f is read partly against the input bar's force through the equilibrium, whose calibration no model
+    carries: the whole budget is folded in (2.45 %, more than that bar's term swapped for the input bar's, 2.24 %).
+    With the model form: 3.20 % and 3.50 %."""
     if any(v.mechanism.name == "bar_modulus" or (v.mechanism.name in BAR_CALIBRATION_FAULTS and v.channel in OUTPUT_BARS)
            for v in variants):
-        return folded_sd()
-    return folded_sd(GAIN_SD)
+        return folded_sd(model_form=model_form)
+    return folded_sd(GAIN_SD, model_form=model_form)
 
 
 def member_variants(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
@@ -68,11 +70,13 @@ def member_variants(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
     return next((m.variants for m in fits if m.label == label), ())
 
 
-def _folded(dg: Diagnosis) -> float | np.ndarray:
-    """The sd folded into the f to quote: the final model's, or per draw of the mixture its model's."""
+def _folded(dg: Diagnosis, model_form: float = WHOLE_RECORD_MODEL_FORM) -> float | np.ndarray:
+    """The sd folded into the f to quote: the final model's, or per draw of the mixture its model's (the stationary
+    analysis' draws carry their model form already)."""
     if dg.mixture_f is None:
-        return folded_sd_of(dg.final.variants)
-    sds = np.array([folded_sd() if k == STATIONARY else folded_sd_of(member_variants(dg, k)) for k in dg.mixture_weights])
+        return folded_sd_of(dg.final.variants, model_form)
+    sds = np.array([folded_sd() if k == STATIONARY else folded_sd_of(member_variants(dg, k), model_form)
+                    for k in dg.mixture_weights])
     return sds[np.asarray(dg.mixture_source, int)] if dg.mixture_source is not None else float(sds.max())
 
 
@@ -82,9 +86,10 @@ def f_draws_to_quote(dg: Diagnosis) -> np.ndarray:
     return dg.mixture_f if dg.mixture_f is not None else dg.final.f_effective
 
 
-def quoted_of(dg: Diagnosis) -> dict[str, float]:
-    """The diagnosed f to quote (:func:`f_draws_to_quote`) with the output bars' calibration."""
-    return quoted_summary(f_draws_to_quote(dg), _folded(dg))
+def quoted_of(dg: Diagnosis, model_form: float = WHOLE_RECORD_MODEL_FORM) -> dict[str, float]:
+    """The diagnosed f to quote (:func:`f_draws_to_quote`) with the output bars' calibration and the whole-record
+    models' form (``model_form``; 0: the calibration alone, as before the form was folded in)."""
+    return quoted_summary(f_draws_to_quote(dg), _folded(dg, model_form))
 
 
 def folded_of(dg: Diagnosis) -> float:

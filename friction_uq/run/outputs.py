@@ -71,6 +71,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     stacking mixture, how its draws were obtained and the Pareto k of the final model's importance step. ``f_stationary``: the stationary f to quote,
     ``f_stationary_posterior`` its posterior summary."""
     from ..discrepancy.diagnosed_f import f_draws_to_quote, folded_of, headline
+    from ..likelihood.force_level import RATIO_MODEL_FORM
     from ..physics.bars import FORCE_RATIO_CALIBRATION_SD
     from ..quoted import folded_sd
     from ..report.quote import f_to_quote
@@ -81,7 +82,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     given = f_stationary_posterior if named is None else summarize_draws(f_draws_to_quote(diagnosis))
     out: dict[str, object] = ({"model": model, "source": source}
                               | {k: fx[k] for k in ("mean", "sd", "q05", "q50", "q95")}
-                              | {"bar_calibration_sd": FORCE_RATIO_CALIBRATION_SD,
+                              | {"bar_calibration_sd": FORCE_RATIO_CALIBRATION_SD, "model_form_sd": RATIO_MODEL_FORM,
                                  "calibration_folded_in_sd": folded_sd() if named is None else folded_of(diagnosis),
                                  "given_bar_headers": {k: given[k] for k in ("mean", "sd", "q05", "q50", "q95")}})
     if diagnosis is not None and (diagnosis.causes or diagnosis.mixture_f is not None):
