@@ -133,17 +133,32 @@ def test_a_right_proposal_keeps_its_first_two_hundred_draws():
     assert ex.method == "importance" and ex.log_post_calls == 200 and ex.ess >= 119
 
 
-def test_emcee_runs_its_chain_until_it_is_long_enough_and_reports_the_chain_s_effective_size():
-    """A proposal far off (both importance stages refused): emcee's first 40 steps underestimate the
-    autocorrelation time; the chain runs on to 50 of those times, or stops at the cap and says it did not converge.
-    The ESS reported is the chain's, not the number of draws resampled from it (2000)."""
+def test_emcee_runs_its_chain_until_its_effective_size_reaches_the_floor_and_reports_the_chain_s():
+    """A proposal far off (both importance stages refused): emcee's chain runs on by its first length until its
+    ESS (walkers x kept steps / autocorrelation time) reaches the floor, or stops at four times that length and
+    says it fell short. The ESS reported is the chain's, not the number of draws resampled from it (2000)."""
+    from friction_uq.stats.exact import ess_floor
+
     wrong = MU + np.array([1.2, 1.8])
     short = exact_draws(NORMAL.logpdf, wrong, S / 100, S / 100, rng=np.random.default_rng(4), n_out=2000,
-                        emcee_steps=40, emcee_burn=10)
-    assert short.method == "emcee" and short.ess < 2000
-    assert not short.converged  # 160 steps at most: short of 50 autocorrelation times (~15 steps each)
+                        emcee_steps=10, emcee_burn=5)
+    # 16 walkers, at most 40 steps of which half or more kept: never more effective draws than the chain holds
+    assert short.method == "emcee" and short.ess <= 16 * 20 and short.converged == (short.ess >= ess_floor())
     long = exact_draws(NORMAL.logpdf, wrong, S / 100, S / 100, rng=np.random.default_rng(4), n_out=2000,
-                       emcee_steps=400, emcee_burn=100)
-    assert long.method == "emcee" and long.converged and long.ess >= 119
+                       emcee_steps=400, emcee_burn=150)
+    assert long.method == "emcee" and long.converged and ess_floor() <= long.ess < 2000
     se = np.sqrt(np.diag(S) / long.ess)
     assert np.all(np.abs(long.z.mean(axis=0) - MU) < 4 * se)
+
+
+def test_a_short_exact_posterior_is_a_warning_that_names_its_effective_size():
+    from types import SimpleNamespace
+
+    from friction_uq.run.warnings import exact_posterior_warning
+
+    dg = SimpleNamespace(causes=("clearance",), posterior_converged=False, posterior_method="emcee", importance_ess=64.2)
+    text = exact_posterior_warning(dg)
+    assert "kept only 64 effective draws, short of the 119" in text and "not reliable" in text
+    assert exact_posterior_warning(SimpleNamespace(causes=("clearance",), posterior_converged=True)) is None
+    assert exact_posterior_warning(SimpleNamespace(causes=(), posterior_converged=False)) is None
+    assert exact_posterior_warning(None) is None
