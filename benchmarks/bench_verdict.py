@@ -11,8 +11,10 @@ comparison, without fitting again:
 
 Prints per group: records, verdicts (named / candidates / unexplained / none), the exact cause named, f's
 90 % interval holding the truth (named: the named model's f; candidates or unexplained: the stacking
-mixture's; none: the baseline's), and the confusion of first named causes. f here is the normal
-approximation's (``diagnose`` then takes the named model's exact posterior).
+mixture's; none: the baseline's), the same with the output bars' calibration folded in ("+calib.") and with the
+whole-record models' form beside it ("+form": the f to quote's fold, :mod:`friction_uq.quoted`), and the confusion
+of first named causes. f here is the normal approximation's (``diagnose`` then takes the named model's exact
+posterior); the stationary analysis' half of a mixture (``diagnose``'s, when nothing is named) is not stored.
 """
 
 from __future__ import annotations
@@ -30,10 +32,12 @@ import numpy as np
 
 from friction_uq.discrepancy.candidates_mixture import mixture
 from friction_uq.discrepancy.diagnose import Ranked
+from friction_uq.discrepancy.diagnosed_f import folded_sd_of
 from friction_uq.discrepancy.elpd import Elpd, elpd_difference
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
 from friction_uq.discrepancy.verdict import NamingRule
+from friction_uq.quoted import WHOLE_RECORD_MODEL_FORM, quoted_summary
 
 
 def _elpd(a: dict, key: str, names) -> Elpd:
@@ -62,15 +66,23 @@ def outcome(rec: dict, rule: NamingRule) -> dict:
     """The rule's verdict on one stored record, the f it would quote and whether that holds the truth."""
     v = rule.judge(rec["reference"], rec["ranked"], misfit=rec["misfit"], seed=0)
     fits = {"reference": rec["reference"]} | {r.fit.label: r.fit for r in rec["ranked"]}
-    if v.kind == "named":
-        f = fits[v.named].f_effective
-    elif v.kind == "none":
-        f = rec["reference"].f_effective
+    if v.kind in ("named", "none"):
+        model = fits[v.named] if v.kind == "named" else rec["reference"]
+        f, members, src = model.f_effective, [model], np.zeros(len(model.f_effective), int)
     else:
-        f, _, _ = mixture(rec["reference"], rec["ranked"], v, 0)
+        f, w, src = mixture(rec["reference"], rec["ranked"], v, 0)
+        members = [fits[k] for k in w]
     q05, q95 = np.quantile(f, [0.05, 0.95])
     named = None if v.named is None or v.kind != "named" else v.named.split("[")[0]
-    return {"kind": v.kind, "named": named, "covered": bool(q05 <= rec["truth_f"] <= q95),
+    truth = rec["truth_f"]
+
+    def quoted_covers(model_form: float) -> bool:  # the f to quote's interval: each draw with its model's fold
+        sd = np.array([folded_sd_of(m.variants, model_form) for m in members])[np.asarray(src, int)]
+        q = quoted_summary(f, sd)
+        return bool(q["q05"] <= truth <= q["q95"])
+
+    return {"kind": v.kind, "named": named, "covered": bool(q05 <= truth <= q95),
+            "quoted_calibration": quoted_covers(0.0), "quoted": quoted_covers(WHOLE_RECORD_MODEL_FORM),
             "candidates": [v.named, *v.rivals] if v.kind == "candidates" else []}
 
 
@@ -89,16 +101,19 @@ def table(records: list[dict], rule: NamingRule) -> str:
         c["exact"] += o["named"] is not None and o["named"] == hidden(rec["group"])
         c["in_candidates"] += hidden(rec["group"]) in [x.split("[")[0] for x in o["candidates"] if x]
         c["covered"] += o["covered"]
+        c["quoted_calibration"] += o["quoted_calibration"]
+        c["quoted"] += o["quoted"]
         confusion[rec["group"]][o["named"] or f"({o['kind']})"] += 1
     head = (f"{'group':<32} {'n':>3} {'named':>5} {'cand.':>5} {'unexpl.':>7} {'unconf.':>7} {'none':>4} {'exact':>5} "
-            f"{'in cand.':>8} {'f cov.':>6}  first named cause (or verdict)")
+            f"{'in cand.':>8} {'f cov.':>6} {'+calib.':>7} {'+form':>5}  first named cause (or verdict)")
     lines = [head]
     for g in sorted(rows):
         c = rows[g]
         conf = ", ".join(f"{k} {v}" for k, v in confusion[g].most_common())
         lines.append(f"{g:<32} {c['n']:>3} {c['named']:>5} {c['candidates']:>5} {c['unexplained']:>7} "
                      f"{c['unconfirmed']:>7} {c['none']:>4} "
-                     f"{c['exact']:>5} {c['in_candidates']:>8} {c['covered']:>6}  {conf}")
+                     f"{c['exact']:>5} {c['in_candidates']:>8} {c['covered']:>6} {c['quoted_calibration']:>7} "
+                     f"{c['quoted']:>5}  {conf}")
     clean = [g for g in rows if g.startswith("clean")]
     effect = [g for g in rows if not g.startswith("clean")]
 
@@ -107,8 +122,9 @@ def table(records: list[dict], rule: NamingRule) -> str:
         return f"{sum(rows[g][key] for g in groups)}/{n}"
 
     lines.append(f"clean records with a cause named: {share(clean, 'named')}; single effects with the exact cause: "
-                 f"{share(effect, 'exact')}; f covered on effect records: {share(effect, 'covered')}, on clean: "
-                 f"{share(clean, 'covered')}")
+                 f"{share(effect, 'exact')}; f covered on effect records: {share(effect, 'covered')} (with the bars' "
+                 f"calibration {share(effect, 'quoted_calibration')}, and the whole-record form {share(effect, 'quoted')})"
+                 f", on clean: {share(clean, 'covered')} ({share(clean, 'quoted_calibration')}, {share(clean, 'quoted')})")
     return "\n".join(lines)
 
 

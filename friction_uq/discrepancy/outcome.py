@@ -20,8 +20,8 @@ POSTERIOR_NOTE = ("exact posterior of the model with the named causes: 200 draws
                   "covariance) importance-weighted by the whole-record posterior (Pareto-smoothed; pareto_k judges the "
                   "normal), more of them while the weights' effective sample size is under 119 (the 90 % interval's "
                   "tails to 0.02); when k is over its limit or the effective size stays short, a Student-t proposal, "
-                  "then emcee, run on until its chain is 50 autocorrelation times long with 119 effective draws "
-                  "(posterior_converged: false if not within 4 times its first length); the exact draws then mapped "
+                  "then emcee, run on while its chain has fewer than 119 effective draws (posterior_converged: false if "
+                  "still short at 4 times its first length); the exact draws then mapped "
                   "to the robust (sandwich) covariance, keeping their shape (open-faced sandwich adjustment, Shaby "
                   "2014)")
 
