@@ -63,7 +63,7 @@ class ExactDraws:
     pareto_k_used: float  # of the stage whose draws are kept (nan for emcee)
     ess: float  # of the kept draws: the weights' 1 / sum w^2, or emcee's chain's (module docstring)
     log_post_calls: int
-    converged: bool = True  # False: the floor on the ESS (or emcee's chain length) not reached within the caps
+    converged: bool = True  # False: the floor on the ESS not reached within the caps (module docstring)
 
 
 def sandwich_map(mode: np.ndarray, cov_laplace: np.ndarray, cov_robust: np.ndarray) -> np.ndarray:
