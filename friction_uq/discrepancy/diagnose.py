@@ -114,7 +114,7 @@ class Diagnosis:
     #: the final model's normal approximation against its exact posterior (Diagnoser.exact_posterior), when a
     #: cause was named: Pareto k, the kept draws' effective sample size, how the exact draws were obtained
     #: (friction_uq.stats.exact: "importance", "importance (second proposal)" or "emcee") and whether they reached
-    #: the floor on their effective sample size (emcee's chain its length too) within the caps
+    #: the floor on their effective sample size within the caps
     pareto_k: float = float("nan")
     importance_ess: float = float("nan")
     posterior_method: str | None = None

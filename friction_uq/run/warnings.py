@@ -158,14 +158,13 @@ def convergence_warning(conv: Convergence) -> str | None:
 
 
 def exact_posterior_warning(diagnosis) -> str | None:
-    """The exact posterior of the model with the named causes fell short of its effective sample size's floor (or
-    emcee's chain of its length) within the caps (:mod:`friction_uq.stats.exact`): its interval's tails rest on too
-    few independent draws."""
+    """The exact posterior of the model with the named causes fell short of its effective sample size's floor
+    within the caps (:mod:`friction_uq.stats.exact`): its interval's tails rest on too few independent draws."""
     if diagnosis is None or not diagnosis.causes or diagnosis.posterior_converged:
         return None
     return (f"The exact posterior under the named causes ({diagnosis.posterior_method}) kept only "
             f"{diagnosis.importance_ess:.0f} effective draws, short of the {ess_floor()} that the 90 % interval's tails "
-            "need, or its chain did not run long enough: the interval of f under them is not reliable; run `diagnose` "
+            "need: the interval of f under them is not reliable; run `diagnose` "
             "again with another --seed and compare.")
 
 

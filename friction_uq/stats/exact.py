@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import stats
@@ -89,29 +89,33 @@ def ess_floor(tail: float = TAIL_PROBABILITY, mcse: float = TAIL_MCSE) -> int:
     return math.ceil(tail * (1.0 - tail) / mcse ** 2)
 
 
-@dataclass
+@dataclass(frozen=True)
 class _Stage:
     """An importance stage's draws of one proposal, their log target and log proposal densities, and the
-    smoothed weights over all of them."""
+    smoothed weights over all of them (computed on construction)."""
 
     z: np.ndarray
     log_target: np.ndarray
     log_proposal: np.ndarray
     first_batch: int
-    log_weights: np.ndarray = None  # type: ignore[assignment]
-    k: float = math.nan
-    ess: float = 0.0
+    log_weights: np.ndarray = field(init=False)
+    k: float = field(init=False)
+    ess: float = field(init=False)
 
-    def weigh(self) -> "_Stage":
+    def __post_init__(self) -> None:
         res = importance_weights(self.log_target, self.log_proposal)
-        self.log_weights, self.k, self.ess = res.log_weights, float(res.pareto_k), float(res.ess)
-        return self
+        for name, value in (("log_weights", res.log_weights), ("k", float(res.pareto_k)), ("ess", float(res.ess))):
+            object.__setattr__(self, name, value)
 
     @property
     def k_ok(self) -> bool:
         """k within the limit for the first batch's draws (the limit the JSON states; more draws allow a higher
         one, not taken)."""
         return bool(self.k <= khat_threshold(self.first_batch))
+
+    def kept(self, floor: int) -> bool:
+        """The stage's draws are the exact posterior: k within its limit and the ESS at the floor."""
+        return self.k_ok and self.ess >= floor
 
 
 def _draw(log_post_rows: Callable[[np.ndarray], np.ndarray], dist, n: int, rng: np.random.Generator):
@@ -123,14 +127,14 @@ def _importance(log_post_rows: Callable[[np.ndarray], np.ndarray], dist, n: int,
                 floor: int) -> _Stage:
     """One proposal's stage: ``n`` draws, then more of the same (k weighed again over all) while k passes and
     the ESS is under ``floor``, up to :data:`MAX_IMPORTANCE_FACTOR` x ``n`` draws (module docstring)."""
-    st = _Stage(*_draw(log_post_rows, dist, n, rng), n).weigh()
+    st = _Stage(*_draw(log_post_rows, dist, n, rng), n)
     cap = MAX_IMPORTANCE_FACTOR * n
     while st.k_ok and st.ess < floor and len(st.z) < cap:
         per_draw = max(st.ess / len(st.z), 1.0 / cap)
         extra = int(min(cap - len(st.z), max(n // 2, math.ceil(1.2 * floor / per_draw) - len(st.z))))
         z, lt, lq = _draw(log_post_rows, dist, extra, rng)
         st = _Stage(np.concatenate([st.z, z]), np.concatenate([st.log_target, lt]),
-                    np.concatenate([st.log_proposal, lq]), n).weigh()
+                    np.concatenate([st.log_proposal, lq]), n)
     return st
 
 
@@ -189,7 +193,7 @@ def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_l
                         n_importance, rng, floor)
     calls, st, method = len(first.z), first, "importance"
     omega = sandwich_map(mode, cov_laplace, cov_robust)
-    if not (first.k_ok and first.ess >= floor):
+    if not first.kept(floor):
         w = np.exp(first.log_weights - np.max(first.log_weights))
         w /= w.sum()
         mean = w @ first.z
@@ -198,7 +202,7 @@ def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_l
                          n_importance, rng, floor)
         calls += len(st.z)
         method = "importance (second proposal)"
-        if not (st.k_ok and st.ess >= floor):
+        if not st.kept(floor):
             zz, ll = np.concatenate([first.z, st.z]), np.concatenate([first.log_weights, st.log_weights])
             out, ess, n_calls, ok = _emcee(log_post_rows, zz, ll, n_out, rng, steps=emcee_steps, burn=emcee_burn,
                                            floor=floor)
