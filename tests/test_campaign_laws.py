@@ -373,8 +373,9 @@ def _constant_fit(data):
 
     from friction_uq.campaign.laws import Fit
 
-    fit_kde = Fit(Model("constant"), data, kbar=1.0, p_ref=1e8, seed=0, nsteps=2, burn=0)
-    fit_normal = Fit(Model("constant"), replace(data, draws=None), kbar=1.0, p_ref=1e8, seed=0, nsteps=2, burn=0)
+    fit_kde = Fit(Model("constant"), data, kbar=1.0, p_ref=1e8, seed=0, nsteps=2, burn=0, max_steps=2)
+    fit_normal = Fit(Model("constant"), replace(data, draws=None), kbar=1.0, p_ref=1e8, seed=0, nsteps=2,
+                     burn=0, max_steps=2)
     return fit_kde, fit_normal
 
 

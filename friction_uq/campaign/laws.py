@@ -47,7 +47,8 @@ positive at every test; cal_s ~ N(0, 0.03); delta ~ N(0, 0.3).
 window, which separates a slip law from a velocity law (:mod:`.law_windows`).
 Priors: S_c log-uniform on (0.1, 100) mm (the tested slips are 0.5-4 mm).
 
-Sampled with emcee (:mod:`.law_coordinates`); leave-one-test-out ELPD in :mod:`.law_loo`.
+Sampled with emcee (:mod:`.law_coordinates`), the chain run on to :data:`TAU_MULTIPLE` autocorrelation times
+(up to :data:`MAX_STEPS`); leave-one-test-out ELPD in :mod:`.law_loo`.
 """
 
 from __future__ import annotations
@@ -76,6 +77,24 @@ __all__ = ["BASES", "CALIBRATION_SD", "FREE_OFFSET_SD", "LAWS", "LAW_PARAMS", "L
 CALIBRATION_SD = 0.03
 #: Prior sd of a free set-up offset (flag models only).
 FREE_OFFSET_SD = 0.3
+
+#: A law fit's chain runs on until its kept part is this many autocorrelation times long: emcee's own
+#: criterion for a reliable estimate of the time itself (its ``tol``). Measured on the bundled campaign
+#: (docs/validation.md): pressure+velocity's time is 170-210 steps where a chain of 1000 steps estimated 40-60,
+#: and its leave-one-test-out ELPD moved with the fit's seed by 0.55 (sd) at 1000 steps, 0.15 at 2500 and 0.03
+#: at 5000, enough at 1000 to move a set-up's flag across its 4-nat line.
+TAU_MULTIPLE = 50
+#: steps added at a time, and the longest chain: the cost's bound (most laws reach it: 14-35 times their time;
+#: at 4000 the flag's dELPD still moved by 0.2 between fit seeds, at 6000 by 0.1)
+STEP_BLOCK = 1000
+MAX_STEPS = 6000
+#: the steps discarded: at least the caller's burn-in, and this many autocorrelation times (the start
+#: forgotten: the walkers begin in a small ball at the mode)
+BURN_TAUS = 5
+#: most draws kept from a chain (thinned evenly, at least every THIN-th step): PSIS-LOO's own error falls with
+#: the draws (thinned to 4480, an 8000-step chain's ELPD moved by 0.25), so at MAX_STEPS none is thinned further
+KEPT_DRAWS = 40000
+THIN = 5
 
 
 @dataclass(frozen=True)
@@ -121,12 +140,18 @@ class Fit:
     """Posterior draws of one model on one data set, and its pointwise log-likelihood function."""
 
     def __init__(self, model: Model, data: LawData, *, kbar: float, p_ref: float, seed: int,
-                 nwalkers: int = 32, nsteps: int = 1000, burn: int = 300, start: np.ndarray | None = None) -> None:
+                 nwalkers: int = 32, nsteps: int = 1000, burn: int = 300, start: np.ndarray | None = None,
+                 max_steps: int | None = None) -> None:
         """``start``: the walkers' first positions (nwalkers, parameters), e.g. draws of the model on more
-        data; without it a random search from a fixed guess finds a start near the mode."""
+        data; without it a random search from a fixed guess finds a start near the mode. ``nsteps``: the chain's
+        first length, run on to :data:`TAU_MULTIPLE` autocorrelation times up to ``max_steps`` (None:
+        :data:`MAX_STEPS`; :func:`chain_length_needed`)."""
         self.model, self.data, self.kbar, self.p_ref = model, data, kbar, p_ref
         self._kernels = data.kernels(kbar)
-        self.draws = self._sample(seed, nwalkers, nsteps, burn, start)
+        #: the chain's steps, the steps discarded, and the largest autocorrelation time estimated (steps)
+        self.steps, self.discarded, self.tau = 0, 0, float("nan")
+        cap = MAX_STEPS if max_steps is None else max_steps
+        self.draws = self._sample(seed, nwalkers, (nsteps, max(nsteps, cap)), burn, start)
 
     def _theta(self, x: np.ndarray) -> dict[str, np.ndarray]:
         return {name: x[:, k:k + 1] for k, name in enumerate(self.model.params)}
@@ -222,9 +247,12 @@ class Fit:
         ball[:, -1] = np.abs(ball[:, -1])
         return ball
 
-    def _sample(self, seed: int, nwalkers: int, nsteps: int, burn: int, start: np.ndarray | None) -> np.ndarray:
+    def _sample(self, seed: int, nwalkers: int, steps: tuple[int, int], burn: int,
+                start: np.ndarray | None) -> np.ndarray:
         """Draws in the law's parameters, sampled in :class:`~.law_coordinates.LawCoordinates` (the same
-        posterior, with the change's Jacobian; a shape the ensemble crosses in a few tens of steps)."""
+        posterior, with the change's Jacobian; a shape the ensemble crosses in a few tens of steps), the chain
+        run on in blocks of :data:`STEP_BLOCK` from ``steps[0]`` until it is long enough
+        (:func:`chain_length_needed`) or ``steps[1]`` long; about :data:`KEPT_DRAWS` draws kept, evenly thinned."""
         import emcee
 
         rng = np.random.default_rng(seed)
@@ -241,8 +269,46 @@ class Fit:
 
         sampler = emcee.EnsembleSampler(nwalkers, start.shape[1], log_prob, vectorize=True)
         state = emcee.State(coords.to_sampling(start), random_state=legacy_state(rng).get_state())
-        sampler.run_mcmc(state, nsteps)
-        return coords.to_law(sampler.get_chain(discard=burn, thin=5, flat=True))[0]
+        state = sampler.run_mcmc(state, steps[0])
+        while True:
+            chain = sampler.get_chain()
+            self.tau = max_autocorr_time(chain[burn:])
+            needed, discard = chain_length_needed(self.tau, burn)
+            if len(chain) >= min(needed, steps[1]):
+                break
+            state = sampler.run_mcmc(state, min(STEP_BLOCK, steps[1] - len(chain)))
+        self.steps, self.discarded = len(chain), min(discard, len(chain) - 1)
+        kept = chain[self.discarded:]
+        thin = max(THIN, (kept.shape[0] * nwalkers) // KEPT_DRAWS)
+        return coords.to_law(kept[::-1][::thin][::-1].reshape(-1, kept.shape[2]))[0]
+
+
+
+
+def max_autocorr_time(chain: np.ndarray) -> float:
+    """The largest integrated autocorrelation time (steps) over the parameters of an emcee chain (steps,
+    walkers, parameters), without emcee's length check (the caller decides what is long enough); NaN for a
+    chain too short to estimate it."""
+    import emcee
+
+    if len(chain) < 2:
+        return float("nan")
+    with np.errstate(invalid="ignore", divide="ignore"):  # a parameter that does not move has no time: left out
+        tau = emcee.autocorr.integrated_time(chain, c=5, tol=0, quiet=True)
+    return float(np.nanmax(tau)) if np.isfinite(tau).any() else float("nan")
+
+
+def chain_length_needed(tau: float, burn: int) -> tuple[int, int]:
+    """The chain's length and discard for an autocorrelation time ``tau``: ``burn`` or :data:`BURN_TAUS` tau
+    discarded, then :data:`TAU_MULTIPLE` tau kept; a time not estimated (NaN) asks for nothing more.
+
+    >>> chain_length_needed(20.0, 300), chain_length_needed(100.0, 300)
+    ((1300, 300), (5500, 500))
+    """
+    if not np.isfinite(tau):
+        return 0, burn
+    discard = max(burn, int(np.ceil(BURN_TAUS * tau)))
+    return discard + int(np.ceil(TAU_MULTIPLE * tau)), discard
 
 
 @dataclass(frozen=True)
