@@ -49,7 +49,7 @@ def three_setups():
     return analyse_tests(tests, tally_causes([]), seed=1)
 
 
-@pytest.mark.slow  # a 15-test law comparison, 70-90 s
+@pytest.mark.slow  # a 15-test law comparison, 95-155 s
 def test_the_velocity_law_is_found_and_the_odd_setup_flagged(three_setups):
     ca = three_setups
     # B's 20 % is far beyond a calibration (3 %): B is flagged (alone: A and C are not taken for off because B
@@ -72,7 +72,7 @@ def test_the_velocity_law_is_found_and_the_odd_setup_flagged(three_setups):
     assert ca.next_tests == []  # decided: no advice
 
 
-@pytest.mark.slow  # a 15-test law comparison, 70-90 s
+@pytest.mark.slow  # a 15-test law comparison, 95-155 s
 def test_campaign_outputs_from_the_analysis(three_setups, tmp_path):
     results = [RecordResult(path=f"{t.label}.h5", status="done", campaign=t.setup, test_id=t.label)
                for t in three_setups.tests]
@@ -100,7 +100,7 @@ def test_campaign_outputs_from_the_analysis(three_setups, tmp_path):
     dt.close()
 
 
-@pytest.mark.slow  # a 15-test law comparison, 70-90 s
+@pytest.mark.slow  # a 15-test law comparison, 95-155 s
 def test_diagnosed_tests_fit_the_law_to_f_under_their_models_not_to_a_biased_kappa(tmp_path):
     """Every test diagnosed: the law is fitted to f under each test's chosen model. Here the stationary
     kappa reads low by up to 30 % as the pressure rises (a clearance's signature), which a fit to kappa

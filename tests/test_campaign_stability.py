@@ -28,7 +28,7 @@ def _verdict(ca) -> tuple:
             tuple(sorted({str(f["setup"]) for f in ca.flagged if "setup" in f})))
 
 
-@pytest.mark.slow  # five campaigns of the ten bundled records without PDF reports, about 5 minutes on 2 cores
+@pytest.mark.slow  # five campaigns of the ten bundled records without PDF reports, about 8 minutes on 2 cores
 def test_the_bundled_campaign_gives_one_verdict_over_five_seeds(tmp_path):
     """The laws' fits are sampled in coordinates where their autocorrelation time is tens of steps
     (friction_uq/campaign/law_coordinates.py); before, it was 200-250 steps against 700 kept, the fits' tails
@@ -37,7 +37,9 @@ def test_the_bundled_campaign_gives_one_verdict_over_five_seeds(tmp_path):
     the laws named, and set-up B flagged (it departs from the shared law by more than its calibration allows;
     B hides a plug friction, data/README.md). Which of the non-constant laws are named is compared across the
     seeds, not fixed here; the measured ELPDs and weights, which move with the law's form, are in
-    docs/validation.md ("Campaigns on the bundled data")."""
+    docs/validation.md ("Campaigns on the bundled data"). With other numerical libraries (thirtieth session) seed 5
+    fell below the flag's 4-nat line again: the fits' chains were a few autocorrelation times long; run on to 50
+    (friction_uq/campaign/laws.py, TAU_MULTIPLE), the flag's dELPD is 4.2-4.6 on every records and fit seed tried."""
     records = sorted(DATA.glob("[AB]/*.h5"))
     verdicts = [_verdict(run_campaign(records, tmp_path / f"s{seed}", seed=seed, pdf=False, progress=False).analysis)
                 for seed in range(1, 6)]

@@ -17,7 +17,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "benchmarks"))
 from bench_campaign_study import LAWS, one_campaign  # noqa: E402
 
 
-@pytest.mark.slow  # two simulated campaigns of six records each, about 1.5 minutes on 2 cores
+@pytest.mark.slow  # two simulated campaigns of six records each, about 2.5 minutes on 2 cores
 @pytest.mark.parametrize("law", ["velocity", "pressure", "slip", "constant"])
 def test_a_two_setup_campaign_gives_the_weight_to_the_law_of_its_wall(law, tmp_path):
     for seed in (6, 7):
