@@ -57,6 +57,9 @@ def _campaign(law, seed):
     return analyse_tests(tests, tally_causes([]), seed=1)
 
 
+# a law comparison of a simulated campaign per wall, about 60 s each on 2 cores since the law fits run on to 50
+# autocorrelation times: slow, to keep the default suite under 10 minutes (it took 658 s with them)
+@pytest.mark.slow
 @pytest.mark.parametrize("law, seed", [(lambda V, S: f_slip(S), 5), (f_velocity, 6)], ids=["slip wall", "velocity wall"])
 def test_the_change_across_each_window_separates_slip_from_velocity(law, seed, tmp_path):
     ca = _campaign(law, seed)
