@@ -39,7 +39,7 @@ def test_the_bundled_campaign_gives_one_verdict_over_five_seeds(tmp_path):
     seeds, not fixed here; the measured ELPDs and weights, which move with the law's form, are in
     docs/validation.md ("Campaigns on the bundled data"). With other numerical libraries (thirtieth session) seed 5
     fell below the flag's 4-nat line again: the fits' chains were a few autocorrelation times long; run on to 50
-    (friction_uq/campaign/laws.py, TAU_MULTIPLE), the flag's dELPD is 4.2-4.6 on every records and fit seed tried."""
+    (friction_uq/campaign/law_chain.py, TAU_MULTIPLE), the flag's dELPD is 4.2-4.6 on every records and fit seed tried."""
     records = sorted(DATA.glob("[AB]/*.h5"))
     verdicts = [_verdict(run_campaign(records, tmp_path / f"s{seed}", seed=seed, pdf=False, progress=False).analysis)
                 for seed in range(1, 6)]

@@ -14,7 +14,7 @@ from .laws import Elpd, Fit, LawData
 
 PARETO_K_MAX = 0.7
 #: an exact leave-one-out refit's chain: it starts from the full fit's walkers, so it burns in less, and it is not
-#: run on (the full fit's was: laws.TAU_MULTIPLE); one test's predictive density is all it gives
+#: run on (the full fit's was: law_chain.TAU_MULTIPLE); one test's predictive density is all it gives
 REFIT = {"nwalkers": 32, "nsteps": 700, "burn": 200, "max_steps": 700}
 
 

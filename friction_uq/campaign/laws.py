@@ -62,6 +62,9 @@ from ..stats import RULE, paired_difference
 from ..stats.trimmed import trimmed_difference
 from ..stats.streams import legacy_state
 from .kernels import log_kernel_mixture
+from . import law_chain
+from .law_chain import (BURN_TAUS, KEPT_DRAWS, MAX_STEPS, STEP_BLOCK, TAU_MULTIPLE, THIN, chain_length_needed,
+                        max_autocorr_time)
 from .law_coordinates import LawCoordinates
 from .law_data import BASES, LawData
 from .law_forms import (LAW_PARAMS, LAWS, LOG_PC_RANGE, LOG_SC_RANGE, LOG_VC_RANGE, NESTS, SPECIAL_CASES,
@@ -69,7 +72,8 @@ from .law_forms import (LAW_PARAMS, LAWS, LOG_PC_RANGE, LOG_SC_RANGE, LOG_VC_RAN
 from .law_windows import TREND_DOF, TREND_FLOOR, TREND_REL, halves_mean, window_change_loglike
 
 #: What the campaign's law modules give, from here (the laws' forms, data and window term live beside)
-__all__ = ["BASES", "CALIBRATION_SD", "FREE_OFFSET_SD", "LAWS", "LAW_PARAMS", "LOG_PC_RANGE", "LOG_SC_RANGE",
+__all__ = ["BASES", "BURN_TAUS", "CALIBRATION_SD", "KEPT_DRAWS", "MAX_STEPS", "STEP_BLOCK", "TAU_MULTIPLE", "THIN",
+           "chain_length_needed", "max_autocorr_time", "FREE_OFFSET_SD", "LAWS", "LAW_PARAMS", "LOG_PC_RANGE", "LOG_SC_RANGE",
            "LOG_VC_RANGE", "NESTS", "SPECIAL_CASES", "TREND_DOF", "TREND_FLOOR", "TREND_REL", "Elpd", "Fit", "LawData",
            "Model", "best_law", "law_mean", "rank"]
 
@@ -78,23 +82,6 @@ CALIBRATION_SD = 0.03
 #: Prior sd of a free set-up offset (flag models only).
 FREE_OFFSET_SD = 0.3
 
-#: A law fit's chain runs on until its kept part is this many autocorrelation times long: emcee's own
-#: criterion for a reliable estimate of the time itself (its ``tol``). Measured on the bundled campaign
-#: (docs/validation.md): pressure+velocity's time is 170-210 steps where a chain of 1000 steps estimated 40-60,
-#: and its leave-one-test-out ELPD moved with the fit's seed by 0.55 (sd) at 1000 steps, 0.15 at 2500 and 0.03
-#: at 5000, enough at 1000 to move a set-up's flag across its 4-nat line.
-TAU_MULTIPLE = 50
-#: steps added at a time, and the longest chain: the cost's bound (most laws reach it: 14-35 times their time;
-#: at 4000 the flag's dELPD still moved by 0.2 between fit seeds, at 6000 by 0.1)
-STEP_BLOCK = 1000
-MAX_STEPS = 6000
-#: the steps discarded: at least the caller's burn-in, and this many autocorrelation times (the start
-#: forgotten: the walkers begin in a small ball at the mode)
-BURN_TAUS = 5
-#: most draws kept from a chain (thinned evenly, at least every THIN-th step): PSIS-LOO's own error falls with
-#: the draws (thinned to 4480, an 8000-step chain's ELPD moved by 0.25), so at MAX_STEPS none is thinned further
-KEPT_DRAWS = 40000
-THIN = 5
 
 
 @dataclass(frozen=True)
@@ -150,7 +137,7 @@ class Fit:
         self._kernels = data.kernels(kbar)
         #: the chain's steps, the steps discarded, and the largest autocorrelation time estimated (steps)
         self.steps, self.discarded, self.tau = 0, 0, float("nan")
-        cap = MAX_STEPS if max_steps is None else max_steps
+        cap = law_chain.MAX_STEPS if max_steps is None else max_steps
         self.draws = self._sample(seed, nwalkers, (nsteps, max(nsteps, cap)), burn, start)
 
     def _theta(self, x: np.ndarray) -> dict[str, np.ndarray]:
@@ -283,32 +270,6 @@ class Fit:
         return coords.to_law(kept[::-1][::thin][::-1].reshape(-1, kept.shape[2]))[0]
 
 
-
-
-def max_autocorr_time(chain: np.ndarray) -> float:
-    """The largest integrated autocorrelation time (steps) over the parameters of an emcee chain (steps,
-    walkers, parameters), without emcee's length check (the caller decides what is long enough); NaN for a
-    chain too short to estimate it."""
-    import emcee
-
-    if len(chain) < 2:
-        return float("nan")
-    with np.errstate(invalid="ignore", divide="ignore"):  # a parameter that does not move has no time: left out
-        tau = emcee.autocorr.integrated_time(chain, c=5, tol=0, quiet=True)
-    return float(np.nanmax(tau)) if np.isfinite(tau).any() else float("nan")
-
-
-def chain_length_needed(tau: float, burn: int) -> tuple[int, int]:
-    """The chain's length and discard for an autocorrelation time ``tau``: ``burn`` or :data:`BURN_TAUS` tau
-    discarded, then :data:`TAU_MULTIPLE` tau kept; a time not estimated (NaN) asks for nothing more.
-
-    >>> chain_length_needed(20.0, 300), chain_length_needed(100.0, 300)
-    ((1300, 300), (5500, 500))
-    """
-    if not np.isfinite(tau):
-        return 0, burn
-    discard = max(burn, int(np.ceil(BURN_TAUS * tau)))
-    return discard + int(np.ceil(TAU_MULTIPLE * tau)), discard
 
 
 @dataclass(frozen=True)
