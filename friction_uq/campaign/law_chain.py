@@ -4,7 +4,11 @@ laws")."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
+
+from ..sampler import integrated_time
 
 #: A law fit's chain runs on until its kept part is this many autocorrelation times long: emcee's own
 #: criterion for a reliable estimate of the time itself (its ``tol``). Measured on the bundled campaign
@@ -27,14 +31,14 @@ THIN = 5
 
 def max_autocorr_time(chain: np.ndarray) -> float:
     """The largest integrated autocorrelation time (steps) over the parameters of an emcee chain (steps,
-    walkers, parameters), without emcee's length check (the caller decides what is long enough); NaN for a
-    chain too short to estimate it."""
-    import emcee
-
+    walkers, parameters), by the package's estimator (:func:`friction_uq.sampler.integrated_time`, emcee's),
+    without a length check (the caller decides what is long enough); a parameter that never moves is left out;
+    NaN for a chain too short to estimate it."""
     if len(chain) < 2:
         return float("nan")
-    with np.errstate(invalid="ignore", divide="ignore"):  # a parameter that does not move has no time: left out
-        tau = emcee.autocorr.integrated_time(chain, c=5, tol=0, quiet=True)
+    with warnings.catch_warnings():  # a still parameter: its autocorrelation is 0/0 in every walker
+        warnings.simplefilter("ignore", RuntimeWarning)
+        tau = integrated_time(chain)
     return float(np.nanmax(tau)) if np.isfinite(tau).any() else float("nan")
 
 

@@ -47,8 +47,8 @@ positive at every test; cal_s ~ N(0, 0.03); delta ~ N(0, 0.3).
 window, which separates a slip law from a velocity law (:mod:`.law_windows`).
 Priors: S_c log-uniform on (0.1, 100) mm (the tested slips are 0.5-4 mm).
 
-Sampled with emcee (:mod:`.law_coordinates`), the chain run on to :data:`TAU_MULTIPLE` autocorrelation times
-(up to :data:`MAX_STEPS`); leave-one-test-out ELPD in :mod:`.law_loo`.
+Sampled with emcee (:mod:`.law_coordinates`), the chain run on to ``TAU_MULTIPLE`` autocorrelation times
+(up to ``MAX_STEPS``, :mod:`.law_chain`); leave-one-test-out ELPD in :mod:`.law_loo`.
 """
 
 from __future__ import annotations
@@ -63,8 +63,7 @@ from ..stats.trimmed import trimmed_difference
 from ..stats.streams import legacy_state
 from .kernels import log_kernel_mixture
 from . import law_chain
-from .law_chain import (BURN_TAUS, KEPT_DRAWS, MAX_STEPS, STEP_BLOCK, TAU_MULTIPLE, THIN, chain_length_needed,
-                        max_autocorr_time)
+from .law_chain import KEPT_DRAWS, STEP_BLOCK, THIN, chain_length_needed, max_autocorr_time
 from .law_coordinates import LawCoordinates
 from .law_data import BASES, LawData
 from .law_forms import (LAW_PARAMS, LAWS, LOG_PC_RANGE, LOG_SC_RANGE, LOG_VC_RANGE, NESTS, SPECIAL_CASES,
@@ -72,8 +71,7 @@ from .law_forms import (LAW_PARAMS, LAWS, LOG_PC_RANGE, LOG_SC_RANGE, LOG_VC_RAN
 from .law_windows import TREND_DOF, TREND_FLOOR, TREND_REL, halves_mean, window_change_loglike
 
 #: What the campaign's law modules give, from here (the laws' forms, data and window term live beside)
-__all__ = ["BASES", "BURN_TAUS", "CALIBRATION_SD", "KEPT_DRAWS", "MAX_STEPS", "STEP_BLOCK", "TAU_MULTIPLE", "THIN",
-           "chain_length_needed", "max_autocorr_time", "FREE_OFFSET_SD", "LAWS", "LAW_PARAMS", "LOG_PC_RANGE", "LOG_SC_RANGE",
+__all__ = ["BASES", "CALIBRATION_SD", "FREE_OFFSET_SD", "LAWS", "LAW_PARAMS", "LOG_PC_RANGE", "LOG_SC_RANGE",
            "LOG_VC_RANGE", "NESTS", "SPECIAL_CASES", "TREND_DOF", "TREND_FLOOR", "TREND_REL", "Elpd", "Fit", "LawData",
            "Model", "best_law", "law_mean", "rank"]
 
@@ -81,7 +79,6 @@ __all__ = ["BASES", "BURN_TAUS", "CALIBRATION_SD", "KEPT_DRAWS", "MAX_STEPS", "S
 CALIBRATION_SD = 0.03
 #: Prior sd of a free set-up offset (flag models only).
 FREE_OFFSET_SD = 0.3
-
 
 
 @dataclass(frozen=True)
@@ -131,8 +128,8 @@ class Fit:
                  max_steps: int | None = None) -> None:
         """``start``: the walkers' first positions (nwalkers, parameters), e.g. draws of the model on more
         data; without it a random search from a fixed guess finds a start near the mode. ``nsteps``: the chain's
-        first length, run on to :data:`TAU_MULTIPLE` autocorrelation times up to ``max_steps`` (None:
-        :data:`MAX_STEPS`; :func:`chain_length_needed`)."""
+        first length, run on to ``law_chain.TAU_MULTIPLE`` autocorrelation times up to ``max_steps`` (None:
+        ``law_chain.MAX_STEPS``; :func:`~.law_chain.chain_length_needed`)."""
         self.model, self.data, self.kbar, self.p_ref = model, data, kbar, p_ref
         self._kernels = data.kernels(kbar)
         #: the chain's steps, the steps discarded, and the largest autocorrelation time estimated (steps)
@@ -267,9 +264,8 @@ class Fit:
         self.steps, self.discarded = len(chain), min(discard, len(chain) - 1)
         kept = chain[self.discarded:]
         thin = max(THIN, (kept.shape[0] * nwalkers) // KEPT_DRAWS)
+        # thinned from the last step back, so that the last walkers (where a leave-one-out refit starts) are kept
         return coords.to_law(kept[::-1][::thin][::-1].reshape(-1, kept.shape[2]))[0]
-
-
 
 
 @dataclass(frozen=True)
