@@ -68,7 +68,8 @@ from .law_coordinates import LawCoordinates
 from .law_data import BASES, LawData
 from .law_forms import (LAW_PARAMS, LAWS, LOG_PC_RANGE, LOG_SC_RANGE, LOG_VC_RANGE, NESTS, SPECIAL_CASES,
                         law_mean)
-from .law_windows import TREND_DOF, TREND_FLOOR, TREND_REL, halves_mean, window_change_loglike
+from .law_points import LawPoints
+from .law_windows import TREND_DOF, TREND_FLOOR, TREND_REL, change_loglike
 
 #: What the campaign's law modules give, from here (the laws' forms, data and window term live beside)
 __all__ = ["BASES", "CALIBRATION_SD", "FREE_OFFSET_SD", "LAWS", "LAW_PARAMS", "LOG_PC_RANGE", "LOG_SC_RANGE",
@@ -132,6 +133,7 @@ class Fit:
         ``law_chain.MAX_STEPS``; :func:`~.law_chain.chain_length_needed`)."""
         self.model, self.data, self.kbar, self.p_ref = model, data, kbar, p_ref
         self._kernels = data.kernels(kbar)
+        self._points = LawPoints(model.law, data, p_ref)
         #: the chain's steps, the steps discarded, and the largest autocorrelation time estimated (steps)
         self.steps, self.discarded, self.tau = 0, 0, float("nan")
         cap = law_chain.MAX_STEPS if max_steps is None else max_steps
@@ -142,27 +144,25 @@ class Fit:
 
     def pointwise(self, x: np.ndarray, data: LawData | None = None, *, chunk: int = 512) -> np.ndarray:
         """log p(test_i | theta) for draws x (W, k): (W, n)."""
-        d = data or self.data
-        kernels = self._kernels if data is None else data.kernels(self.kbar)
         if len(x) > chunk:
             return np.vstack([self.pointwise(x[i:i + chunk], data, chunk=chunk) for i in range(0, len(x), chunk)])
         th = self._theta(x)
-        law = self.model.law
-        p_rel = (d.p - self.p_ref) / self.p_ref
-        y = d.kappa / self.kbar
+        if data is None:
+            return self._loglike(th, self.data, self._kernels, self._points)
+        return self._loglike(th, data, data.kernels(self.kbar), LawPoints(self.model.law, data, self.p_ref))
 
-        def at(V: np.ndarray, p: np.ndarray, S: np.ndarray | None) -> np.ndarray:
-            return law_mean(law, th, V, p, S)
-
-        mean = at(d.V, p_rel, d.slip)
-        hV, hp = 1e-3 * np.maximum(d.V, 1.0), 1e-3
+    def _loglike(self, th: dict[str, np.ndarray], d: LawData, kernels: tuple | None, points: LawPoints,
+                 at: dict[str, np.ndarray] | None = None) -> np.ndarray:
+        """log p(test_i | theta) from the law at the likelihood's points on ``d`` (``at``: ``points.evaluate(th)``,
+        when the caller has it already): (W, n)."""
+        at = points.evaluate(th) if at is None else at
+        mean = at["mean"]
         # errors in variables: the measured V and p, and the slip (V integrated: V's relative error)
-        dV = (at(d.V + hV, p_rel, d.slip) - at(d.V - hV, p_rel, d.slip)) / (2 * hV)
-        dp = (at(d.V, p_rel + hp, d.slip) - at(d.V, p_rel - hp, d.slip)) / (2 * hp)
+        dV = (at["V+"] - at["V-"]) / (2 * points.hV)
+        dp = (at["p+"] - at["p-"]) / (2 * points.hp)
         var_x = (dV * d.V_sd) ** 2 + (dp * d.p_sd / self.p_ref) ** 2
-        if law == "slip":
-            hS = 1e-3 * d.slip
-            dS = (at(d.V, p_rel, d.slip + hS) - at(d.V, p_rel, d.slip - hS)) / (2 * hS)
+        if "S+" in at:
+            dS = (at["S+"] - at["S-"]) / (2 * points.hS)
             var_x = var_x + (dS * d.slip * d.V_sd / np.maximum(d.V, 1e-9)) ** 2
         if self.model.offset_setup is not None or self.model.cal_setups or self.model.freed:
             scale = self.model.setup_scale(th, d.setups)
@@ -170,12 +170,12 @@ class Fit:
         var = var_x + (th["r"] * mean) ** 2
         if kernels is None:
             var = var + (d.kappa_sd / self.kbar) ** 2
-            out = -0.5 * (y - mean) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
+            out = -0.5 * (d.kappa / self.kbar - mean) ** 2 / var - 0.5 * np.log(2 * np.pi * var)
         else:
             yj, logw, h2 = kernels
             out = log_kernel_mixture(np.ascontiguousarray(mean, dtype=float), np.ascontiguousarray(var + h2[None, :]),
                                      yj, logw)
-        return out + window_change_loglike(law, th, d, self.p_ref) if d.reads_window_changes else out
+        return out + change_loglike(at["first"], at["second"], d) if d.reads_window_changes else out
 
     def log_prior(self, x: np.ndarray) -> np.ndarray:
         th = self._theta(x)
@@ -202,19 +202,18 @@ class Fit:
 
     def _log_prob(self, x: np.ndarray) -> np.ndarray:
         lp = self.log_prior(x)
-        if self.model.law == "pressure+velocity":  # the only law whose terms can take it below 0 at a test
-            d = self.data
-            th = self._theta(x)
-            mean = law_mean(self.model.law, th, d.V, (d.p - self.p_ref) / self.p_ref)
-            positive = np.all(mean > 0, axis=1)
-            if d.reads_window_changes:  # and within each window
-                positive &= np.all([np.all(h > 0, axis=1) for h in halves_mean(self.model.law, th, d, self.p_ref)],
-                                   axis=0)
-            lp = np.where(positive, lp, -np.inf)
         ok = np.isfinite(lp)
         out = np.full(len(x), -np.inf)
         if ok.any():
-            out[ok] = lp[ok] + self.pointwise(x[ok]).sum(axis=1)
+            th = self._theta(x[ok])
+            at = self._points.evaluate(th)
+            ll = self._loglike(th, self.data, self._kernels, self._points, at).sum(axis=1)
+            if self.model.law == "pressure+velocity":  # the only law whose terms can take it below 0 at a test
+                positive = np.all(at["mean"] > 0, axis=1)
+                if self.data.reads_window_changes:  # and within each window
+                    positive &= np.all(at["first"] > 0, axis=1) & np.all(at["second"] > 0, axis=1)
+                ll = np.where(positive, ll, -np.inf)
+            out[ok] = lp[ok] + ll
         return out
 
     def _start(self, rng: np.random.Generator, nwalkers: int) -> np.ndarray:
