@@ -54,3 +54,26 @@ def test_the_likelihood_on_other_data_reads_their_points():
     other = Fit(model, held_out, kbar=1.0, p_ref=100e6, seed=1, nsteps=2, burn=1, max_steps=2)
     x = np.array([[0.8, 1.3, np.log(8.0), 0.02], [1.1, 0.9, np.log(20.0), 0.05]])
     np.testing.assert_array_equal(fit.pointwise(x, held_out), other.pointwise(x))
+
+
+def test_the_prior_is_the_documented_one_at_and_beyond_each_support():
+    """laws' docstring: levels uniform on (0, 5), amp_p on (-5, 5), log scales on their ranges, cal ~ N(0, 0.03),
+    delta ~ N(0, 0.3) (both above -1), r half-normal(0.1) on [0, inf)."""
+    from friction_uq.campaign.law_forms import LOG_PC_RANGE
+
+    d = _data(4)
+    model = Model("pressure+velocity", "B", ("B",))
+    fit = Fit(model, d, kbar=1.0, p_ref=100e6, seed=1, nsteps=2, burn=1, max_steps=2)
+    assert model.params == ("d", "s", "log_vc", "amp_p", "log_pc", "delta", "r")
+    x = np.array([0.8, 1.3, np.log(8.0), 0.1, 0.0, 0.06, 0.02])
+    want = -0.5 * (0.06 / 0.3) ** 2 - 0.5 * (0.02 / 0.1) ** 2
+    assert fit.log_prior(x[None])[0] == pytest.approx(want, rel=1e-12)
+    at_zero = x.copy()
+    at_zero[6] = 0.0
+    assert np.isfinite(fit.log_prior(at_zero[None])[0])
+    outside = [(0, 0.0), (1, 5.0), (2, np.log(300.0)), (3, -5.0), (4, LOG_PC_RANGE[1]), (5, -1.0), (6, -1e-9),
+               (0, np.nan)]
+    for k, v in outside:
+        y = x.copy()
+        y[k] = v
+        assert fit.log_prior(y[None])[0] == -np.inf, (k, v)

@@ -189,9 +189,11 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     offsets = [setups[-1]] if len(setups) == 2 else (setups if len(setups) > 2 else [])
     cal = tuple(setups[1:])  # every set-up but the first: a calibration offset (laws.CALIBRATION_SD)
     laws = LawComparison(ca, data, kbar, p_ref, seed, say, t0)
-    elpds = laws.compare(cal, ())
-    law_for_flags = simplest_supported(ca.weights, ca.ranking)
     two = len(setups) == 2
+    # with two set-ups the flag's first round fits every law with the second's offset, whatever the comparison
+    # finds: fitted in the comparison's batch, which keeps both processes busy to its end
+    elpds = laws.compare(cal, (), ahead=[Model(law, offsets[0], cal) for law in data.laws] if two else ())
+    law_for_flags = simplest_supported(ca.weights, ca.ranking)
     pressure_named = any("log_pc" in LAW_PARAMS[law] for law in supported_laws(ca.weights, ca.ranking))
     first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies, every_law=two)
     if not freed and two:

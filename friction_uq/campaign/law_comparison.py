@@ -156,7 +156,11 @@ def fits_with_loo(jobs: Sequence[tuple[Model, LawData, float, float, int]]) -> l
     warm_up_kernels()  # loaded here once, before the fork, not in every child (0.5-1 s each)
     import arviz  # noqa: F401 - the same: the children's PSIS uses it, and a child that imports it pays ~1 s
 
-    fits, psis = zip(*forked_map(_fit, jobs, workers=LAW_WORKERS)) if jobs else ((), ())
+    # the longest chains first (most parameters), so that the last job to start is a short one; the values come back
+    # in the jobs' order whichever process ran each
+    order = sorted(range(len(jobs)), key=lambda n: -len(jobs[n][0].params))
+    done = dict(zip(order, forked_map(_fit, [jobs[n] for n in order], workers=LAW_WORKERS)))
+    fits, psis = zip(*(done[n] for n in range(len(jobs)))) if jobs else ((), ())
     todo = [(n, i) for n, (_, k) in enumerate(psis) for i in to_refit(k)]
     values = forked_map(_refit, [(fits[n], i, jobs[n][4]) for n, i in todo], workers=LAW_WORKERS)
     refits: list[dict[int, float]] = [{} for _ in fits]
@@ -174,29 +178,37 @@ class LawComparison:
         self.k = 0
         #: model name -> (ELPD, summary of its offset's draws) of every model with a free offset fitted so far
         self.offset_fits: dict[str, tuple[Elpd, dict[str, float]]] = {}
+        #: model name -> (fit, ELPD) of models fitted ahead, in an earlier batch, before they were asked for
+        self._ahead: dict[str, tuple[Fit, Elpd]] = {}
 
-    def fit_all(self, models: Sequence[Model]) -> list[tuple[Fit, Elpd]]:
+    def fit_all(self, models: Sequence[Model], ahead: Sequence[Model] = ()) -> list[tuple[Fit, Elpd]]:
         """Each model fitted with its leave-one-test-out ELPD, on up to :data:`LAW_WORKERS` forked processes; the
-        k-th model of the analysis takes seed ``seed + 1000 k`` whichever process fits it."""
-        first = self.k + 1
-        self.k += len(models)
-        self.say(f"friction law model{'s' if len(models) > 1 else ''} {first}{f'-{self.k}' if len(models) > 1 else ''} "
-                 f"({', '.join(m.name for m in models)}): fit and leave-one-test-out; "
-                 f"{time.perf_counter() - self.t0:.0f} s so far")
-        jobs = [(m, self.data, self.kbar, self.p_ref, self.seed + 1000 * (first - 1 + i)) for i, m in enumerate(models)]
-        out = fits_with_loo(jobs)
+        k-th model of the analysis takes seed ``seed + 1000 k`` whichever process fits it. ``ahead``: models the
+        analysis will ask for next, fitted in the same batch (the processes kept busy; the same seeds as when asked
+        for later); a model fitted ahead is not fitted again."""
+        new = [m for m in list(models) + list(ahead) if m.name not in self._ahead]
+        if new:
+            first = self.k + 1
+            self.k += len(new)
+            self.say(f"friction law model{'s' if len(new) > 1 else ''} {first}{f'-{self.k}' if len(new) > 1 else ''} "
+                     f"({', '.join(m.name for m in new)}): fit and leave-one-test-out; "
+                     f"{time.perf_counter() - self.t0:.0f} s so far")
+            jobs = [(m, self.data, self.kbar, self.p_ref, self.seed + 1000 * (first - 1 + i)) for i, m in enumerate(new)]
+            self._ahead |= {m.name: r for m, r in zip(new, fits_with_loo(jobs))}
+        out = [self._ahead[m.name] for m in models]
         for m, (fit, _) in zip(models, out):
             self.ca.fits[m.name] = fit
         return out
 
     def compare(self, cal: tuple[str, ...], freed: tuple[str, ...],
-                elpds: dict[str, Elpd] | None = None) -> dict[str, Elpd]:
+                elpds: dict[str, Elpd] | None = None, *, ahead: Sequence[Model] = ()) -> dict[str, Elpd]:
         """Every law with calibration offsets (and the ``freed`` set-ups' levels left out): ranking and weights.
         ``elpds``: the four models fitted already (a free offset on one set-up is the same model whether it was
-        fitted to flag the set-up or to leave its level out)."""
+        fitted to flag the set-up or to leave its level out). ``ahead``: models fitted in the same batch for what
+        follows (:meth:`fit_all`)."""
         if elpds is None:
             models = [Model(law, None, cal, freed) for law in self.data.laws]
-            elpds = {m.name: e for m, (_, e) in zip(models, self.fit_all(models))}
+            elpds = {m.name: e for m, (_, e) in zip(models, self.fit_all(models, ahead))}
         self.ca.ranking = rank(list(elpds.values()))
         self.ca.weights = {Model(k.split(" + ")[0]).law: w
                            for k, w in stacking_weights({n: e.pointwise for n, e in elpds.items()}).items()}

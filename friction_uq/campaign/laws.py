@@ -67,7 +67,7 @@ from .law_chain import KEPT_DRAWS, STEP_BLOCK, THIN, chain_length_needed, max_au
 from .law_coordinates import LawCoordinates
 from .law_data import BASES, LawData
 from .law_forms import (LAW_PARAMS, LAWS, LOG_PC_RANGE, LOG_SC_RANGE, LOG_VC_RANGE, NESTS, SPECIAL_CASES,
-                        law_mean)
+                        law_mean, prior_table)
 from .law_points import LawPoints
 from .law_windows import TREND_DOF, TREND_FLOOR, TREND_REL, change_loglike
 
@@ -134,6 +134,7 @@ class Fit:
         self.model, self.data, self.kbar, self.p_ref = model, data, kbar, p_ref
         self._kernels = data.kernels(kbar)
         self._points = LawPoints(model.law, data, p_ref)
+        self._prior = prior_table(model.params, calibration_sd=CALIBRATION_SD, free_offset_sd=FREE_OFFSET_SD)
         #: the chain's steps, the steps discarded, and the largest autocorrelation time estimated (steps)
         self.steps, self.discarded, self.tau = 0, 0, float("nan")
         cap = law_chain.MAX_STEPS if max_steps is None else max_steps
@@ -178,26 +179,14 @@ class Fit:
         return out + change_loglike(at["first"], at["second"], d) if d.reads_window_changes else out
 
     def log_prior(self, x: np.ndarray) -> np.ndarray:
-        th = self._theta(x)
-        lp = np.zeros(len(x))
-        for name, v in th.items():
-            v = v[:, 0]
-            if name in ("a", "d", "s"):
-                lp += np.where((v > 0) & (v < 5), 0.0, -np.inf)
-            elif name == "log_vc":
-                lp += np.where((v > LOG_VC_RANGE[0]) & (v < LOG_VC_RANGE[1]), 0.0, -np.inf)
-            elif name == "log_pc":
-                lp += np.where((v > LOG_PC_RANGE[0]) & (v < LOG_PC_RANGE[1]), 0.0, -np.inf)
-            elif name == "log_sc":
-                lp += np.where((v > LOG_SC_RANGE[0]) & (v < LOG_SC_RANGE[1]), 0.0, -np.inf)
-            elif name == "amp_p":
-                lp += np.where(np.abs(v) < 5, 0.0, -np.inf)
-            elif name == "delta" or name.startswith("free_"):
-                lp += np.where(v > -1, -0.5 * (v / FREE_OFFSET_SD) ** 2, -np.inf)
-            elif name.startswith("cal_"):
-                lp += np.where(v > -1, -0.5 * (v / CALIBRATION_SD) ** 2, -np.inf)
-            elif name == "r":
-                lp += np.where(v >= 0, -0.5 * (v / 0.1) ** 2, -np.inf)
+        """The log prior density of draws x (W, k) up to a constant (module docstring): every support in one test,
+        then the normal priors' terms in the parameters' order."""
+        lo, hi, normal = self._prior
+        lp = np.where(np.all((x > lo) & (x < hi), axis=1), 0.0, -np.inf)
+        for k, sd in normal:
+            lp += -0.5 * (x[:, k] / sd) ** 2
+        if "r" in self.model.params:
+            lp = np.where(x[:, self.model.params.index("r")] >= 0, lp, -np.inf)
         return lp
 
     def _log_prob(self, x: np.ndarray) -> np.ndarray:
