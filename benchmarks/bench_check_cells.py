@@ -14,12 +14,13 @@ can be set and judged without fitting again. Groups (f, nu, striker speed, rise 
 
     python benchmarks/bench_check_cells.py --save FILE [--groups clean,clean_axisymmetric,...] [--n 40]
         [--seed 41]
-    python benchmarks/bench_check_cells.py --load FILE [FILE ...]
+    python benchmarks/bench_check_cells.py --load FILE [FILE ...] [--by-load]
 
 ``--load`` prints, per group, the records flagged before (the channels' own tolerances, one threshold for
 every cell) and as the package applies the check (``CHECK_TOLERANCE``, ``CELL_THRESHOLD``), the cells over,
 and the largest statistic of the cells with a threshold of their own and of the three other largest cells, as
-applied.
+applied. ``--by-load`` adds, per set-up, the statistic of the input bar's unloading against f V and of the external
+bar's early rise against nu (where the clean axisymmetric records it flags sit; docs/trust.md).
 """
 
 from __future__ import annotations
@@ -51,8 +52,41 @@ def collect(group: str, n: int, seed: int) -> list[dict]:
             path = os.path.join(tmp, f"{group}-{k}.h5")
             write(cfg, path, int(rng.integers(2**31)), edit, header)
             if (stats := record_statistics(path, seed, f"{group} {k} ({note})", t)) is not None:
-                rows.append({"group": group, "k": k, "note": note, "cells": stats})
+                rows.append({"group": group, "k": k, "note": note, "cells": stats} | drawn(cfg, k))
     return rows
+
+
+def drawn(cfg, k: int) -> dict:
+    """What the record's test was drawn at: its set-up (A for even k, as ``make`` draws it), wall friction
+    coefficient (None for a law other than Coulomb's), Poisson ratio and striker speed."""
+    return {"setup": "AB"[k % 2], "f": cfg.friction_params.get("f"), "nu": cfg.poisson_ratio,
+            "V": cfg.striker_velocity}
+
+
+#: ``--by-load``: the cells whose statistic is shown against the test's load, the quantity it is binned by, the
+#: bins' edges
+BY_LOAD = ((("input_bar", "unloading"), "f V (m/s)", lambda r: r["f"] * r["V"], (0.0, 0.6, 0.9, 1.2, 9.0)),
+           (("external_output_bar", "early rise"), "nu", lambda r: r["nu"], (0.0, 0.40, 0.44, 0.45, 1.0)))
+
+
+def by_load(rows: list[dict]) -> str:
+    """Each :data:`BY_LOAD` cell's statistic as applied, per set-up and bin of the test's load: where in the tested
+    ranges the records flagged sit (rows saved without what they were drawn at, or of a law other than Coulomb's,
+    are left out)."""
+    rows = [r for r in rows if r.get("f") is not None]
+    lines = [f"{'set-up':<6} {'cell':<32} {'bin':<18} {'n':>4} {'median':>7} {'90 %':>6} {'largest':>8} {'over':>5}"]
+    for cell, label, key, edges in BY_LOAD:
+        for setup in ("A", "B"):
+            rs = [r for r in rows if r["setup"] == setup and cell in r["cells"]]
+            v = np.array([key(r) for r in rs])
+            st = np.array([applied(r["cells"], CHECK_TOLERANCE)[cell] for r in rs])
+            for lo, hi in zip(edges[:-1], edges[1:]):
+                on = (v >= lo) & (v < hi)
+                if on.any():
+                    lines.append(f"{setup:<6} {cell[0] + '/' + cell[1]:<32} {f'{label} {lo:g}-{hi:g}':<18} "
+                                 f"{int(on.sum()):>4} {np.median(st[on]):>7.1f} {np.quantile(st[on], 0.9):>6.1f} "
+                                 f"{st[on].max():>8.1f} {int(np.sum(st[on] > cell_threshold(*cell))):>5}")
+    return "\n".join(lines)
 
 
 def applied(cells: dict, table: dict) -> dict[tuple[str, str], float]:
@@ -95,6 +129,7 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--seed", type=int, default=41)
     ap.add_argument("--save")
     ap.add_argument("--load", nargs="+")
+    ap.add_argument("--by-load", action="store_true", help="also each BY_LOAD cell's statistic by the test's load")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
     rows = []
@@ -112,6 +147,8 @@ def main(argv: list[str]) -> int:
           f"{', '.join(f'{c[0]}/{c[1]} {t:g}' for c, t in CELL_THRESHOLD.items()) or 'none'}); "
           f"CHECK_TOLERANCE {CHECK_TOLERANCE!r}")
     print(summary(rows))
+    if a.by_load:
+        print(by_load(rows))
     print(f"{len(rows)} records, {time.perf_counter() - t0:.0f} s")
     return 0
 
