@@ -178,15 +178,16 @@ class LawComparison:
         self.k = 0
         #: model name -> (ELPD, summary of its offset's draws) of every model with a free offset fitted so far
         self.offset_fits: dict[str, tuple[Elpd, dict[str, float]]] = {}
-        #: model name -> (fit, ELPD) of models fitted ahead, in an earlier batch, before they were asked for
-        self._ahead: dict[str, tuple[Fit, Elpd]] = {}
+        #: model -> (fit, ELPD) of every model fitted so far, those fitted ahead of being asked for among them (keyed by
+        #: the model, not its name: a free offset to flag a set-up and one that leaves its level out share a name)
+        self._fitted: dict[Model, tuple[Fit, Elpd]] = {}
 
     def fit_all(self, models: Sequence[Model], ahead: Sequence[Model] = ()) -> list[tuple[Fit, Elpd]]:
         """Each model fitted with its leave-one-test-out ELPD, on up to :data:`LAW_WORKERS` forked processes; the
         k-th model of the analysis takes seed ``seed + 1000 k`` whichever process fits it. ``ahead``: models the
         analysis will ask for next, fitted in the same batch (the processes kept busy; the same seeds as when asked
         for later); a model fitted ahead is not fitted again."""
-        new = [m for m in list(models) + list(ahead) if m.name not in self._ahead]
+        new = list(dict.fromkeys(m for m in [*models, *ahead] if m not in self._fitted))
         if new:
             first = self.k + 1
             self.k += len(new)
@@ -194,8 +195,8 @@ class LawComparison:
                      f"({', '.join(m.name for m in new)}): fit and leave-one-test-out; "
                      f"{time.perf_counter() - self.t0:.0f} s so far")
             jobs = [(m, self.data, self.kbar, self.p_ref, self.seed + 1000 * (first - 1 + i)) for i, m in enumerate(new)]
-            self._ahead |= {m.name: r for m, r in zip(new, fits_with_loo(jobs))}
-        out = [self._ahead[m.name] for m in models]
+            self._fitted |= dict(zip(new, fits_with_loo(jobs)))
+        out = [self._fitted[m] for m in models]
         for m, (fit, _) in zip(models, out):
             self.ca.fits[m.name] = fit
         return out
