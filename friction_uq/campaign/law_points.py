@@ -48,9 +48,6 @@ class LawPoints:
         self._V, self._p = (np.concatenate([v[i] for v in sets.values()]) for i in (0, 1))
         self._S = np.concatenate([v[2] for v in sets.values()]) if law == "slip" else None
 
-    def __contains__(self, key: str) -> bool:
-        return key in self._slices
-
     def evaluate(self, theta: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """The law at every point set for parameter arrays of shape (W, 1): (W, n) each, by point set's key."""
         y = law_mean(self.law, theta, self._V, self._p, self._S)
