@@ -23,8 +23,9 @@ Groups (f, nu, striker speed, rise time and noise drawn as in ``bench_misfit.py`
   simulation (``axisymmetric_<fault>``).
 
 For each record: ``diagnose``'s first round (the baseline against every extended model), written as one
-``.npz`` per record: each model's pointwise block ELPD and calibration terms, its draws of f_effective, the
-misfit decision's flagged cells, and the truth.
+``.npz`` per record: each model's pointwise block ELPD and calibration terms, its draws of f_effective and its
+mode (f, nu and the mechanism's parameters), the misfit decision's flagged cells, and the truth (f at the window,
+nu).
 
     python benchmarks/verdict_records.py OUT_DIR [--clean 20] [--per 4] [--seed 17] [--only GROUP,...]
 """
@@ -188,9 +189,11 @@ def dump(out: str, name: str, group: str, note: str, cfg, prep, dg) -> None:
                    f"m{i}_f": rk.fit.f_effective[:400]}
         v = rk.fit.variants[-1]
         models.append({"label": rk.fit.label, "mechanism": v.mechanism.name, "channel": v.channel,
-                       "calibration_names": list(e.calibration_names), "delpd": rk.delpd, "se": rk.se})
+                       "calibration_names": list(e.calibration_names), "delpd": rk.delpd, "se": rk.se,
+                       "mode": {k: float(x) for k, x in rk.fit.fit.mode.items()}})
     m = dg.misfits[0]
-    meta = {"group": group, "note": note, "truth_f": true_f(cfg, prep), "misfit": bool(m.detected),
+    meta = {"group": group, "note": note, "truth_f": true_f(cfg, prep), "truth_nu": cfg.poisson_ratio,
+            "misfit": bool(m.detected),
             "flagged": [[c.channel, c.phase, c.statistic, c.threshold] for c in m.flagged()],
             "base_calibration_names": list(base.elpd.calibration_names), "models": models,
             "named_now": dg.cause.mechanism.name if dg.cause else None}
