@@ -193,7 +193,7 @@ def dump(out: str, name: str, group: str, note: str, cfg, prep, dg) -> None:
                        "mode": {k: float(x) for k, x in rk.fit.fit.mode.items()}})
     m = dg.misfits[0]
     meta = {"group": group, "note": note, "truth_f": true_f(cfg, prep), "truth_nu": cfg.poisson_ratio,
-            "misfit": bool(m.detected),
+            "misfit": bool(m.detected), "base_mode": {k: float(x) for k, x in base.fit.mode.items()},
             "flagged": [[c.channel, c.phase, c.statistic, c.threshold] for c in m.flagged()],
             "base_calibration_names": list(base.elpd.calibration_names), "models": models,
             "named_now": dg.cause.mechanism.name if dg.cause else None}
