@@ -10,7 +10,7 @@ import pytest
 from friction_uq.campaign.law_data import LawData
 from friction_uq.campaign.law_forms import law_mean
 from friction_uq.campaign.law_points import STEP, LawPoints
-from friction_uq.campaign.law_windows import halves_mean
+from friction_uq.campaign.law_windows import halves_points
 from friction_uq.campaign.laws import Fit, Model
 
 
@@ -38,7 +38,8 @@ def test_each_point_set_is_the_law_evaluated_there_alone(law):
              "p-": law_mean(law, THETA, d.V, p_rel - STEP, S)}
     if law == "slip":
         alone["S+"] = law_mean(law, THETA, d.V, p_rel, d.slip + STEP * d.slip)
-    alone["first"], alone["second"] = halves_mean(law, THETA, d, p_ref)
+    alone["first"], alone["second"] = (law_mean(law, THETA, V, p, S_h if law == "slip" else None)
+                                       for V, p, S_h in halves_points(d, p_ref))
     for key, want in alone.items():
         np.testing.assert_array_equal(at[key], np.broadcast_to(want, (2, d.n)))
     assert ("S+" in at) == (law == "slip")

@@ -120,15 +120,16 @@ def test_the_window_term_is_a_student_t_of_the_changes_error_and_the_model_form_
     from scipy import stats
 
     from friction_uq.campaign.law_data import LawData
-    from friction_uq.campaign.law_windows import TREND_DOF, TREND_REL, halves_mean, window_change_loglike
+    from friction_uq.campaign.law_forms import law_mean
+    from friction_uq.campaign.law_windows import TREND_DOF, TREND_REL, change_loglike, halves_points
 
     halves = np.array([[[1e-3, 6.0, 1.01], [2e-3, 6.1, 0.99]], [[2e-3, 12.0, 1.0], [4e-3, 12.1, 1.0]]])
     d = LawData(["A-01", "A-02"], ["A", "A"], np.ones(2), np.full(2, 0.01), np.array([6.05, 12.05]),
                 np.full(2, 0.01), np.array([60e6, 120e6]), np.full(2, 1e6), slip=np.array([1.5e-3, 3e-3]),
                 trend=np.array([[-0.02, 0.01], [0.01, 0.004]]), halves=halves)
     th = {"d": np.array([[0.8], [1.0]]), "s": np.array([[1.3], [1.0]]), "log_vc": np.log([[8.0], [8.0]])}
-    got = window_change_loglike("velocity", th, d, 90e6)
-    first, second = halves_mean("velocity", th, d, 90e6)
+    first, second = (law_mean("velocity", th, V, p_rel, S) for V, p_rel, S in halves_points(d, 90e6))
+    got = change_loglike(first, second, d)
     pred = np.log(second / first)
     scale = np.sqrt(d.trend[:, 1] ** 2 + TREND_FLOOR**2 + (TREND_REL * pred) ** 2)
     want = stats.t.logpdf(d.trend[:, 0], df=TREND_DOF, loc=pred, scale=scale)

@@ -57,15 +57,16 @@ def law_mean(law: str, theta: dict[str, np.ndarray], V: np.ndarray, p_rel: np.nd
 
 
 def prior_table(params: tuple[str, ...], *, calibration_sd: float,
-                free_offset_sd: float) -> tuple[np.ndarray, np.ndarray, list[tuple[int, float]]]:
-    """The priors of a model's parameters (``laws``' docstring): each one's open support (lower, upper: arrays of
-    len(params)) and the normal priors as (index, sd), in the parameters' order. The levels are uniform on (0, 5),
-    amp_p on (-5, 5), the log scales on their ranges; a set-up's calibration offset (cal_*) is N(0, calibration_sd),
-    a free offset (delta, free_*) N(0, free_offset_sd), both above -1; r is half-normal(0.1), its support [0, inf)
-    closed and tested apart by the caller."""
+                free_offset_sd: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple[int, float]]]:
+    """The priors of a model's parameters (``laws``' docstring): each one's support (lower, upper: arrays of
+    len(params)), whether its lower end belongs to it (r's does: [0, inf); every other support is open), and the
+    normal priors as (index, sd), in the parameters' order. The levels are uniform on (0, 5), amp_p on (-5, 5), the
+    log scales on their ranges; a set-up's calibration offset (cal_*) is N(0, calibration_sd), a free offset
+    (delta, free_*) N(0, free_offset_sd), both above -1; r is half-normal(0.1)."""
     ranges = {"a": (0.0, 5.0), "d": (0.0, 5.0), "s": (0.0, 5.0), "log_vc": LOG_VC_RANGE, "log_pc": LOG_PC_RANGE,
               "log_sc": LOG_SC_RANGE, "amp_p": (-5.0, 5.0)}
-    lo, hi, normal = np.full(len(params), -np.inf), np.full(len(params), np.inf), []
+    lo, hi = np.full(len(params), -np.inf), np.full(len(params), np.inf)
+    closed, normal = np.zeros(len(params), bool), []
     for k, name in enumerate(params):
         if name in ranges:
             lo[k], hi[k] = ranges[name]
@@ -73,5 +74,6 @@ def prior_table(params: tuple[str, ...], *, calibration_sd: float,
             lo[k] = -1.0
             normal.append((k, calibration_sd if name.startswith("cal_") else free_offset_sd))
         elif name == "r":
+            lo[k], closed[k] = 0.0, True
             normal.append((k, 0.1))
-    return lo, hi, normal
+    return lo, hi, closed, normal

@@ -46,18 +46,9 @@ def halves_points(d: LawData, p_ref: float) -> tuple[tuple[np.ndarray, np.ndarra
     return tuple((d.halves[:, k, 1], (d.p * d.halves[:, k, 2] - p_ref) / p_ref, d.halves[:, k, 0]) for k in (0, 1))
 
 
-def halves_mean(law: str, th: dict[str, np.ndarray], d: LawData, p_ref: float) -> tuple[np.ndarray, np.ndarray]:
-    """The law at each test's two window halves: two (W, n) arrays (theta entries of shape (W, 1))."""
-    return tuple(law_mean(law, th, V, p_rel, S) for V, p_rel, S in halves_points(d, p_ref))
-
-
-def window_change_loglike(law: str, th: dict[str, np.ndarray], d: LawData, p_ref: float) -> np.ndarray:
-    """log p(kappa's change across test i's window | theta): (W, n) (module docstring)."""
-    return change_loglike(*halves_mean(law, th, d, p_ref), d)
-
-
 def change_loglike(first: np.ndarray, second: np.ndarray, d: LawData) -> np.ndarray:
-    """:func:`window_change_loglike` from the law at the two halves, ``first`` and ``second`` (W, n)."""
+    """log p(kappa's change across test i's window | theta) from the law at the two halves (:func:`halves_points`),
+    ``first`` and ``second`` (W, n): (W, n) (module docstring)."""
     with np.errstate(divide="ignore", invalid="ignore"):
         pred = np.where((first > 0) & (second > 0), np.log(second / first), np.nan)
     scale2 = d.trend[:, 1] ** 2 + TREND_FLOOR**2 + (TREND_REL * pred) ** 2

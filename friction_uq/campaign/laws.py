@@ -144,19 +144,22 @@ class Fit:
         return {name: x[:, k:k + 1] for k, name in enumerate(self.model.params)}
 
     def pointwise(self, x: np.ndarray, data: LawData | None = None, *, chunk: int = 512) -> np.ndarray:
-        """log p(test_i | theta) for draws x (W, k): (W, n)."""
-        if len(x) > chunk:
-            return np.vstack([self.pointwise(x[i:i + chunk], data, chunk=chunk) for i in range(0, len(x), chunk)])
-        th = self._theta(x)
+        """log p(test_i | theta) for draws x (W, k): (W, n), on the fitted data or on ``data``, ``chunk`` draws at a
+        time."""
         if data is None:
-            return self._loglike(th, self.data, self._kernels, self._points)
-        return self._loglike(th, data, data.kernels(self.kbar), LawPoints(self.model.law, data, self.p_ref))
+            d, kernels, points = self.data, self._kernels, self._points
+        else:
+            d, kernels, points = data, data.kernels(self.kbar), LawPoints(self.model.law, data, self.p_ref)
+        out = []
+        for i in range(0, len(x), chunk):
+            th = self._theta(x[i:i + chunk])
+            out.append(self._loglike(th, d, kernels, points, points.evaluate(th)))
+        return np.vstack(out) if out else np.zeros((0, d.n))
 
     def _loglike(self, th: dict[str, np.ndarray], d: LawData, kernels: tuple | None, points: LawPoints,
-                 at: dict[str, np.ndarray] | None = None) -> np.ndarray:
-        """log p(test_i | theta) from the law at the likelihood's points on ``d`` (``at``: ``points.evaluate(th)``,
-        when the caller has it already): (W, n)."""
-        at = points.evaluate(th) if at is None else at
+                 at: dict[str, np.ndarray]) -> np.ndarray:
+        """log p(test_i | theta) on ``d`` from the law at the likelihood's points, ``at = points.evaluate(th)``
+        (:class:`~.law_points.LawPoints`): (W, n)."""
         mean = at["mean"]
         # errors in variables: the measured V and p, and the slip (V integrated: V's relative error)
         dV = (at["V+"] - at["V-"]) / (2 * points.hV)
@@ -181,12 +184,11 @@ class Fit:
     def log_prior(self, x: np.ndarray) -> np.ndarray:
         """The log prior density of draws x (W, k) up to a constant (module docstring): every support in one test,
         then the normal priors' terms in the parameters' order."""
-        lo, hi, normal = self._prior
-        lp = np.where(np.all((x > lo) & (x < hi), axis=1), 0.0, -np.inf)
+        lo, hi, closed, normal = self._prior
+        inside = np.where(closed, x >= lo, x > lo) & (x < hi)
+        lp = np.where(np.all(inside, axis=1), 0.0, -np.inf)
         for k, sd in normal:
             lp += -0.5 * (x[:, k] / sd) ** 2
-        if "r" in self.model.params:
-            lp = np.where(x[:, self.model.params.index("r")] >= 0, lp, -np.inf)
         return lp
 
     def _log_prob(self, x: np.ndarray) -> np.ndarray:
