@@ -36,6 +36,7 @@ from ..stats.streams import stream
 from .elpd import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
+from .nu_cut import CutFit, FixedNu, NuCut, conditional_fit, cut_draws
 
 #: Block of the leave-one-block-out ELPD (s).
 BLOCK = 10e-6
@@ -72,6 +73,8 @@ class ModelFit:
     f_effective: np.ndarray
     predicted: dict[str, np.ndarray]
     lik: WholeRecordLikelihood | None = None
+    #: the fit at the stationary nu, when f is the cut posterior's (:mod:`.nu_cut`); None: f is the joint fit's
+    cut: CutFit | None = None
 
     def f_summary(self) -> dict[str, float]:
         return summarize_draws(self.f_effective)
@@ -82,8 +85,10 @@ class Diagnoser:
 
     def __init__(self, prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], *, hoop: bool,
                  seed: int, n_draws: int = 60, base_scales: Mapping[str, tuple[float, float]] | None = None,
-                 nominal: Mapping[str, float] | None = None) -> None:
+                 nominal: Mapping[str, float] | None = None, nu_cut: NuCut | None = None) -> None:
         self.prep = prep
+        #: the stationary draws of nu that a model's f is conditioned on (:mod:`.nu_cut`); None: the joint fit's f
+        self.nu_cut = nu_cut
         rec = prep.record
         self.loading = measured_loading(rec, prep.forces)
         self.dispersive_loading = measured_loading(rec, prep.forces, dispersion=True)  # for ``dispersion``
@@ -155,11 +160,26 @@ class Diagnoser:
                                       block=self.block)[0] + logw)
         elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z, block_of)
         elpd = with_calibration(elpd, self._calibration(lik, fit, unit, scales["sample_modulus"]))
-        names = list(fit.draws)
-        S = len(fit.draws["f"])
-        f_eff = np.array([self._f_effective(variants, {n: float(fit.draws[n][s]) for n in names}) for s in range(S)])
+        cut = None
+        if self.nu_cut is None:
+            f_eff = self._f_of(variants, fit.draws)
+        else:
+            cut = conditional_fit(lik, log_prior, fit.mode, self.nu_cut, n_draws=self.n_draws,
+                                  rng=stream(self.seed, "nu cut", label), prior_scale=scales, score_blocks=block_of)
+            params = [lik.model.parameters[n] for n in cut.fit.names]
+            z = np.column_stack([np.asarray(p.to_unbounded(cut.fit.draws[p.name]), float) for p in params])
+            nu = self.nu_cut.sample(len(z), stream(self.seed, "nu cut draws", label))
+            draws = cut_draws(params, z, cut, nu)
+            f_eff = self._f_of(variants, draws)
+            # the draws are the cut posterior's (paired with f); the predictive keeps the joint fit's, as calibrated
+            fit = replace(fit, draws=draws, laplace_draws=fit.laplace_draws or fit.draws)
         return ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd, f_effective=f_eff,
-                        predicted={c: v[None] for c, v in pred.items()}, lik=lik)
+                        predicted={c: v[None] for c, v in pred.items()}, lik=lik, cut=cut)
+
+    def _f_of(self, variants: tuple[Variant, ...], draws: Mapping[str, np.ndarray]) -> np.ndarray:
+        """f_effective of each draw."""
+        S = len(draws["f"])
+        return np.array([self._f_effective(variants, {n: float(v[s]) for n, v in draws.items()}) for s in range(S)])
 
     def log_prior(self, variants: tuple[Variant, ...]) -> Callable[[Mapping[str, float]], float]:
         """The log prior density of a model's parameters (f, nu, the sample's modulus, the mechanisms')."""
@@ -179,15 +199,18 @@ class Diagnoser:
         whole-record likelihood, the priors, the transforms' Jacobians): Pareto k says how far the normal
         was from it; beyond the limit a second proposal or emcee samples it. The exact draws are then
         given the robust covariance by the open-faced sandwich adjustment, which keeps their shape. The
-        returned model's draws and f_effective are these; its mode, ELPD and predictions are unchanged.
+        returned model's draws and f_effective are these; its mode, ELPD and predictions are unchanged. Under the
+        cut (:mod:`.nu_cut`) it is theta's posterior at the stationary nu that is made exact, then moved with nu.
         ``workers``: processes sharing the density's evaluations (forked once; the draws do not depend on it).
         """
-        fit = mf.fit
+        fit = mf.fit if mf.cut is None else mf.cut.fit  # under the cut: theta's posterior at the stationary nu
+        lik = mf.lik if mf.cut is None else FixedNu(mf.lik, mf.cut.nu0)
         params = [mf.lik.model.parameters[name] for name in fit.names]
         mode = np.array([float(p.to_unbounded(fit.mode[p.name])) for p in params])
         cov = fit.cov_z if fit.cov_z is not None else np.eye(len(params)) * 1e-6
         robust = robust_covariance(fit.jacobian, fit.whitened, cov, mf.lik.blocks(self.block))
-        log_prior = self.log_prior(mf.variants)
+        model_prior = self.log_prior(mf.variants)
+        log_prior = model_prior if mf.cut is None else (lambda v: model_prior(dict(v) | {"nu": mf.cut.nu0}))
 
         def log_post(z: np.ndarray) -> float:
             vals = {p.name: float(p.from_unbounded(v)) for p, v in zip(params, z)}
@@ -195,7 +218,7 @@ class Diagnoser:
             if not np.isfinite(lp):
                 return -np.inf
             try:
-                return mf.lik.loglike(vals) + lp + sum(float(p.log_jacobian(v)) for p, v in zip(params, z))
+                return lik.loglike(vals) + lp + sum(float(p.log_jacobian(v)) for p, v in zip(params, z))
             except ValueError:  # parameters the simulator cannot run
                 return -np.inf
 
@@ -203,11 +226,14 @@ class Diagnoser:
         with ForkedPool(log_post, workers=workers) as pool:
             ex = exact_draws(log_post, mode, cov, robust, rng=rng, n_importance=n, n_out=EXACT_DRAWS,
                              map_rows=pool.map)
-        draws = {p.name: np.asarray(p.from_unbounded(ex.z_adjusted[:, i]), float) for i, p in enumerate(params)}
-        f_eff = np.array([self._f_effective(mf.variants, {k: float(v[s]) for k, v in draws.items()})
-                          for s in range(EXACT_DRAWS)])
-        new_fit = replace(fit, draws=draws, log_weights=np.full(EXACT_DRAWS, -math.log(EXACT_DRAWS)),
-                          pareto_k=ex.pareto_k, laplace_draws=fit.laplace_draws or fit.draws)
+        if mf.cut is None:
+            draws = {p.name: np.asarray(p.from_unbounded(ex.z_adjusted[:, i]), float) for i, p in enumerate(params)}
+        else:
+            nu = self.nu_cut.sample(EXACT_DRAWS, stream(self.seed, "nu cut exact", mf.label))
+            draws = cut_draws(params, ex.z_adjusted, mf.cut, nu)
+        f_eff = self._f_of(mf.variants, draws)
+        new_fit = replace(mf.fit, draws=draws, log_weights=np.full(EXACT_DRAWS, -math.log(EXACT_DRAWS)),
+                          pareto_k=ex.pareto_k, laplace_draws=mf.fit.laplace_draws or mf.fit.draws)
         return replace(mf, fit=new_fit, f_effective=f_eff), ex
 
     def _calibration(self, lik: WholeRecordLikelihood, fit: WholeRecordFit, unit: Mapping[str, np.ndarray],
@@ -232,16 +258,16 @@ class Diagnoser:
         a threaded process can deadlock) fits them in turn. Same results as one by one."""
         def fit_job(job: tuple[tuple[Variant, ...], Mapping[str, float], str]) -> tuple:
             mf = self.fit(*job)  # what of the fit can be pickled back from a forked worker
-            return mf.fit, mf.hoop_gain, mf.elpd, mf.f_effective, mf.predicted
+            return mf.fit, mf.hoop_gain, mf.elpd, mf.f_effective, mf.predicted, mf.cut
 
         if min(workers, len(jobs)) <= 1 or not can_fork():
             return [self.fit(*job) for job in jobs]
         parts = forked_map(fit_job, jobs, workers=workers)
         out = []
-        for (variants, _, label), (fit, gain, elpd, f_eff, predicted) in zip(jobs, parts):
+        for (variants, _, label), (fit, gain, elpd, f_eff, predicted, cut) in zip(jobs, parts):
             lik = WholeRecordLikelihood(self.prep, self._model(variants))  # closures do not cross processes
             out.append(ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd,
-                                f_effective=f_eff, predicted=predicted, lik=lik))
+                                f_effective=f_eff, predicted=predicted, lik=lik, cut=cut))
         return out
 
     def predictive(self, mf: ModelFit, n: int = 30) -> dict[str, np.ndarray]:

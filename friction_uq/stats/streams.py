@@ -19,6 +19,9 @@ PURPOSES = {
     "exact posterior": 11,  # importance sampling / emcee behind the final model's Laplace fit
     "effective prior": 13,  # the prior of f_effective, computed by simulation when the draws are written
     "mixture": 14,  # the stacking mixture's draws of f when diagnose names no single cause (discrepancy.verdict)
+    "nu cut": 15,  # a model's conditional fit at the stationary nu (discrepancy.nu_cut)
+    "nu cut draws": 16,  # the stationary draws of nu paired with that fit's draws
+    "nu cut exact": 17,  # the stationary draws of nu paired with the exact posterior's draws
 }
 
 

@@ -1,0 +1,99 @@
+"""f under a whole-record model with nu from the stationary analysis (friction_uq.discrepancy.nu_cut)."""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+
+import numpy as np
+import pytest
+
+from friction_uq.analysis import prepare
+from friction_uq.discrepancy.extended import Diagnoser
+from friction_uq.discrepancy.nu_cut import CutFit, NuCut, conditional_fit, cut_draws
+from friction_uq.discrepancy.fit import WholeRecordFit
+from friction_uq.models.parameters import F, NU
+from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.record import read_record
+from friction_uq.simulate import simulate_to_file
+from simulated import noisy_config
+
+TRUE_F, TRUE_NU = 0.06, 0.4
+
+
+@pytest.mark.parametrize("draws", [[0.4], [0.4, np.nan], [0.4, 0.5], [0.0, 0.3]])
+def test_the_stationary_draws_of_nu_are_refused_unless_two_finite_and_inside_zero_to_a_half(draws):
+    with pytest.raises(ValueError, match="draws of nu"):
+        NuCut(np.array(draws))
+
+
+def test_the_cut_draws_pair_the_stationary_nu_with_theta_moved_along_its_slope():
+    fit = WholeRecordFit(names=("f",), mode={"f": 0.05}, draws={}, log_weights=np.zeros(0), pareto_k=0.0,
+                         loglike_mode=0.0, n_calls=0)
+    cf = CutFit(fit=fit, nu0=0.4, slope=np.array([-2.0]))
+    z = np.array([[F.to_unbounded(0.05)], [F.to_unbounded(0.06)]])
+    nu = np.array([0.41, 0.38])
+    out = cut_draws([F], z, cf, nu)
+    np.testing.assert_array_equal(out["nu"], nu)
+    np.testing.assert_allclose(F.to_unbounded(out["f"]), z[:, 0] - 2.0 * (nu - 0.4), rtol=0, atol=1e-12)
+
+
+@pytest.fixture(scope="module")
+def record(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cut") / "r.h5"
+    simulate_to_file(noisy_config(friction_params=MappingProxyType({"f": TRUE_F})), path, seed=31)
+    prep = prepare(read_record(path))
+    priors = load_priors(default_prior_path("I1"))
+
+    def log_prior(v):
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    scales = {par.name: par.gaussian_stand_in(priors[par.name]) for par in (F, NU)}
+    return prep, log_prior, scales
+
+
+def test_under_the_cut_the_evidence_is_the_joint_fits_and_f_follows_the_stationary_nu(record):
+    prep, log_prior, scales = record
+    nu = np.random.default_rng(3).normal(TRUE_NU, 0.012, 4000)  # a stationary posterior's spread of nu
+    start = {"f": TRUE_F, "nu": TRUE_NU}
+    joint = Diagnoser(prep, log_prior, hoop=True, seed=5, n_draws=400, base_scales=scales).fit((), start, "baseline")
+    cut = Diagnoser(prep, log_prior, hoop=True, seed=5, n_draws=400, base_scales=scales,
+                    nu_cut=NuCut(nu)).fit((), start, "baseline")
+    assert joint.cut is None and cut.cut is not None
+    assert cut.elpd.total == joint.elpd.total  # the names are judged on the joint fit
+    assert cut.fit.mode == joint.fit.mode
+    # the two output forces fix kappa = f nu / (1 - nu) (eq. 17), so f moves against nu: f's spread is nu's
+    f, nu_f = cut.f_effective, cut.fit.draws["nu"]
+    assert np.isin(nu_f, nu).all()  # each f paired with a stationary draw of nu
+    kappa = f * nu_f / (1.0 - nu_f)
+    # at a fixed kappa, d ln f / d nu = -(1/nu + 1/(1 - nu)): f's relative spread is nu's through it, in quadrature
+    # with the conditional fit's own (at nu_0)
+    cond = cut.cut.fit.draws["f"]
+    expected = np.hypot(np.std(cond) / np.mean(cond), np.std(nu) * (1.0 / TRUE_NU + 1.0 / (1.0 - TRUE_NU)))
+    assert np.std(f) / np.mean(f) == pytest.approx(expected, rel=0.15)
+    assert np.std(kappa) / np.mean(kappa) < 0.5 * np.std(f) / np.mean(f)
+    lo, hi = np.quantile(f, [0.05, 0.95])
+    assert lo < TRUE_F < hi
+
+
+def test_the_conditional_modes_slope_in_nu_predicts_the_mode_at_another_nu(record):
+    prep, log_prior, scales = record
+    dg = Diagnoser(prep, log_prior, hoop=True, seed=5, n_draws=50, base_scales=scales)
+    model = dg._model(())
+    from friction_uq.discrepancy.record_likelihood import WholeRecordLikelihood
+
+    lik = WholeRecordLikelihood(prep, model)
+    sc = {"sample_modulus": dg.modulus.gaussian_stand_in(dg.modulus_prior), **scales}
+    start = {"f": TRUE_F, "nu": TRUE_NU, "sample_modulus": dg.E0}
+    blocks = lik.blocks(dg.block)
+    rng = np.random.default_rng(1)
+    at = conditional_fit(lik, dg.log_prior(()), start, NuCut(np.array([0.39, 0.40, 0.41])), n_draws=10, rng=rng,
+                         prior_scale=sc, score_blocks=blocks)
+    moved = conditional_fit(lik, dg.log_prior(()), start, NuCut(np.array([0.42, 0.43, 0.44])), n_draws=10, rng=rng,
+                            prior_scale=sc, score_blocks=blocks)
+    params = [model.parameters[n] for n in at.fit.names]
+    z0 = np.array([float(p.to_unbounded(at.fit.mode[p.name])) for p in params])
+    z1 = np.array([float(p.to_unbounded(moved.fit.mode[p.name])) for p in params])
+    predicted = at.slope * (moved.nu0 - at.nu0)
+    i = at.fit.names.index("f")
+    assert abs(z1[i] - z0[i]) > 0.02  # f moves with nu: kappa is what the record fixes
+    np.testing.assert_allclose(z1[i] - z0[i], predicted[i], rtol=0.15)
