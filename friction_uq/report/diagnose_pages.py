@@ -87,6 +87,7 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
              f"(nu {np.median(dg.baseline.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.baseline)):.4f})",
              f"f, model '{dg.final.label}': {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] "
              f"(nu {np.median(dg.final.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.final)):.4f})",
+             *_nu_source_line(dg),
              f"hoop gauge gain (final model, most probable under its 5 % prior): {dg.final.hoop_gain:.3f}", ""]
     for v in dg.causes:
         turn = "" if v in dg.named_causes else " (a candidate fitted in turn, not named)"
@@ -147,3 +148,11 @@ def page_extended_fit(dg: Diagnosis, *, test: str) -> Figure:
     axes[-1].set_xlabel("time on the record (us)")
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     return fig
+
+
+def _nu_source_line(dg) -> list[str]:
+    """Where the models' nu comes from, and what the whole record alone reads (friction_uq.discrepancy.nu_cut)."""
+    if dg.final.cut is None:
+        return []
+    return [f"nu from the stationary analysis (the window's hoop level); the whole record's dynamics alone would read "
+            f"nu {dg.final.fit.mode['nu']:.3f} under this model"]
