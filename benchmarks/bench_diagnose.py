@@ -45,7 +45,6 @@ from friction_uq.likelihood import Likelihood  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
 from friction_uq.sampler import LogPosterior, start_ball  # noqa: E402
-from friction_uq.sampler.ensemble import sample_posterior  # noqa: E402
 from friction_uq.simulate import simulate_to_file  # noqa: E402
 
 #: Hidden mechanism -> config edit at a detectable strength (and the truth's f at the window).
@@ -98,10 +97,9 @@ def analyse(path: str, priors, seed: int, max_causes: int):
     def log_prior(v):
         return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
 
-    # the stationary posterior's nu, which every model's f is conditioned on as in ``run`` (friction_uq.discrepancy.nu_cut)
-    nu = sample_posterior(prep.data, priors, seed=seed, hoop=True).flat("nu")
+    # every model's f from the cut posterior, as ``run`` has it (friction_uq.discrepancy.nu_cut)
     return prep, diagnose(prep, log_prior, {"f": th[0], "nu": th[1]}, hoop=True, seed=seed, n_draws=1000,
-                          max_causes=max_causes, stationary_nu=nu)
+                          max_causes=max_causes, nu_cut=True)
 
 
 def analyse_as_run(path: str, out: str, seed: int):

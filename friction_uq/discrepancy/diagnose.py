@@ -37,7 +37,6 @@ from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide, misfit_detected
-from .nu_cut import NuCut
 from .candidates_mixture import (further_mixture, mixture, named_causes, open_rivals, open_rounds, rival_mixture,
                                  superfluous_mixture)
 from .rival_swaps import Swap, check_swaps, swap_jobs
@@ -226,24 +225,23 @@ class _Search:
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
              hoop: bool, seed: int, n_draws: int = 1000, progress: Callable[[str], None] | None = None,
              base_scales: Mapping[str, tuple[float, float]] | None = None, max_causes: int = MAX_CAUSES,
-             workers: int | None = None, stationary_f: np.ndarray | None = None,
-             stationary_nu: np.ndarray | None = None) -> Diagnosis:
+             workers: int | None = None, stationary_f: np.ndarray | None = None, nu_cut: bool = False) -> Diagnosis:
     """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring).
 
     ``base_scales``: Gaussian stand-ins (centre, sd in the unbounded coordinate) of the f and nu
     priors for the mode search. ``workers``: processes fitting a round's extended models and sharing the
     exact posterior's evaluations (None: the machine's cores, at most :data:`MAX_WORKERS`); the result does
     not depend on it. ``stationary_f``: the stationary analysis' draws of f, half of the f to quote when no cause
-    is named (:mod:`.candidates_mixture`); None: the candidates' mixture alone. ``stationary_nu``: its draws of nu,
-    which every model's f is conditioned on (the cut posterior, :mod:`.nu_cut`; the names are the joint fits');
-    None: f is each model's joint fit's.
+    is named (:mod:`.candidates_mixture`); None: the candidates' mixture alone. ``nu_cut``: every model's f from the
+    cut posterior, nu read from the record's stationary windows under the model (:mod:`.nu_cut`; the names are the
+    joint fits'); False: f is each model's joint fit's.
     """
     t0 = time.perf_counter()
     if workers is None:
         workers = min(MAX_WORKERS, os.cpu_count() or 1)
     say = progress or (lambda msg: None)
     dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales,
-                   nominal=start, nu_cut=None if stationary_nu is None else NuCut(stationary_nu))
+                   nominal=start, nu_cut=nu_cut)
     say(f"baseline (up to {max_causes} rounds of up to {len(candidates())} extended models follow)")
     base = dg.fit((), start, "baseline")
     st = _search(dg, prep, _Search(base, base), max_causes=max_causes, workers=workers, seed=seed, say=say, t0=t0)

@@ -36,7 +36,7 @@ from ..stats.streams import stream
 from .elpd import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
-from .nu_cut import CutFit, FixedNu, NuCut, conditional_fit, cut_draws
+from .nu_cut import CutFit, Fixed, NuCut, conditional_fit, cut_draws, window_nu
 
 #: Block of the leave-one-block-out ELPD (s).
 BLOCK = 10e-6
@@ -47,6 +47,8 @@ SAMPLE_MODULUS_SD_LOG = 0.1
 IMPORTANCE_DRAWS = 200
 #: Equal-weight draws of the exact (sandwich-adjusted) posterior kept for the named model.
 EXACT_DRAWS = 1000
+#: Draws of nu's normal approximation from the stationary windows (:func:`.nu_cut.window_nu`).
+NU_WINDOW_DRAWS = 2000
 
 
 @dataclass(frozen=True)
@@ -85,9 +87,9 @@ class Diagnoser:
 
     def __init__(self, prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], *, hoop: bool,
                  seed: int, n_draws: int = 60, base_scales: Mapping[str, tuple[float, float]] | None = None,
-                 nominal: Mapping[str, float] | None = None, nu_cut: NuCut | None = None) -> None:
+                 nominal: Mapping[str, float] | None = None, nu_cut: bool = False) -> None:
         self.prep = prep
-        #: the stationary draws of nu that a model's f is conditioned on (:mod:`.nu_cut`); None: the joint fit's f
+        #: a model's f from the cut posterior, nu from the record's stationary window (:mod:`.nu_cut`); else the joint fit's
         self.nu_cut = nu_cut
         rec = prep.record
         self.loading = measured_loading(rec, prep.forces)
@@ -161,20 +163,31 @@ class Diagnoser:
         elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z, block_of)
         elpd = with_calibration(elpd, self._calibration(lik, fit, unit, scales["sample_modulus"]))
         cut = None
-        if self.nu_cut is None:
+        if not self.nu_cut:
             f_eff = self._f_of(variants, fit.draws)
         else:
-            cut = conditional_fit(lik, log_prior, fit.mode, self.nu_cut, n_draws=self.n_draws,
-                                  rng=stream(self.seed, "nu cut", label), prior_scale=scales, score_blocks=block_of)
+            cut = self._cut(model, lik, log_prior, fit.mode, scales, block_of, label)
             params = [lik.model.parameters[n] for n in cut.fit.names]
             z = np.column_stack([np.asarray(p.to_unbounded(cut.fit.draws[p.name]), float) for p in params])
-            nu = self.nu_cut.sample(len(z), stream(self.seed, "nu cut draws", label))
+            nu = cut.nu.sample(len(z), stream(self.seed, "nu cut draws", label))
             draws = cut_draws(params, z, cut, nu)
             f_eff = self._f_of(variants, draws)
             # the draws are the cut posterior's (paired with f); the predictive keeps the joint fit's, as calibrated
             fit = replace(fit, draws=draws, laplace_draws=fit.laplace_draws or fit.draws)
         return ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd, f_effective=f_eff,
                         predicted={c: v[None] for c, v in pred.items()}, lik=lik, cut=cut)
+
+    def _cut(self, model: SimulatorModel, lik: WholeRecordLikelihood, log_prior, mode: Mapping[str, float],
+             scales: Mapping[str, tuple[float, float]], block_of: np.ndarray, label: str) -> CutFit:
+        """The cut posterior's fit (:mod:`.nu_cut`): theta at the stationary analysis' nu, nu from the windows under
+        that theta, then theta at the windows' nu."""
+        nu0 = float(self.nominal.get("nu", mode["nu"]))
+        first = conditional_fit(lik, log_prior, mode, NuCut(np.array([nu0, nu0])), n_draws=2,
+                                rng=stream(self.seed, "nu cut", label), prior_scale=scales, score_blocks=block_of)
+        nu_window = window_nu(self.prep, model, log_prior, first.fit.mode | {"nu": nu0}, n_draws=NU_WINDOW_DRAWS,
+                              rng=stream(self.seed, "nu window", label), prior_scale=scales)
+        return conditional_fit(lik, log_prior, first.fit.mode, nu_window, n_draws=self.n_draws,
+                               rng=stream(self.seed, "nu cut", label), prior_scale=scales, score_blocks=block_of)
 
     def _f_of(self, variants: tuple[Variant, ...], draws: Mapping[str, np.ndarray]) -> np.ndarray:
         """f_effective of each draw."""
@@ -204,7 +217,7 @@ class Diagnoser:
         ``workers``: processes sharing the density's evaluations (forked once; the draws do not depend on it).
         """
         fit = mf.fit if mf.cut is None else mf.cut.fit  # under the cut: theta's posterior at the stationary nu
-        lik = mf.lik if mf.cut is None else FixedNu(mf.lik, mf.cut.nu0)
+        lik = mf.lik if mf.cut is None else Fixed(mf.lik, {"nu": mf.cut.nu0})
         params = [mf.lik.model.parameters[name] for name in fit.names]
         mode = np.array([float(p.to_unbounded(fit.mode[p.name])) for p in params])
         cov = fit.cov_z if fit.cov_z is not None else np.eye(len(params)) * 1e-6
@@ -229,7 +242,7 @@ class Diagnoser:
         if mf.cut is None:
             draws = {p.name: np.asarray(p.from_unbounded(ex.z_adjusted[:, i]), float) for i, p in enumerate(params)}
         else:
-            nu = self.nu_cut.sample(EXACT_DRAWS, stream(self.seed, "nu cut exact", mf.label))
+            nu = mf.cut.nu.sample(EXACT_DRAWS, stream(self.seed, "nu cut exact", mf.label))
             draws = cut_draws(params, ex.z_adjusted, mf.cut, nu)
         f_eff = self._f_of(mf.variants, draws)
         new_fit = replace(mf.fit, draws=draws, log_weights=np.full(EXACT_DRAWS, -math.log(EXACT_DRAWS)),

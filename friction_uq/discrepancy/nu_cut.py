@@ -1,4 +1,4 @@
-"""f under a whole-record model with nu from the stationary analysis: the cut posterior.
+"""f under a whole-record model with nu from the record's stationary window: the cut posterior.
 
 A whole-record model reads nu from the record's dynamics as well as from the hoop gauge's level: the
 rises, the hoop's course around the window and its unloading all move with nu at a fixed confined modulus.
@@ -9,22 +9,24 @@ Those shapes are where a 1-D model and the real cell (or an axisymmetric simulat
 stationary analysis reads nu from the quasi-static relation of the hoop's level over the window to the
 axial stress alone, which two simulators of the test agree on.
 
-So the f a whole-record model gives is taken from the *cut* posterior (modular inference: the feedback of
-the misspecified module on a shared parameter is cut; Plummer 2015, Jacob et al. 2017):
+So the f a whole-record model gives is taken from a *cut* posterior (modular inference: the feedback of
+the misspecified part of a model on a shared parameter is cut; Plummer 2015, Jacob et al. 2017), in two modules:
 
-    p_cut(theta, nu) = p_stationary(nu | window) p(theta | nu, whole record),
+* nu from the quasi-static part of the record under the model: the same model's likelihood over every gauge's
+  stationary window alone (:func:`window_nu`), with f free beside nu (the output forces fix kappa, the hoop's
+  level with its 5 % calibration fixes nu) and the model's other parameters at the joint fit's mode (a
+  clearance's gap, a plug's friction: what changes the window's relation of the wall pressure to the axial
+  stress). The stationary analysis reads nu the same way but without the mechanism: a gap or a plug friction the
+  stationary model does not have puts its nu 0.01-0.14 off, which this module does not inherit;
+* theta, the model's other parameters (f, the sample's modulus, the mechanism's), from the whole record given nu
+  (:func:`conditional_fit`: the fit at nu fixed at that posterior's median nu_0 and its Laplace approximation); its
+  dependence on nu is the conditional mode's linear response, d theta / d nu = -(J^T J)^-1 J^T J_nu (Gauss-Newton
+  at the conditional mode, J_nu by a central difference; :func:`conditional_slope`).
 
-theta being the model's other parameters (f, the sample's modulus, the mechanism's). The second factor is
-the whole-record fit at nu fixed (:func:`conditional_fit`: its mode at the stationary median nu_0 and its
-Laplace approximation); its dependence on nu is the conditional mode's linear response,
-d theta / d nu = -(J_theta^T J_theta)^-1 J_theta^T J_nu (Gauss-Newton at the conditional mode, J_nu by a central
-difference; :func:`conditional_slope`). A draw is then nu from the stationary posterior's draws and theta
-from the conditional normal at nu_0, moved along the slope by nu - nu_0 (:func:`cut_draws`).
-
-What this changes is f's draws alone: the models' evidence (ELPD), the ranking, the names and the misfit
-decisions are the joint fit's, as they were calibrated (:mod:`.extended`). On records of the 1-D simulation
-with a hidden plug friction the stationary nu is itself 0.01-0.02 low (the stationary model has no plug);
-the cut then reads f a few % high with an interval widened by nu's own uncertainty (measured: docs/trust.md).
+A draw is nu from the first module's draws and theta from the conditional normal at nu_0, moved along the slope by
+nu - nu_0 (:func:`cut_draws`). What this changes is f's draws alone (and nu's, paired with them): the models'
+evidence (ELPD), the ranking, the names and the misfit decisions are the joint fit's, as they were calibrated
+(:mod:`.extended`).
 """
 
 from __future__ import annotations
@@ -34,49 +36,55 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis import Prepared
 from ..models.parameters import Parameter
+from ..models.simulator import SimulatorModel
 from .fit import LogPrior, WholeRecordFit, fit_whole_record
 from .record_likelihood import WholeRecordLikelihood
+from .whole_record import CHANNEL_LABELS
 
 #: Central-difference step of d(residual)/d nu (nu itself, not its unbounded coordinate).
 NU_STEP = 1e-3
+#: Prior sd (relative to the window's level) of the smooth bends of each gauge's course over its window that the
+#: first module marginalises (Legendre degrees 1 and 2): wide, so that the windows' levels alone inform nu and f.
+WINDOW_SHAPE_SD = 0.5
 
 
 @dataclass(frozen=True)
 class NuCut:
-    """The stationary analysis' draws of nu, which a whole-record model's f is conditioned on."""
+    """Draws of nu from the first module (:func:`window_nu`), which a whole-record model's f is conditioned on."""
 
     draws: np.ndarray
 
     def __post_init__(self) -> None:
         d = np.asarray(self.draws, float).ravel()
         if d.size < 2 or not np.all(np.isfinite(d)) or np.any((d <= 0.0) | (d >= 0.5)):
-            raise ValueError("the stationary draws of nu for the cut must be at least two, finite, in (0, 0.5)")
+            raise ValueError("the draws of nu for the cut must be at least two, finite, in (0, 0.5)")
         object.__setattr__(self, "draws", d)
 
     @property
     def centre(self) -> float:
-        """nu_0: the stationary posterior's median, where the conditional fit is made."""
+        """nu_0: the draws' median, where the conditional fit is made."""
         return float(np.median(self.draws))
 
     def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
-        """n draws of nu (with replacement: the stationary chain's draws are many more than a fit's)."""
+        """n draws of nu (with replacement)."""
         return rng.choice(self.draws, size=n, replace=True)
 
 
-class FixedNu:
-    """A whole-record likelihood with nu held at a value: what :func:`fit_whole_record` and the exact
+class Fixed:
+    """A whole-record likelihood with some parameters held at values: what :func:`fit_whole_record` and the exact
     posterior need of a likelihood (its model's parameters, whitened residuals, log-likelihood, size)."""
 
-    def __init__(self, lik: WholeRecordLikelihood, nu: float) -> None:
-        self.lik, self.nu = lik, float(nu)
+    def __init__(self, lik: WholeRecordLikelihood, values: Mapping[str, float]) -> None:
+        self.lik, self.values = lik, dict(values)
         self.model = lik.model
 
     def whitened(self, values: Mapping[str, float]) -> np.ndarray:
-        return self.lik.whitened(dict(values) | {"nu": self.nu})
+        return self.lik.whitened(self.values | dict(values))
 
     def loglike(self, values: Mapping[str, float]) -> float:
-        return self.lik.loglike(dict(values) | {"nu": self.nu})
+        return self.lik.loglike(self.values | dict(values))
 
     @property
     def n_samples(self) -> int:
@@ -90,19 +98,36 @@ class CutFit:
     fit: WholeRecordFit
     nu0: float
     slope: np.ndarray  # d z_theta / d nu, in the order of fit.names
+    nu: NuCut  # the first module's draws of nu
+
+
+def window_nu(prep: Prepared, model: SimulatorModel, log_prior: LogPrior, mode: Mapping[str, float], *,
+              n_draws: int, rng: np.random.Generator, prior_scale: Mapping[str, tuple[float, float]]) -> NuCut:
+    """nu's posterior from every gauge's stationary window under the model (module docstring): f and nu free, the
+    model's other parameters at ``mode`` (the joint fit's), the gauges' calibrations marginalised as over the
+    whole record; its normal approximation's draws."""
+    held = {k: v for k, v in mode.items() if k not in ("f", "nu", "hoop_gain")}
+    lik = WholeRecordLikelihood(prep, model, window_only=True,
+                                shape_sd={(c, "stationary"): WINDOW_SHAPE_SD for c in CHANNEL_LABELS})
+    fixed = Fixed(lik, held)
+    fit = fit_whole_record(fixed, lambda v: log_prior(held | dict(v)), {"f": mode["f"], "nu": mode["nu"]},
+                           n_draws=n_draws, rng=rng, importance=False,
+                           prior_scale={k: v for k, v in prior_scale.items() if k in ("f", "nu")})
+    return NuCut(fit.draws["nu"])
 
 
 def conditional_fit(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Mapping[str, float], cut: NuCut, *,
                     n_draws: int, rng: np.random.Generator, prior_scale: Mapping[str, tuple[float, float]],
                     score_blocks: np.ndarray) -> CutFit:
-    """The whole-record fit of theta at nu = nu_0 from ``start`` (the joint fit's mode) and its slope in nu."""
+    """The whole-record fit of theta at nu = nu_0 (``cut``'s median) from ``start`` (the joint fit's mode) and its
+    slope in nu."""
     nu0 = cut.centre
-    fixed = FixedNu(lik, nu0)
+    fixed = Fixed(lik, {"nu": nu0})
     st = {k: v for k, v in start.items() if k not in ("nu", "hoop_gain")}
     scales = {k: v for k, v in prior_scale.items() if k != "nu"}
     fit = fit_whole_record(fixed, lambda v: log_prior(dict(v) | {"nu": nu0}), st, n_draws=n_draws, rng=rng,
                            importance=False, prior_scale=scales, score_blocks=score_blocks)
-    return CutFit(fit=fit, nu0=nu0, slope=conditional_slope(lik, fit, nu0))
+    return CutFit(fit=fit, nu0=nu0, slope=conditional_slope(lik, fit, nu0), nu=cut)
 
 
 def conditional_slope(lik: WholeRecordLikelihood, fit: WholeRecordFit, nu0: float) -> np.ndarray:
@@ -120,7 +145,7 @@ def conditional_slope(lik: WholeRecordLikelihood, fit: WholeRecordFit, nu0: floa
 
 def cut_draws(params: list[Parameter], z: np.ndarray, cf: CutFit, nu: np.ndarray) -> dict[str, np.ndarray]:
     """Draws of every parameter under the cut: theta's conditional draws ``z`` (unbounded, at nu_0) moved along
-    the slope by nu - nu_0, beside the stationary draws ``nu`` (one per row of ``z``)."""
+    the slope by nu - nu_0, beside the first module's draws ``nu`` (one per row of ``z``)."""
     zs = z + np.outer(nu - cf.nu0, cf.slope)
     out = {p.name: np.asarray(p.from_unbounded(zs[:, i]), float) for i, p in enumerate(params)}
     out["nu"] = np.asarray(nu, float)

@@ -33,16 +33,16 @@ def whole_record_check(prep: Prepared, priors: Priors, start: Mapping[str, float
 
 def run_diagnose(prep: Prepared, priors: Priors, start: Mapping[str, float], *, hoop: bool, seed: int,
                  say: Callable[[str], None] = lambda msg: None, check: WholeRecordCheck | None = None,
-                 stationary_f: np.ndarray | None = None, stationary_nu: np.ndarray | None = None) -> Diagnosis:
+                 stationary_f: np.ndarray | None = None) -> Diagnosis:
     """:func:`.diagnose.diagnose` with the run's f and nu priors (and their Gaussian stand-ins for the
     mode search), started from the stationary posterior's medians; ``check``: the run's whole-record
     check, whose hoop reading the calibration finding compares with the final model's; ``stationary_f``: the
-    stationary posterior's draws of f (half of the f to quote when no cause is named); ``stationary_nu``: its draws
-    of nu, which every whole-record model's f is conditioned on (:mod:`.nu_cut`)."""
+    stationary posterior's draws of f (half of the f to quote when no cause is named). Every whole-record model's f
+    is the cut posterior's (:mod:`.nu_cut`)."""
     scales = {par.name: par.gaussian_stand_in(priors[par.name]) for par in (F, NU)}
     dg = diagnose(prep, f_nu_log_prior(priors), start, hoop=hoop and prep.record.has_hoop, seed=seed,
                   progress=lambda m: say(f"diagnose: {m}"), base_scales=scales, stationary_f=stationary_f,
-                  stationary_nu=stationary_nu)
+                  nu_cut=True)
     return dg if check is None else replace(dg, check_hoop_gain=check.hoop_gain)
 
 

@@ -76,11 +76,12 @@ class WholeRecordLikelihood:
 
     def __init__(self, prep: Prepared, model: SimulatorModel, *, hoop_gain_sd: float = HOOP_GAIN_SD,
                  phase_tolerance: Mapping[tuple[str, str], float] | None = None,
-                 shape_sd: Mapping[tuple[str, str], float] | None = None) -> None:
+                 shape_sd: Mapping[tuple[str, str], float] | None = None, window_only: bool = False) -> None:
         """``phase_tolerance``: the relative tolerance of a (channel, phase) where it is not the channel's
         (:data:`~.whole_record.TOLERANCE`); None: :data:`LIKELIHOOD_TOLERANCE`, {}: the channel's everywhere (the
         whole-record check's fit, as its decision was calibrated). ``shape_sd``: the phases with smooth shape terms
-        (:data:`SHAPE_SD`, the default when None; {}: none)."""
+        (:data:`SHAPE_SD`, the default when None; {}: none). ``window_only``: every gauge over its stationary window
+        alone (the quasi-static part of the record, :mod:`.nu_cut`'s module for nu)."""
         rec = prep.record
         self.phase_tolerance = LIKELIHOOD_TOLERANCE if phase_tolerance is None else phase_tolerance
         self.shape_sd = SHAPE_SD if shape_sd is None else shape_sd
@@ -92,6 +93,8 @@ class WholeRecordLikelihood:
         self.gain_sd = {c: sd for c, sd in (GAIN_SD | {"tube_hoop": hoop_gain_sd}).items()
                         if c in self.channels and sd > 0.0}
         self.bounds = channel_spans(prep, self.channels)
+        if window_only:
+            self.bounds = {c: (b[1], b[1], b[2], b[2]) for c, b in self.bounds.items()}
         self.noise = {c: channel_noise(prep, c) for c in self.channels}
         self.measured = {c: rec.strain(c) - prep.forces.channels[c].noise.offset for c in self.channels}
         self.weight: dict[str, np.ndarray] = {}  # sd / s_t over each span (module docstring)

@@ -193,7 +193,7 @@ def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck,
     say("diagnose: fitting each mechanism of the catalogue to the whole record")
     start = {"f": post.summary["f"].q50, "nu": post.summary["nu"].q50}
     diag = pipeline.run_diagnose(s.prepared, s.priors, start, hoop=s.use_hoop, seed=seed, say=say, check=wrc,
-                                 stationary_f=post.samples.flat("f"), stationary_nu=post.samples.flat("nu"))
+                                 stationary_f=post.samples.flat("f"))
     outcome.add_to_datatree(post.datatree, diag, s.priors["f"])
     return diag
 

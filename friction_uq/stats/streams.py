@@ -19,9 +19,10 @@ PURPOSES = {
     "exact posterior": 11,  # importance sampling / emcee behind the final model's Laplace fit
     "effective prior": 13,  # the prior of f_effective, computed by simulation when the draws are written
     "mixture": 14,  # the stacking mixture's draws of f when diagnose names no single cause (discrepancy.verdict)
-    "nu cut": 15,  # a model's conditional fit at the stationary nu (discrepancy.nu_cut)
-    "nu cut draws": 16,  # the stationary draws of nu paired with that fit's draws
-    "nu cut exact": 17,  # the stationary draws of nu paired with the exact posterior's draws
+    "nu cut": 15,  # a model's conditional fit at the windows' nu (discrepancy.nu_cut)
+    "nu cut draws": 16,  # the windows' draws of nu paired with that fit's draws
+    "nu cut exact": 17,  # the windows' draws of nu paired with the exact posterior's draws
+    "nu window": 18,  # nu's normal approximation from the stationary windows (discrepancy.nu_cut)
 }
 
 
