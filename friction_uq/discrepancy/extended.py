@@ -11,7 +11,8 @@ modulus), each left out in turn. The baseline is the same simulator without exte
 named from these scores is :mod:`.diagnose`'s rule.
 
 The headline f under an extended model is the wall's coefficient at the stationary window's mean
-sliding speed, pressure and slip (``f_effective`` of the mechanism), summarised over the draws.
+sliding speed, pressure and slip (``f_effective`` of the mechanism), summarised over the draws: with ``nu_cut``
+(as ``run`` has it) the cut posterior's, nu read from the stationary windows under the model (:mod:`.nu_cut`).
 """
 
 from __future__ import annotations

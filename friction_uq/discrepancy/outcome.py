@@ -103,7 +103,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "f_baseline_stationary": f_without,
         "f_baseline_whole_record": dg.baseline.f_summary(),
         "nu_extended": summarize_draws(dg.final.fit.draws["nu"]),
-        "nu_source": ("the stationary analysis' posterior (the cut: theta fitted to the whole record given nu)"
+        "nu_source": ("the stationary windows' levels under the model (the cut: theta fitted to the whole record "
+                      "given nu)"
                       if dg.final.cut is not None else "the whole-record fit"),
         "nu_whole_record": dg.final.fit.mode["nu"],
         "kappa_extended": summarize_draws(kappa_draws(dg.final)),

@@ -154,5 +154,5 @@ def _nu_source_line(dg) -> list[str]:
     """Where the models' nu comes from, and what the whole record alone reads (friction_uq.discrepancy.nu_cut)."""
     if dg.final.cut is None:
         return []
-    return [f"nu from the stationary analysis (the window's hoop level); the whole record's dynamics alone would read "
-            f"nu {dg.final.fit.mode['nu']:.3f} under this model"]
+    return [f"nu from the gauges' levels over the stationary window under this model; the whole record, its dynamics "
+            f"included, would read nu {dg.final.fit.mode['nu']:.3f}"]

@@ -55,7 +55,7 @@ def reproducible(dt):
 
 
 #: The run's JSON: its schema name and version (6: a diagnosed model's f and ``nu_extended`` are the cut posterior's,
-#: nu from the stationary analysis (``discrepancy.nu_source``), the whole record's own reading ``nu_whole_record``;
+#: nu from the stationary windows (``discrepancy.nu_source``), the whole record's own reading ``nu_whole_record``;
 #: 5: ``window_halves``, kappa's change across the window; 4: ``f``'s interval carries the output bars' calibration, the
 #: posterior's own is ``f.given_bar_headers``; 3: ``discrepancy.causes`` holds only the named causes, beside
 #: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
