@@ -182,12 +182,9 @@ class Diagnoser:
              scales: Mapping[str, tuple[float, float]], block_of: np.ndarray, label: str) -> CutFit:
         """The cut posterior's fit (:mod:`.nu_cut`): theta at the stationary analysis' nu, nu from the windows under
         that theta, then theta at the windows' nu."""
-        nu0 = float(self.nominal.get("nu", mode["nu"]))
-        first = conditional_fit(lik, log_prior, mode, NuCut(np.array([nu0, nu0])), n_draws=2,
-                                rng=stream(self.seed, "nu cut", label), prior_scale=scales, score_blocks=block_of)
-        nu_window = window_nu(self.prep, model, log_prior, first.fit.mode | {"nu": nu0}, n_draws=NU_WINDOW_DRAWS,
-                              rng=stream(self.seed, "nu window", label), prior_scale=scales)
-        return conditional_fit(lik, log_prior, first.fit.mode, nu_window, n_draws=self.n_draws,
+        nu_window = window_nu(self.prep, model, log_prior, dict(mode) | {"sample_modulus": self.E0},
+                              n_draws=NU_WINDOW_DRAWS, rng=stream(self.seed, "nu window", label), prior_scale=scales)
+        return conditional_fit(lik, log_prior, mode, nu_window, n_draws=self.n_draws,
                                rng=stream(self.seed, "nu cut", label), prior_scale=scales, score_blocks=block_of)
 
     def _f_of(self, variants: tuple[Variant, ...], draws: Mapping[str, np.ndarray]) -> np.ndarray:

@@ -106,13 +106,14 @@ def window_nu(prep: Prepared, model: SimulatorModel, log_prior: LogPrior, mode: 
     """nu's posterior from every gauge's stationary window under the model (module docstring): f and nu free, the
     model's other parameters at ``mode`` (the joint fit's), the gauges' calibrations marginalised as over the
     whole record; its normal approximation's draws."""
-    held = {k: v for k, v in mode.items() if k not in ("f", "nu", "hoop_gain")}
+    free = ("f", "nu", "sample_modulus")
+    held = {k: v for k, v in mode.items() if k not in free + ("hoop_gain",)}
     lik = WholeRecordLikelihood(prep, model, window_only=True,
                                 shape_sd={(c, "stationary"): WINDOW_SHAPE_SD for c in CHANNEL_LABELS})
     fixed = Fixed(lik, held)
-    fit = fit_whole_record(fixed, lambda v: log_prior(held | dict(v)), {"f": mode["f"], "nu": mode["nu"]},
+    fit = fit_whole_record(fixed, lambda v: log_prior(held | dict(v)), {k: mode[k] for k in free},
                            n_draws=n_draws, rng=rng, importance=False,
-                           prior_scale={k: v for k, v in prior_scale.items() if k in ("f", "nu")})
+                           prior_scale={k: v for k, v in prior_scale.items() if k in free})
     return NuCut(fit.draws["nu"])
 
 
