@@ -13,11 +13,12 @@ So the f a whole-record model gives is taken from a *cut* posterior (modular inf
 the misspecified part of a model on a shared parameter is cut; Plummer 2015, Jacob et al. 2017), in two modules:
 
 * nu from the quasi-static part of the record under the model: the same model's likelihood over every gauge's
-  stationary window alone (:func:`window_nu`), with f free beside nu (the output forces fix kappa, the hoop's
-  level with its 5 % calibration fixes nu) and the model's other parameters at the joint fit's mode (a
-  clearance's gap, a plug's friction: what changes the window's relation of the wall pressure to the axial
-  stress). The stationary analysis reads nu the same way but without the mechanism: a gap or a plug friction the
-  stationary model does not have puts its nu 0.01-0.14 off, which this module does not inherit;
+  stationary window alone, its slow bends there marginalised (:func:`window_nu`), with f and the sample's modulus
+  free beside nu (the output forces fix kappa, the hoop's level with its 5 % calibration fixes nu; the modulus
+  under its prior, for it is what the dynamics bend with nu) and the mechanism's parameters at the joint fit's
+  mode (a clearance's gap, a plug's friction: what changes the window's relation of the wall pressure to the axial
+  stress). The stationary analysis reads nu from the window too, but without the mechanism: a gap or end-face
+  friction the stationary model does not have puts its nu 0.03-0.14 off, which this module does not inherit;
 * theta, the model's other parameters (f, the sample's modulus, the mechanism's), from the whole record given nu
   (:func:`conditional_fit`: the fit at nu fixed at that posterior's median nu_0 and its Laplace approximation); its
   dependence on nu is the conditional mode's linear response, d theta / d nu = -(J^T J)^-1 J^T J_nu (Gauss-Newton
@@ -103,9 +104,9 @@ class CutFit:
 
 def window_nu(prep: Prepared, model: SimulatorModel, log_prior: LogPrior, mode: Mapping[str, float], *,
               n_draws: int, rng: np.random.Generator, prior_scale: Mapping[str, tuple[float, float]]) -> NuCut:
-    """nu's posterior from every gauge's stationary window under the model (module docstring): f and nu free, the
-    model's other parameters at ``mode`` (the joint fit's), the gauges' calibrations marginalised as over the
-    whole record; its normal approximation's draws."""
+    """nu's posterior from every gauge's stationary window under the model (module docstring): f, nu and the sample's
+    modulus free (from ``mode``'s values), the mechanism's parameters at ``mode`` (the joint fit's), the gauges'
+    calibrations and slow bends marginalised; its normal approximation's draws."""
     free = ("f", "nu", "sample_modulus")
     held = {k: v for k, v in mode.items() if k not in free + ("hoop_gain",)}
     lik = WholeRecordLikelihood(prep, model, window_only=True,
