@@ -37,7 +37,7 @@ from ..stats.streams import stream
 from .elpd import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
-from .nu_cut import CutFit, Fixed, NuCut, conditional_fit, cut_draws, window_nu
+from .nu_cut import CutFit, Fixed, conditional_fit, window_nu
 
 #: Block of the leave-one-block-out ELPD (s).
 BLOCK = 10e-6
@@ -76,7 +76,7 @@ class ModelFit:
     f_effective: np.ndarray
     predicted: dict[str, np.ndarray]
     lik: WholeRecordLikelihood | None = None
-    #: the fit at the stationary nu, when f is the cut posterior's (:mod:`.nu_cut`); None: f is the joint fit's
+    #: the fit at the windows' nu, when f is the cut posterior's (:mod:`.nu_cut`); None: f is the joint fit's
     cut: CutFit | None = None
 
     def f_summary(self) -> dict[str, float]:
@@ -170,8 +170,7 @@ class Diagnoser:
             cut = self._cut(model, lik, log_prior, fit.mode, scales, block_of, label)
             params = [lik.model.parameters[n] for n in cut.fit.names]
             z = np.column_stack([np.asarray(p.to_unbounded(cut.fit.draws[p.name]), float) for p in params])
-            nu = cut.nu.sample(len(z), stream(self.seed, "nu cut draws", label))
-            draws = cut_draws(params, z, cut, nu)
+            draws = cut.draws(params, z, stream(self.seed, "nu cut draws", label))
             f_eff = self._f_of(variants, draws)
             # the draws are the cut posterior's (paired with f); the predictive keeps the joint fit's, as calibrated
             fit = replace(fit, draws=draws, laplace_draws=fit.laplace_draws or fit.draws)
@@ -180,8 +179,8 @@ class Diagnoser:
 
     def _cut(self, model: SimulatorModel, lik: WholeRecordLikelihood, log_prior, mode: Mapping[str, float],
              scales: Mapping[str, tuple[float, float]], block_of: np.ndarray, label: str) -> CutFit:
-        """The cut posterior's fit (:mod:`.nu_cut`): theta at the stationary analysis' nu, nu from the windows under
-        that theta, then theta at the windows' nu."""
+        """The cut posterior's fit (:mod:`.nu_cut`): nu from the stationary windows under the joint fit's mechanism
+        parameters (the sample's modulus from its header's, free), then theta at that nu."""
         nu_window = window_nu(self.prep, model, log_prior, dict(mode) | {"sample_modulus": self.E0},
                               n_draws=NU_WINDOW_DRAWS, rng=stream(self.seed, "nu window", label), prior_scale=scales)
         return conditional_fit(lik, log_prior, mode, nu_window, n_draws=self.n_draws,
@@ -211,10 +210,10 @@ class Diagnoser:
         was from it; beyond the limit a second proposal or emcee samples it. The exact draws are then
         given the robust covariance by the open-faced sandwich adjustment, which keeps their shape. The
         returned model's draws and f_effective are these; its mode, ELPD and predictions are unchanged. Under the
-        cut (:mod:`.nu_cut`) it is theta's posterior at the stationary nu that is made exact, then moved with nu.
+        cut (:mod:`.nu_cut`) it is theta's posterior at the windows' nu that is made exact, then moved with nu.
         ``workers``: processes sharing the density's evaluations (forked once; the draws do not depend on it).
         """
-        fit = mf.fit if mf.cut is None else mf.cut.fit  # under the cut: theta's posterior at the stationary nu
+        fit = mf.fit if mf.cut is None else mf.cut.fit  # under the cut: theta's posterior at the windows' nu
         lik = mf.lik if mf.cut is None else Fixed(mf.lik, {"nu": mf.cut.nu0})
         params = [mf.lik.model.parameters[name] for name in fit.names]
         mode = np.array([float(p.to_unbounded(fit.mode[p.name])) for p in params])
@@ -240,8 +239,7 @@ class Diagnoser:
         if mf.cut is None:
             draws = {p.name: np.asarray(p.from_unbounded(ex.z_adjusted[:, i]), float) for i, p in enumerate(params)}
         else:
-            nu = mf.cut.nu.sample(EXACT_DRAWS, stream(self.seed, "nu cut exact", mf.label))
-            draws = cut_draws(params, ex.z_adjusted, mf.cut, nu)
+            draws = mf.cut.draws(params, ex.z_adjusted, stream(self.seed, "nu cut exact", mf.label))
         f_eff = self._f_of(mf.variants, draws)
         new_fit = replace(mf.fit, draws=draws, log_weights=np.full(EXACT_DRAWS, -math.log(EXACT_DRAWS)),
                           pareto_k=ex.pareto_k, laplace_draws=mf.fit.laplace_draws or mf.fit.draws)

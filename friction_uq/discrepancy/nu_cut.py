@@ -101,6 +101,10 @@ class CutFit:
     slope: np.ndarray  # d z_theta / d nu, in the order of fit.names
     nu: NuCut  # the first module's draws of nu
 
+    def draws(self, params: list[Parameter], z: np.ndarray, rng: np.random.Generator) -> dict[str, np.ndarray]:
+        """:func:`cut_draws` of theta's conditional draws ``z`` with as many draws of nu, taken from ``rng``."""
+        return cut_draws(params, z, self, self.nu.sample(len(z), rng))
+
 
 def window_nu(prep: Prepared, model: SimulatorModel, log_prior: LogPrior, mode: Mapping[str, float], *,
               n_draws: int, rng: np.random.Generator, prior_scale: Mapping[str, tuple[float, float]]) -> NuCut:
