@@ -28,6 +28,7 @@ def _verdict(ca) -> tuple:
             tuple(sorted({str(f["setup"]) for f in ca.flagged if "setup" in f})))
 
 
+@pytest.mark.long
 @pytest.mark.slow  # five campaigns of the ten bundled records without PDF reports, about 6.5 minutes on 2 cores
 def test_the_bundled_campaign_gives_one_verdict_over_five_seeds(tmp_path):
     """The laws' fits are sampled in coordinates where their autocorrelation time is tens of steps
@@ -69,6 +70,7 @@ def _two_setups(seed: int) -> list[RecordPosterior]:
     return tests
 
 
+@pytest.mark.long
 @pytest.mark.slow  # five law comparisons of ten tests, about 3 minutes
 def test_a_two_setup_campaign_gives_one_verdict_over_five_seeds():
     verdicts = [_verdict(analyse_tests(_two_setups(seed), tally_causes([]), seed=seed)) for seed in range(1, 6)]
