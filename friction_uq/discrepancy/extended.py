@@ -179,8 +179,8 @@ class Diagnoser:
 
     def _cut(self, model: SimulatorModel, lik: WholeRecordLikelihood, log_prior, mode: Mapping[str, float],
              scales: Mapping[str, tuple[float, float]], block_of: np.ndarray, label: str) -> CutFit:
-        """The cut posterior's fit (:mod:`.nu_cut`): nu from the stationary windows, every parameter free under its
-        prior (the search from the joint fit's mode, the sample's modulus from its header's), then theta at that nu."""
+        """The cut posterior's fit (:mod:`.nu_cut`): nu from the stationary windows under the joint fit's mechanism
+        parameters (the sample's modulus from its header's, free), then theta at that nu."""
         nu_window = window_nu(self.prep, model, log_prior, dict(mode) | {"sample_modulus": self.E0},
                               n_draws=NU_WINDOW_DRAWS, rng=stream(self.seed, "nu window", label), prior_scale=scales)
         return conditional_fit(lik, log_prior, mode, nu_window, n_draws=self.n_draws,
