@@ -458,6 +458,32 @@ def test_a_misfit_left_after_the_named_causes_is_said():
     assert _remaining(SimpleNamespace(verdicts=(left,), misfits=misfits[:1])) == ""  # no cause named before it
 
 
+@pytest.mark.parametrize("after, order", [
+    ((0.045, 0.0405), "named"),  # f 0.050 -> 0.045 -> 0.0405: shifts 0.005 and 0.0045, within f's sd (0.001)
+    ((0.048, 0.043), "by shift"),  # shifts 0.002 and 0.005: the second cause moves f most
+    ((0.045, 0.050), "named"),  # 0.005 either way: a tie, however the sampler's bits fall
+])
+def test_the_causes_are_said_by_how_much_each_moves_f_only_when_the_shifts_differ_by_more_than_fs_sd(after, order):
+    """The sentence lists the causes the one that moves f most first; shifts of f that differ by less than the
+    final model's posterior sd of f say nothing about which matters more, and the causes then keep the order they
+    were named in, the sentence saying so (a tie's order would otherwise follow the sampler's bits)."""
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.diagnosis_words import ordered_steps
+
+    first, second = object(), object()
+    fit = lambda v, f: SimpleNamespace(fit=SimpleNamespace(variants=(v,), f_effective=np.full(9, f)))
+    final_f = np.random.default_rng(0).normal(after[1], 0.001, 4000)
+    dg = SimpleNamespace(baseline=SimpleNamespace(f_effective=np.full(9, 0.050)), causes=(first, second),
+                         rounds=((fit(first, after[0]),), (fit(second, after[1]),)),
+                         final=SimpleNamespace(f_effective=final_f))
+    steps, words = ordered_steps(dg)
+    if order == "named":
+        assert [s[0] for s in steps] == [first, second] and words.startswith("in the order named"), words
+    else:
+        assert [s[0] for s in steps] == [second, first] and words == "the one that moves f most first"
+
+
 def test_the_last_rounds_weight_on_further_mechanisms_gives_f_their_mixture():
     """After a named cause, a last round that names nothing but puts its stacking weight on further mechanisms
     (B-05: the plug friction and the velocity weakening it hides, each failing the spread test): f is the mixture

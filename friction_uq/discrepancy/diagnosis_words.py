@@ -62,6 +62,18 @@ def f_steps(dg: Diagnosis) -> list[tuple[Variant, float, float]]:
     return out
 
 
+def ordered_steps(dg: Diagnosis) -> tuple[list[tuple[Variant, float, float]], str]:
+    """The named causes' steps of f (:func:`f_steps`), the one that moves f most first, and how the sentence says
+    the order: when the shifts of f differ by no more than the final model's posterior sd of f, the order says
+    nothing about which matters more (a tie would be broken by the sampler's bits), and the causes keep the order
+    they were named in."""
+    steps = f_steps(dg)
+    shifts = [abs(b - a) for _, a, b in steps]
+    if len(steps) > 1 and max(shifts) - min(shifts) <= float(np.std(dg.final.f_effective)):
+        return steps, "in the order named (their shifts of f differ by less than f's posterior sd)"
+    return sorted(steps, key=lambda s: -abs(s[2] - s[1])), "the one that moves f most first"
+
+
 def chain_gauge(v: Variant, dg: Diagnosis | None) -> tuple[str, Parameter, float] | None:
     """For a measurement-chain fault fitted on every gauge (``per_gauge``): the gauge it names, the parameter and
     its posterior median, from the final model's draws when it holds the fault (else the round's fit)."""
@@ -103,7 +115,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
                 f"{dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f} "
                 f"nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
                 f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
-    steps = sorted(f_steps(dg), key=lambda s: -abs(s[2] - s[1]))
+    steps, order = ordered_steps(dg)
     fitted = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
     named = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in dg.named_causes)
     spare = _superfluous(dg)
@@ -118,7 +130,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in open_)
         rivals = ", ".join(dg.open_candidates)
         if named:
-            lead = (f"Causes found, the one that moves f most first: {named}{gauges}. A further cause this record "
+            lead = (f"Causes found, {order}: {named}{gauges}. A further cause this record "
                     f"does not tell apart: {rivals} (fitted in turn: {turn}).{spare}")
         else:
             lead = ("Candidates, not a cause: this record does not tell apart "
@@ -127,7 +139,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         evidence = "first cause" if named else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     elif more := further(dg):  # the last round's weight lies on further mechanisms it did not name: their mixture
-        lead = f"Causes found, the one that moves f most first: {named}{gauges}.{spare}"
+        lead = f"Causes found, {order}: {named}{gauges}.{spare}"
         shares = ", ".join(f"{'them' if k == dg.final.label else '+ ' + more[k]} {100 * w:.0f} %"
                            for k, w in dg.mixture_weights.items())
         with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
@@ -137,7 +149,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
     else:
-        lead = f"Causes found, the one that moves f most first: {named}{gauges}.{spare}"
+        lead = f"Causes found, {order}: {named}{gauges}.{spare}"
         quote = "with them (the f to quote)" if dg.mixture_of != "superfluous" else (
             f"from the {mixture_label(dg)}: the model with every mechanism fitted and the same without the one not "
             "named, weighted by how well each predicts the record (the f to quote)")
