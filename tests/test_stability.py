@@ -20,7 +20,8 @@ from bench_stability import diagnose_once, verdict_of  # noqa: E402
 DATA = Path(__file__).resolve().parents[1] / "data"
 
 
-@pytest.mark.slow  # five whole diagnoses, 3-4 min on 2 cores
+@pytest.mark.slow  # five whole diagnoses, 10 min on 2 cores (602 s, stop 52): long, run by hand with -m long
+@pytest.mark.long
 def test_five_seeds_name_the_same_causes_on_a_bundled_record(tmp_path):
     runs = []
     for seed in range(1, 6):
