@@ -23,7 +23,6 @@ import os
 import re
 import sys
 
-
 import numpy as np
 import pytest
 

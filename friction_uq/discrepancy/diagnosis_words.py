@@ -71,7 +71,8 @@ def ordered_steps(dg: Diagnosis) -> tuple[list[tuple[Variant, float, float]], st
     shifts = [abs(b - a) for _, a, b in steps]
     if len(steps) > 1 and max(shifts) - min(shifts) <= float(np.std(dg.final.f_effective)):
         return steps, "in the order named (their shifts of f differ by less than f's posterior sd)"
-    return sorted(steps, key=lambda s: -abs(s[2] - s[1])), "the one that moves f most first"
+    by_shift = sorted(range(len(steps)), key=lambda k: -shifts[k])
+    return [steps[k] for k in by_shift], "the one that moves f most first"
 
 
 def chain_gauge(v: Variant, dg: Diagnosis | None) -> tuple[str, Parameter, float] | None:
