@@ -4,8 +4,9 @@ Dask's nanny ("Worker process still alive after 4.0 seconds, killing"), numba's,
 matplotlib's warnings mean something to a developer, not to the person reading the run's result:
 while a command works, Python warnings and the log records of the libraries named in
 :data:`LIBRARIES` are kept and, when the command ends, appended to ``<out>/friction-uq.log`` (only
-when there is one to write, and only into an output folder that exists: a refused command leaves
-nothing behind). The terminal keeps the tool's own lines.
+when there is one to write, only into an output folder that exists, and only when the command ended without an
+error: a refused or failed command leaves nothing behind, not even in a folder that was there before). The terminal
+keeps the tool's own lines.
 """
 
 from __future__ import annotations
@@ -66,16 +67,19 @@ def libraries_to_log(out_dir: str | os.PathLike[str]) -> Iterator[None]:
     capture = logging.getLogger("py.warnings")
     capture.setLevel(logging.WARNING)
     logging.captureWarnings(True)
+    ended = False
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
             yield
+        ended = True
     finally:
         _ACTIVE.remove(handler)
         logging.captureWarnings(False)
         for lg, handlers, propagate in saved:
             lg.handlers, lg.propagate = handlers, propagate
-        _append(out_dir, handler.lines)
+        if ended:  # a command that failed leaves nothing behind (its one sentence is the message)
+            _append(out_dir, handler.lines)
 
 
 def _append(out_dir: str | os.PathLike[str], lines: list[str]) -> None:

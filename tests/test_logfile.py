@@ -32,6 +32,18 @@ def test_nothing_is_written_without_a_message_or_without_the_folder(tmp_path):
     assert not missing.exists()  # a refused command leaves nothing behind
 
 
+def test_a_command_that_fails_writes_no_log_even_into_a_folder_that_was_there(tmp_path):
+    # a library's message during a run that then fails (a forked worker's warning, say): the folder stays as it was
+    try:
+        with libraries_to_log(tmp_path):
+            warnings.warn("This process is multi-threaded, use of fork() may lead to deadlocks", DeprecationWarning,
+                          stacklevel=1)
+            raise ValueError("the run failed")
+    except ValueError:
+        pass
+    assert not any(tmp_path.iterdir())
+
+
 def test_a_library_that_installs_its_handlers_later_is_rerouted(tmp_path, capsys):
     from friction_uq._logfile import reroute
 
