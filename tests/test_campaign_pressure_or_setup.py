@@ -1,11 +1,13 @@
 """Two set-ups at different pressures: a pressure term and an offset of one set-up are told apart only by the
 pressures within each set-up (friction_uq.campaign.analysis, ``_Laws.offset_alternative``). A velocity-weakening
 wall whose second set-up reads 20 % high (a plug friction the stationary analysis cannot see) is not a pressure
-law; a pressure law measured without an offset is not a set-up flag."""
+law; a pressure law measured without an offset is not a set-up flag. The three campaigns' sampled law comparisons
+are slow studies (-m slow); the rule that reads them is tested here on fixed densities in the default suite."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from friction_uq.campaign.analysis import RecordPosterior, analyse_tests, supported_laws
 from friction_uq.priors import PRIORS_DIR
@@ -35,6 +37,7 @@ def _tests(f_of, offset_b: float, *, p_with_v: bool, seed: int = 7) -> list[Reco
     return tests
 
 
+@pytest.mark.slow  # ten tests' law comparison, every law and offset sampled: 30-50 s each on 2 cores
 def test_a_set_up_reading_high_is_flagged_where_pressure_varies_within_each_set_up():
     ca = analyse_tests(_tests(lambda V, p: 0.035 + 0.040 * np.exp(-V / 8.0), 0.20, p_with_v=False), {}, seed=2)
     assert [f["setup"] for f in ca.flagged if "setup" in f] == ["B"]
@@ -50,6 +53,7 @@ def test_a_set_up_reading_high_is_flagged_where_pressure_varies_within_each_set_
     assert 0.10 < flag["offset"]["q50"] < 0.30  # B's departure, measured
 
 
+@pytest.mark.slow  # ten tests' law comparison, every law and offset sampled: 30-50 s each on 2 cores
 def test_where_pressure_goes_with_speed_in_each_set_up_the_two_readings_are_both_said():
     """Within each set-up p grows with V: a pressure term on a velocity law mimics B's 20 %: on these ten tests
     velocity + offset B and pressure+velocity predict alike (within 4 nats), so the campaign does not flag B nor
@@ -65,6 +69,7 @@ def test_where_pressure_goes_with_speed_in_each_set_up_the_two_readings_are_both
     assert said and "velocity + offset B" in said[0]
 
 
+@pytest.mark.slow  # ten tests' law comparison, every law and offset sampled: 30-50 s each on 2 cores
 def test_a_pressure_law_without_an_offset_flags_no_set_up():
     ca = analyse_tests(_tests(lambda V, p: 0.05 * (1.0 + 0.5 * (p - 1.1e8) / 1.1e8), 0.0, p_with_v=False), {}, seed=2)
     assert not [f for f in ca.flagged if "setup" in f]
