@@ -409,6 +409,7 @@ def test_the_kernel_likelihood_keeps_a_skewed_posterior_that_its_mean_and_sd_mis
     assert np.max(np.abs(fit_normal.pointwise(x)[:, 0] - exact)) > 0.5
 
 
+@pytest.mark.slow  # a law comparison with and without each set-up's offset: 40 s on 2 cores
 def test_a_diagnosed_campaign_flags_the_setup_whose_stationary_analysis_is_off_and_names_the_cause():
     """Two set-ups under one velocity law. B's stationary kappa reads 20 % high (a plug friction on its
     output bar) and its diagnosis named plug friction, which A's never did; under the diagnosed models

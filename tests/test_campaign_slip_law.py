@@ -84,6 +84,7 @@ def test_the_change_across_each_window_separates_slip_from_velocity(law, seed, t
     assert pdf.read_bytes()[:4] == b"%PDF"
 
 
+@pytest.mark.slow  # a six-test law comparison, every law sampled: 40-60 s on 2 cores
 def test_without_the_windows_changes_the_slip_law_is_left_out_and_said():
     rng = np.random.default_rng(7)
     tests = [_test(rng, f"{s}-0{k + 1}", s, V, f_velocity) for s in ("A", "B") for k, V in enumerate((7.0, 10.0, 13.0))]
