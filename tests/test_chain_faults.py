@@ -107,7 +107,7 @@ def test_candidates_a_record_does_not_tell_apart_are_said_as_candidates_not_caus
     assert doc["causes"] == [] and doc["cause"] is None and doc["open_candidates"][0] == doc["fitted_in_turn"][0]
     assert doc["verdict"] == "candidates" and doc["mixture"] is not None
     assert doc["sentence"].startswith("Candidates, not a cause: this record does not tell apart ")
-    assert "Causes found" not in doc["sentence"]
+    assert "Causes found" not in doc["sentence"] and "Cause found" not in doc["sentence"]
     from friction_uq.report.quote import quote_line
 
     line = quote_line({"q05": 0.106, "q50": 0.114, "q95": 0.122}, dg)

@@ -75,6 +75,13 @@ def ordered_steps(dg: Diagnosis) -> tuple[list[tuple[Variant, float, float]], st
     return [steps[k] for k in by_shift], "the one that moves f most first"
 
 
+def found(order: str, steps: list[tuple[Variant, float, float]], dg: Diagnosis) -> str:
+    """The sentence's opening on the named causes: "Cause found:" for one (an order says nothing then), else
+    "Causes found, <order>:" (:func:`ordered_steps`)."""
+    n = sum(v in dg.named_causes for v, _, _ in steps)
+    return "Cause found:" if n == 1 else f"Causes found, {order}:"
+
+
 def chain_gauge(v: Variant, dg: Diagnosis | None) -> tuple[str, Parameter, float] | None:
     """For a measurement-chain fault fitted on every gauge (``per_gauge``): the gauge it names, the parameter and
     its posterior median, from the final model's draws when it holds the fault (else the round's fit)."""
@@ -131,7 +138,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in open_)
         rivals = ", ".join(dg.open_candidates)
         if named:
-            lead = (f"Causes found, {order}: {named}{gauges}. A further cause this record "
+            lead = (f"{found(order, steps, dg)} {named}{gauges}. A further cause this record "
                     f"does not tell apart: {rivals} (fitted in turn: {turn}).{spare}")
         else:
             lead = ("Candidates, not a cause: this record does not tell apart "
@@ -140,7 +147,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         evidence = "first cause" if named else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     elif more := further(dg):  # the last round's weight lies on further mechanisms it did not name: their mixture
-        lead = f"Causes found, {order}: {named}{gauges}.{spare}"
+        lead = f"{found(order, steps, dg)} {named}{gauges}.{spare}"
         shares = ", ".join(f"{'them' if k == dg.final.label else '+ ' + more[k]} {100 * w:.0f} %"
                            for k, w in dg.mixture_weights.items())
         with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
@@ -150,7 +157,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
     else:
-        lead = f"Causes found, {order}: {named}{gauges}.{spare}"
+        lead = f"{found(order, steps, dg)} {named}{gauges}.{spare}"
         quote = "with them (the f to quote)" if dg.mixture_of != "superfluous" else (
             f"from the {mixture_label(dg)}: the model with every mechanism fitted and the same without the one not "
             "named, weighted by how well each predicts the record (the f to quote)")
