@@ -124,6 +124,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
                 f"nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
                 f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     steps, order = ordered_steps(dg)
+    opening = found(order, steps, dg)
     fitted = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
     named = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in dg.named_causes)
     spare = _superfluous(dg)
@@ -138,7 +139,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         turn = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in open_)
         rivals = ", ".join(dg.open_candidates)
         if named:
-            lead = (f"{found(order, steps, dg)} {named}{gauges}. A further cause this record "
+            lead = (f"{opening} {named}{gauges}. A further cause this record "
                     f"does not tell apart: {rivals} (fitted in turn: {turn}).{spare}")
         else:
             lead = ("Candidates, not a cause: this record does not tell apart "
@@ -147,7 +148,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         evidence = "first cause" if named else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     elif more := further(dg):  # the last round's weight lies on further mechanisms it did not name: their mixture
-        lead = f"{found(order, steps, dg)} {named}{gauges}.{spare}"
+        lead = f"{opening} {named}{gauges}.{spare}"
         shares = ", ".join(f"{'them' if k == dg.final.label else '+ ' + more[k]} {100 * w:.0f} %"
                            for k, w in dg.mixture_weights.items())
         with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
@@ -157,7 +158,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
     else:
-        lead = f"{found(order, steps, dg)} {named}{gauges}.{spare}"
+        lead = f"{opening} {named}{gauges}.{spare}"
         quote = "with them (the f to quote)" if dg.mixture_of != "superfluous" else (
             f"from the {mixture_label(dg)}: the model with every mechanism fitted and the same without the one not "
             "named, weighted by how well each predicts the record (the f to quote)")
