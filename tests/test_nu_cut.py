@@ -77,6 +77,27 @@ def test_under_the_cut_the_evidence_is_the_joint_fits_and_f_moves_with_the_windo
     assert lo < TRUE_F < hi
 
 
+def test_a_cut_left_for_later_gives_the_same_bits_as_one_made_with_the_fit(record):
+    # diagnose makes the cut only for the models whose f it reports: made later from the kept fit, it must be the
+    # same posterior (its streams are the model's label's), and the joint fit's f is said until then
+    prep, log_prior, scales = record
+    start = {"f": TRUE_F, "nu": TRUE_NU}
+    jobs = [((), start, "baseline")]
+    now = Diagnoser(prep, log_prior, hoop=True, seed=5, n_draws=50, base_scales=scales, nu_cut=True)
+    later = Diagnoser(prep, log_prior, hoop=True, seed=5, n_draws=50, base_scales=scales, nu_cut=True)
+    made = now.fit_many(jobs)[0]
+    left = later.fit_many(jobs, cut=False)[0]
+    assert made.f_from == "cut posterior" and left.f_from == "whole-record fit" and left.cut is None
+    assert later.known(left) is left  # nothing is fitted by asking what is known
+    done = later.resolved(left)
+    assert later.resolved(left) is done and later.known(left) is done  # made once
+    assert done.elpd.total == left.elpd.total == made.elpd.total
+    np.testing.assert_array_equal(done.f_effective, made.f_effective)
+    for name, draws in made.fit.draws.items():
+        np.testing.assert_array_equal(done.fit.draws[name], draws)
+    assert not np.array_equal(left.f_effective, done.f_effective)
+
+
 def test_the_window_likelihood_reads_each_gauge_over_its_stationary_window_alone(record):
     from friction_uq.discrepancy.record_likelihood import WholeRecordLikelihood
 

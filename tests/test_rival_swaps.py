@@ -119,6 +119,11 @@ def test_the_weight_never_rules_out_a_model_among_those_that_carry_90_percent_of
     assert rule.ruling(a, b, weight=0.05, drop=drop, carried=True) is None
 
 
+def _as_is(model):
+    """The model as fitted (no cut posterior): what ``_mixture_after_causes`` draws f from here."""
+    return model
+
+
 class _Fitter:
     """Stands in for the Diagnoser: each swapped model's pointwise ELPD given by the rival it holds."""
 
@@ -126,7 +131,8 @@ class _Fitter:
         self.blocks = blocks
         self.asked = []
 
-    def fit_many(self, jobs, workers):
+    def fit_many(self, jobs, workers, cut=True):
+        assert not cut  # the swaps' models are judged on their evidence; the cut waits for a mixture that reports f
         self.asked += [label for _, _, label in jobs]
         return [_fit(label, self.blocks[label.split("+")[0]]) for _, _, label in jobs]
 
@@ -264,8 +270,15 @@ def test_a_candidate_whose_rivals_later_rounds_all_named_must_still_earn_its_pla
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
     # f is then the stacking mixture of the final model and the model without the candidate, both with the clearance
     final.f_effective = np.full(50, 0.04)  # the final model's f apart from the model without the candidate's 0.05
-    x, w, _, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None)
+    asked = []
+
+    def resolve(model):  # the cut posterior is asked of the members whose f the mixture draws from, and only of them
+        asked.append(model.label)
+        return model
+
+    x, w, _, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None, resolve)
     assert kind == "superfluous" and list(w) == [final.label, "clearance"] and abs(sum(w.values()) - 1.0) < 1e-9
+    assert asked == ["clearance"]  # the final model has its own already
     assert set(np.unique(x)) <= {0.04, 0.05}  # drawn from these two models only, in their weights' shares
     assert abs(np.mean(x == 0.05) - w["clearance"]) <= 1.0 / len(x)
     # a round whose rival stays open gives f from that round's rivals, as before the check was asked of it
@@ -273,7 +286,7 @@ def test_a_candidate_whose_rivals_later_rounds_all_named_must_still_earn_its_pla
     out, swaps, checked = check_swaps(_Fitter({"clearance": alike, "bandwidth": good - 1.0}), final, causes,
                                       verdicts, rounds, rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
     assert out[0].superfluous and open_rounds(causes, out) == (0,)
-    assert _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None)[3] == "rivals"
+    assert _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None, _as_is)[3] == "rivals"
     # the last cause's round is not asked, whether its rivals were named or not
     causes, verdicts, rounds, _ = _record(first_rivals=("clearance",))
     last = [replace(verdicts[0], kind="named", rivals=()), replace(verdicts[1], kind="candidates", rivals=())]
@@ -320,7 +333,7 @@ def test_a_superfluous_candidate_in_the_sentence_the_f_to_quote_and_the_warning(
                                       rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: False)
     final.f_effective, final.predicted = np.full(50, 0.04), {}
     rounds = [tuple(SimpleNamespace(fit=r.fit, delpd=100.0, se=10.0) for r in rnd) for rnd in rounds]
-    mix, w, src, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None)
+    mix, w, src, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None, _as_is)
     worst = SimpleNamespace(channel="tube_hoop", level=-5.0, relative_level=-0.06, phase="unloading")
     dg = Diagnosis(baseline=SimpleNamespace(f_effective=np.full(50, 0.06), label="baseline", variants=()),
                    rounds=tuple(rounds), misfits=(), causes=tuple(causes), not_separable=(), separate_by=None,
@@ -345,7 +358,7 @@ def test_a_superfluous_candidate_in_the_sentence_the_f_to_quote_and_the_warning(
                                       rounds, rule=NamingRule(), workers=1, seed=0, flagged=lambda fit: True)
     final.f_effective, final.predicted = np.full(50, 0.04), {}
     rounds = [tuple(SimpleNamespace(fit=r.fit, delpd=100.0, se=10.0) for r in rnd) for rnd in rounds]
-    mix, w, src, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None)
+    mix, w, src, kind = _mixture_after_causes(final, rounds, out, causes, swaps, checked, 0, None, _as_is)
     dg = replace(dg, rounds=tuple(rounds), causes=tuple(causes), final=final, verdicts=tuple(out), swaps=swaps,
                  swap_models=checked, mixture_f=mix, mixture_weights=w, mixture_source=src, mixture_of=kind)
     said = sentence(dg, {"q05": 0.055, "q50": 0.060, "q95": 0.065})

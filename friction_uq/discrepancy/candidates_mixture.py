@@ -23,7 +23,7 @@ the stationary analysis' draws for one half, the stacking mixture of the candida
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -37,6 +37,14 @@ MIXTURE_DRAWS = 1000
 STATIONARY = "stationary"
 #: Its share of the f to quote when no cause is named: the two analyses in equal parts (module docstring).
 STATIONARY_SHARE = 0.5
+
+#: A mixture member's model with its f as reported (``Diagnoser.resolved``: the cut posterior's under ``nu_cut``).
+Resolve = Callable[[ModelFit], ModelFit]
+
+
+def _as_fitted(mf: ModelFit) -> ModelFit:
+    """The model as fitted (no cut is made)."""
+    return mf
 
 
 def unresolved_rounds(causes, verdicts) -> tuple[int, ...]:
@@ -71,17 +79,18 @@ def named_causes(causes, verdicts) -> list:
 
 
 def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant], seed: int,
-                  stationary_f: np.ndarray | None = None) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+                  stationary_f: np.ndarray | None = None, resolve: Resolve = _as_fitted
+                  ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
     is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
     fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved.
     ``stationary_f``: the stationary analysis' draws, given half the weight when the record names no cause
-    (module docstring)."""
+    (module docstring). ``resolve``: a member's model with its f as reported (``Diagnoser.resolved``)."""
     for k in open_rounds(causes, verdicts)[:1]:
         verdict = verdicts[k]
         left = open_rivals(verdict, causes)
         fits = {r.fit.label: r.fit for r in rounds[k]}
-        draws = {final.label: final.f_effective} | {label: fits[label].f_effective for label in left}
+        draws = {final.label: final.f_effective} | {label: resolve(fits[label]).f_effective for label in left}
         w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
         if sum(w.values()) <= 0.0:
             w = {label: 1.0 for label in w}
@@ -91,7 +100,7 @@ def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes
     return None, {}, None
 
 
-def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int
+def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int, resolve: Resolve = _as_fitted
                         ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """When a candidate fitted in turn is superfluous (:mod:`.rival_swaps`) and no round leaves a rival open: f's
     draws from the stacking mixture of the final model and ``checked``, the swap check's models of that round (the
@@ -100,7 +109,7 @@ def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int
     if not checked:
         return None, {}, None
     weights = round_weights(final, list(checked), seed)
-    draws = {final.label: final.f_effective} | {f.label: f.f_effective for f in checked}
+    draws = {final.label: final.f_effective} | {f.label: resolve(f).f_effective for f in checked}
     w = {final.label: weights["reference"]} | {f.label: weights[f.label] for f in checked}
     if sum(w.values()) <= 0.0:
         w = {label: 1.0 for label in w}
@@ -108,7 +117,8 @@ def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int
 
 
 def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
-                    seed: int) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+                    seed: int, resolve: Resolve = _as_fitted
+                    ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """After at least one cause, when the last round named nothing (none, unexplained or unconfirmed) and the
     models that carry its stacking weight (:class:`~friction_uq.stats.WeightRule`) include further mechanisms
     whose evidence over the model with the causes is decisive by the package's rule (they fail the naming rule
@@ -125,15 +135,15 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
     if not further:
         return None, {}, None
     fits = {r.fit.label: r.fit for r in rounds[-1]}
-    draws = {label: fits[label].f_effective for label in further}  # heaviest first, as the weights
+    draws = {label: resolve(fits[label]).f_effective for label in further}  # heaviest first, as the weights
     if "reference" in verdict.supported and verdict.weights["reference"] > 0.0:  # the final model carries weight
         draws = {final.label: final.f_effective} | draws
     w = {k: verdict.weights["reference" if k == final.label else k] for k in draws}
     return _draw_mixture(draws, w, seed)
 
 
-def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stationary_f: np.ndarray | None = None
-            ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stationary_f: np.ndarray | None = None,
+            resolve: Resolve = _as_fitted) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """f's draws from the stacking mixture of the models that carry the weight (:mod:`.verdict`), their weights
     and each draw's model, when the first round named no single cause but found candidates, an unexplained
     misfit or an unconfirmed mechanism; (None, {}, None) otherwise. ``stationary_f``: the stationary analysis'
@@ -143,7 +153,7 @@ def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stati
     fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
     keep = [k for k in verdict.supported if verdict.weights[k] > 0.0]
     w = {k: verdict.weights[k] for k in keep}
-    draws, w = _with_stationary({k: fits[k].f_effective for k in keep}, w, stationary_f)
+    draws, w = _with_stationary({k: resolve(fits[k]).f_effective for k in keep}, w, stationary_f)
     return _draw_mixture(draws, w, seed)
 
 

@@ -37,8 +37,8 @@ from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide, misfit_detected
-from .candidates_mixture import (further_mixture, mixture, named_causes, open_rivals, open_rounds, rival_mixture,
-                                 superfluous_mixture)
+from .candidates_mixture import (Resolve, further_mixture, mixture, named_causes, open_rivals, open_rounds,
+                                 rival_mixture, superfluous_mixture)
 from .rival_swaps import Swap, check_swaps, swap_jobs
 from .verdict import NamingRule, Verdict
 from .whole_record import WholeRecord, compare_whole_record
@@ -232,9 +232,11 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     priors for the mode search. ``workers``: processes fitting a round's extended models and sharing the
     exact posterior's evaluations (None: the machine's cores, at most :data:`MAX_WORKERS`); the result does
     not depend on it. ``stationary_f``: the stationary analysis' draws of f, half of the f to quote when no cause
-    is named (:mod:`.candidates_mixture`); None: the candidates' mixture alone. ``nu_cut``: every model's f from the
+    is named (:mod:`.candidates_mixture`); None: the candidates' mixture alone. ``nu_cut``: the f of every model
+    that f is reported from (the baseline, each round's reference, the final model, the mixtures' members) from the
     cut posterior, nu read from the record's stationary windows under the model (:mod:`.nu_cut`; the names are the
-    joint fits'); False: f is each model's joint fit's.
+    joint fits'), the other candidates' f their joint fits' (``ModelFit.f_from``: the cut is made only where f is
+    reported, half of a model's fitting time); False: f is each model's joint fit's.
     """
     t0 = time.perf_counter()
     if workers is None:
@@ -265,14 +267,17 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     k = ess = float("nan")
     method, converged = None, True
     mix, mix_w, mix_src = (None, {}, None) if causes or not verdicts else \
-        mixture(st.base, rounds[0], verdicts[0], seed, stationary_f)
+        mixture(st.base, rounds[0], verdicts[0], seed, stationary_f, resolve=dg.resolved)
     mixture_of = "candidates" if mix is not None else None
     if causes:
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
         final, ex = dg.exact_posterior(final, workers=workers)
         k, ess, method, converged = ex.pareto_k, ex.ess, ex.method, ex.converged
         mix, mix_w, mix_src, mixture_of = _mixture_after_causes(final, rounds, verdicts, causes, swaps, checked,
-                                                                seed, stationary_f)
+                                                                seed, stationary_f, dg.resolved)
+    # the models whose f is reported (the reference models, the mixtures' members) with their cut posterior
+    rounds = [[replace(r, fit=dg.known(r.fit)) for r in rnd] for rnd in rounds]
+    checked = tuple(dg.known(m) for m in checked)
     return Diagnosis(baseline=st.base, rounds=tuple(rounds), misfits=tuple(st.misfits), causes=tuple(causes),
                      not_separable=st.not_sep, channels_not_separable=st.other_channels, separate_by=st.separate_by,
                      final=final, rms=residual_rms(a, b), seconds=time.perf_counter() - t0,
@@ -283,18 +288,18 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
 
 
 def _mixture_after_causes(final: ModelFit, rounds: list, verdicts: list, causes: list, swaps: tuple, checked: tuple,
-                          seed: int, stationary_f: np.ndarray | None) -> tuple:
+                          seed: int, stationary_f: np.ndarray | None, resolve: Resolve) -> tuple:
     """f's mixture once causes were fitted, and which: a round's open rivals first, else the last round's further
     mechanisms, else a superfluous candidate's round (:mod:`.candidates_mixture`); (None, {}, None, None): f is the
     final model's."""
-    mix, w, src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f)
+    mix, w, src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f, resolve)
     if mix is not None:
         return mix, w, src, "rivals"
-    mix, w, src = further_mixture(final, rounds, verdicts, causes, seed)
+    mix, w, src = further_mixture(final, rounds, verdicts, causes, seed, resolve)
     if mix is not None:
         return mix, w, src, "further"
     k = next((j for j, v in enumerate(verdicts[:len(causes)]) if v.superfluous), None)
-    mix, w, src = superfluous_mixture(final, [m for s, m in zip(swaps, checked) if s.round == k], seed)
+    mix, w, src = superfluous_mixture(final, [m for s, m in zip(swaps, checked) if s.round == k], seed, resolve)
     return mix, w, src, ("superfluous" if mix is not None else None)
 
 
@@ -317,7 +322,7 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
         say(f"round {k + 1}: {len(jobs)} extended models ({', '.join(j[2] for j in jobs)}) on {workers} "
             f"process(es){eta}; {time.perf_counter() - t0:.0f} s so far")
         t_round = time.perf_counter()
-        fits = dg.fit_many(jobs, workers=workers)
+        fits = dg.fit_many(jobs, workers=workers, cut=False)  # the cut for the models whose f is reported only
         fit_seconds += (time.perf_counter() - t_round) * max(1, min(workers, len(jobs)))
         fitted += len(jobs)
         ranked = rank(st.reference, fits, misfit=st.misfits[-1].detected)
@@ -333,7 +338,7 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
         # later round, one that is an alternative does not (then f is the mixture of the two, below)
         best = next(r for r in ranked if r.fit.label == verdict.named)
         st.causes.append(best.fit.variants[-1])
-        st.reference = best.fit
+        st.reference = dg.resolved(best.fit)
     return st
 
 

@@ -82,6 +82,17 @@ class ModelFit:
     def f_summary(self) -> dict[str, float]:
         return summarize_draws(self.f_effective)
 
+    @property
+    def f_from(self) -> str:
+        """Whose draws f_effective holds: the cut posterior's (:mod:`.nu_cut`) or the whole-record fit's."""
+        return "cut posterior" if self.cut is not None else "whole-record fit"
+
+
+def _key(mf: ModelFit) -> tuple:
+    """A fitted model's identity: its label and its mode (a swap check may fit a round's label again from another
+    start, :mod:`.rival_swaps`)."""
+    return (mf.label, tuple(sorted(mf.fit.mode.items())))
+
 
 class Diagnoser:
     """Fits and scores extended models of one record (module docstring)."""
@@ -110,6 +121,8 @@ class Diagnoser:
         self.base_scales = dict(base_scales or {})
         #: f and nu of the stationary analysis: with the header's modulus, a second start of every extended fit
         self.nominal = dict(nominal or {})
+        #: the models whose cut posterior was made (:meth:`resolved`), by label and mode (:func:`_key`)
+        self._resolved: dict[tuple, ModelFit] = {}
 
     def _model(self, variants: tuple[Variant, ...]) -> SimulatorModel:
         extra = [self.modulus] + [p for v in variants for p in v.mechanism.parameters]
@@ -123,7 +136,11 @@ class Diagnoser:
         return SimulatorModel(self.prep.record.apparatus, self.loading, hoop=self.hoop, extra=tuple(extra),
                               apply=apply, dispersive_loading=self.dispersive_loading)
 
-    def fit(self, variants: tuple[Variant, ...], start: Mapping[str, float], label: str) -> ModelFit:
+    def fit(self, variants: tuple[Variant, ...], start: Mapping[str, float], label: str, *,
+            cut: bool = True) -> ModelFit:
+        """The model's whole-record fit and ELPD; with ``nu_cut``, f from the cut posterior (:meth:`resolved`) unless
+        ``cut`` is False: then f is the joint fit's until :meth:`resolved` is asked for it (the names and the evidence
+        do not depend on the cut; the cut is seeded by the label, so it gives the same bits whenever it is made)."""
         model = self._model(variants)
         lik = WholeRecordLikelihood(self.prep, model)
         log_prior = self.log_prior(variants)
@@ -134,9 +151,7 @@ class Diagnoser:
                 st[p.name] = start.get(p.name, v.mechanism.start[p.name])
         # seeded by the model's label: the same draws whichever process fits it, in whatever order
         rng = stream(self.seed, "extended fit", label)
-        scales = {"sample_modulus": self.modulus.gaussian_stand_in(self.modulus_prior), **self.base_scales}
-        for v in variants:
-            scales.update(v.mechanism.prior_z())
+        scales = self._scales(variants)
         # the baseline from several nu (the closed form's, and either side of the prior): see fit.py. An
         # extended model also from the stationary analysis's f and nu with the header's modulus: a reference
         # model that misses the record bends nu and the modulus to fit it (on a record with bare end faces, nu
@@ -163,28 +178,53 @@ class Diagnoser:
                                       block=self.block)[0] + logw)
         elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z, block_of)
         elpd = with_calibration(elpd, self._calibration(lik, fit, unit, scales["sample_modulus"]))
-        cut = None
-        if not self.nu_cut:
-            f_eff = self._f_of(variants, fit.draws)
-        else:
-            cut = self._cut(model, lik, log_prior, fit.mode, scales, block_of, label)
-            params = [lik.model.parameters[n] for n in cut.fit.names]
-            z = np.column_stack([np.asarray(p.to_unbounded(cut.fit.draws[p.name]), float) for p in params])
-            draws = cut.draws(params, z, stream(self.seed, "nu cut draws", label))
-            f_eff = self._f_of(variants, draws)
-            # the draws are the cut posterior's (paired with f); the predictive keeps the joint fit's, as calibrated
-            fit = replace(fit, draws=draws, laplace_draws=fit.laplace_draws or fit.draws)
-        return ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd, f_effective=f_eff,
-                        predicted={c: v[None] for c, v in pred.items()}, lik=lik, cut=cut)
+        mf = ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd,
+                      f_effective=self._f_of(variants, fit.draws), predicted={c: v[None] for c, v in pred.items()},
+                      lik=lik)
+        return self.resolved(mf) if cut else mf
 
-    def _cut(self, model: SimulatorModel, lik: WholeRecordLikelihood, log_prior, mode: Mapping[str, float],
-             scales: Mapping[str, tuple[float, float]], block_of: np.ndarray, label: str) -> CutFit:
+    def _scales(self, variants: tuple[Variant, ...]) -> dict[str, tuple[float, float]]:
+        """The Gaussian stand-ins of a model's priors for the mode searches (the sample's modulus, the mechanisms')."""
+        scales = {"sample_modulus": self.modulus.gaussian_stand_in(self.modulus_prior), **self.base_scales}
+        for v in variants:
+            scales.update(v.mechanism.prior_z())
+        return scales
+
+    def resolved(self, mf: ModelFit) -> ModelFit:
+        """The model with f from the cut posterior (:mod:`.nu_cut`) when ``nu_cut`` is on, made once per model
+        (kept by its label); the model as it is otherwise. Its ELPD, mode and predictions are the joint fit's;
+        its draws become the cut posterior's (paired with f), the joint fit's kept as ``laplace_draws`` for the
+        predictive, as calibrated."""
+        if not self.nu_cut or mf.cut is not None:
+            return mf
+        key = _key(mf)
+        if key in self._resolved:
+            return self._resolved[key]
+        assert mf.lik is not None  # every fit made here carries its likelihood
+        cut = self._cut(mf)
+        params = [mf.lik.model.parameters[n] for n in cut.fit.names]
+        z = np.column_stack([np.asarray(p.to_unbounded(cut.fit.draws[p.name]), float) for p in params])
+        draws = cut.draws(params, z, stream(self.seed, "nu cut draws", mf.label))
+        fit = replace(mf.fit, draws=draws, laplace_draws=mf.fit.laplace_draws or mf.fit.draws)
+        out = replace(mf, fit=fit, f_effective=self._f_of(mf.variants, draws), cut=cut)
+        self._resolved[key] = out
+        return out
+
+    def known(self, mf: ModelFit) -> ModelFit:
+        """The model as :meth:`resolved` made it, if it was asked for; else as it is (no fit is made here)."""
+        return self._resolved.get(_key(mf), mf) if mf.cut is None else mf
+
+    def _cut(self, mf: ModelFit) -> CutFit:
         """The cut posterior's fit (:mod:`.nu_cut`): nu from the stationary windows under the joint fit's mechanism
         parameters (the sample's modulus from its header's, free), then theta at that nu."""
-        nu_window = window_nu(self.prep, model, log_prior, dict(mode) | {"sample_modulus": self.E0},
+        lik, mode, label = mf.lik, mf.fit.mode, mf.label
+        assert lik is not None
+        log_prior, scales = self.log_prior(mf.variants), self._scales(mf.variants)
+        nu_window = window_nu(self.prep, lik.model, log_prior, dict(mode) | {"sample_modulus": self.E0},
                               n_draws=NU_WINDOW_DRAWS, rng=stream(self.seed, "nu window", label), prior_scale=scales)
         return conditional_fit(lik, log_prior, mode, nu_window, n_draws=self.n_draws,
-                               rng=stream(self.seed, "nu cut", label), prior_scale=scales, score_blocks=block_of)
+                               rng=stream(self.seed, "nu cut", label), prior_scale=scales,
+                               score_blocks=lik.blocks(self.block))
 
     def _f_of(self, variants: tuple[Variant, ...], draws: Mapping[str, np.ndarray]) -> np.ndarray:
         """f_effective of each draw."""
@@ -261,22 +301,26 @@ class Diagnoser:
         return out
 
     def fit_many(self, jobs: list[tuple[tuple[Variant, ...], Mapping[str, float], str]], *,
-                 workers: int = 1) -> list[ModelFit]:
+                 workers: int = 1, cut: bool = True) -> list[ModelFit]:
         """:meth:`fit` for each (variants, start, label) job, on ``workers`` processes (forked: they share
         this object). A daemon process or one running other threads (a campaign's Dask worker: forking
-        a threaded process can deadlock) fits them in turn. Same results as one by one."""
+        a threaded process can deadlock) fits them in turn. Same results as one by one. ``cut``: as
+        :meth:`fit`'s (False: the cut is left to :meth:`resolved`, for the models whose f is reported)."""
         def fit_job(job: tuple[tuple[Variant, ...], Mapping[str, float], str]) -> tuple:
-            mf = self.fit(*job)  # what of the fit can be pickled back from a forked worker
+            mf = self.fit(*job, cut=cut)  # what of the fit can be pickled back from a forked worker
             return mf.fit, mf.hoop_gain, mf.elpd, mf.f_effective, mf.predicted, mf.cut
 
         if min(workers, len(jobs)) <= 1 or not can_fork():
-            return [self.fit(*job) for job in jobs]
+            return [self.fit(*job, cut=cut) for job in jobs]
         parts = forked_map(fit_job, jobs, workers=workers)
         out = []
-        for (variants, _, label), (fit, gain, elpd, f_eff, predicted, cut) in zip(jobs, parts):
+        for (variants, _, label), (fit, gain, elpd, f_eff, predicted, cut_fit) in zip(jobs, parts):
             lik = WholeRecordLikelihood(self.prep, self._model(variants))  # closures do not cross processes
-            out.append(ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd,
-                                f_effective=f_eff, predicted=predicted, lik=lik, cut=cut))
+            mf = ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd,
+                          f_effective=f_eff, predicted=predicted, lik=lik, cut=cut_fit)
+            if cut_fit is not None:
+                self._resolved.setdefault(_key(mf), mf)
+            out.append(mf)
         return out
 
     def predictive(self, mf: ModelFit, n: int = 30) -> dict[str, np.ndarray]:

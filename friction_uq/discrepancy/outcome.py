@@ -49,7 +49,7 @@ def _entry(r: Ranked, verdict=None) -> dict[str, object]:
     return {"name": v.mechanism.name, "channel": v.channel, "model": r.fit.label, "delpd": r.delpd, "se": r.se,
             "decisive": r.decisive, **judged, "parameters": params,
             "calibration_elpd": dict(zip(r.fit.elpd.calibration_names, map(float, r.fit.elpd.calibration))),
-            "f_effective": summarize_draws(r.fit.f_effective),
+            "f_effective": summarize_draws(r.fit.f_effective), "f_from": r.fit.f_from,
             "draws": int(len(r.fit.f_effective)), "ess": _ess(r.fit.fit.log_weights)}
 
 
@@ -199,7 +199,7 @@ def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
               "calibration_elpd": (("calibration",), mf.elpd.calibration)}
         method = dg.posterior_method if mf is dg.final and dg.causes else "normal approximation (robust covariance)"
         dt[f"discrepancy_{key}/posterior"] = xr.DataTree(xr.Dataset(post, attrs={
-            "model": mf.label, "hoop_gain": mf.hoop_gain, "posterior_method": method}))
+            "model": mf.label, "hoop_gain": mf.hoop_gain, "posterior_method": method, "f_from": mf.f_from}))
         dt[f"discrepancy_{key}/log_likelihood"] = xr.DataTree(xr.Dataset(
             ll, coords={"calibration": list(mf.elpd.calibration_names)}, attrs={
             "elpd": mf.elpd.total, "elpd_se": mf.elpd.se,

@@ -127,7 +127,8 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
     if not jobs:
         return verdicts, (), ()
     fits = dg.fit_many([(variants, swap_start(final, rounds, causes, k, label, variants),
-                         "+".join(v.label for v in variants)) for k, label, variants in jobs], workers=workers)
+                         "+".join(v.label for v in variants)) for k, label, variants in jobs], workers=workers,
+                       cut=False)  # the cut for a swap's model only where a mixture reports its f
     weights = round_weights(final, fits, seed)
     behind = {"reference": 0.0} | {f.label: elpd_difference(final.elpd, f.elpd)[0] for f in fits}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
