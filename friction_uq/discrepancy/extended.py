@@ -215,8 +215,8 @@ class Diagnoser:
         return self._resolved.get(_key(mf), mf) if mf.cut is None else mf
 
     def _cut(self, mf: ModelFit) -> CutFit:
-        """The cut posterior's fit (:mod:`.nu_cut`): nu from the stationary windows under the joint fit's mechanism
-        parameters (the sample's modulus from its header's, free), then theta at that nu."""
+        """The cut posterior's fit (:mod:`.nu_cut`): nu from the stationary windows, every parameter free under its
+        prior (the search from the joint fit's mode, the sample's modulus from its header's), then theta at that nu."""
         lik, mode, label = mf.lik, mf.fit.mode, mf.label
         assert lik is not None
         log_prior, scales = self.log_prior(mf.variants), self._scales(mf.variants)

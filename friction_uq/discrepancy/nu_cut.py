@@ -13,12 +13,15 @@ So the f a whole-record model gives is taken from a *cut* posterior (modular inf
 the misspecified part of a model on a shared parameter is cut; Plummer 2015, Jacob et al. 2017), in two modules:
 
 * nu from the quasi-static part of the record under the model: the same model's likelihood over every gauge's
-  stationary window alone, its slow bends there marginalised (:func:`window_nu`), with f and the sample's modulus
-  free beside nu (the output forces fix kappa, the hoop's level with its 5 % calibration fixes nu; the modulus
-  under its prior, for it is what the dynamics bend with nu) and the mechanism's parameters at the joint fit's
-  mode (a clearance's gap, a plug's friction: what changes the window's relation of the wall pressure to the axial
-  stress). The stationary analysis reads nu from the window too, but without the mechanism: a gap or end-face
-  friction the stationary model does not have puts its nu 0.03-0.14 off, which this module does not inherit;
+  stationary window alone, its slow bends there marginalised (:func:`window_nu`), with every parameter of the model
+  free under its prior: f, nu, the sample's modulus (the output forces fix kappa, the hoop's level with its 5 %
+  calibration fixes nu; the modulus is what the dynamics bend with nu) and the mechanism's (a clearance's gap, a
+  plug's friction: what changes the window's relation of the wall pressure to the axial stress). The stationary
+  analysis reads nu from the window too, but without the mechanism: a gap or end-face friction the stationary model
+  does not have puts its nu 0.03-0.14 off, which this module does not inherit. The mechanism's parameters are not
+  taken from the joint fit: held at its mode they would carry the whole record's dynamics, the cut part, into nu
+  (on B-02's four-cause model nu's sd fell to 0.002, a fifth of what the hoop gauge's calibration allows; free, it
+  is 0.008, docs/trust.md);
 * theta, the model's other parameters (f, the sample's modulus, the mechanism's), from the whole record given nu
   (:func:`conditional_fit`: the fit at nu fixed at that posterior's median nu_0 and its Laplace approximation); its
   dependence on nu is the conditional mode's linear response, d theta / d nu = -(J^T J)^-1 J^T J_nu (Gauss-Newton
@@ -106,18 +109,15 @@ class CutFit:
         return cut_draws(params, z, self, self.nu.sample(len(z), rng))
 
 
-def window_nu(prep: Prepared, model: SimulatorModel, log_prior: LogPrior, mode: Mapping[str, float], *,
+def window_nu(prep: Prepared, model: SimulatorModel, log_prior: LogPrior, start: Mapping[str, float], *,
               n_draws: int, rng: np.random.Generator, prior_scale: Mapping[str, tuple[float, float]]) -> NuCut:
-    """nu's posterior from every gauge's stationary window under the model (module docstring): f, nu and the sample's
-    modulus free (from ``mode``'s values), the mechanism's parameters at ``mode`` (the joint fit's), the gauges'
-    calibrations and slow bends marginalised; its normal approximation's draws."""
-    free = ("f", "nu", "sample_modulus")
-    held = {k: v for k, v in mode.items() if k not in free + ("hoop_gain",)}
+    """nu's posterior from every gauge's stationary window under the model (module docstring): every parameter of
+    the model free under its prior (``prior_scale``: their Gaussian stand-ins), the search from ``start`` (the joint
+    fit's mode), the gauges' calibrations and slow bends marginalised; its normal approximation's draws."""
     lik = WholeRecordLikelihood(prep, model, window_only=True,
                                 shape_sd={(c, "stationary"): WINDOW_SHAPE_SD for c in CHANNEL_LABELS})
-    fixed = Fixed(lik, held)
-    fit = fit_whole_record(fixed, lambda v: log_prior(held | dict(v)), {k: mode[k] for k in free},
-                           n_draws=n_draws, rng=rng, importance=False,
+    free = {k: v for k, v in start.items() if k != "hoop_gain"}
+    fit = fit_whole_record(lik, log_prior, free, n_draws=n_draws, rng=rng, importance=False,
                            prior_scale={k: v for k, v in prior_scale.items() if k in free})
     return NuCut(fit.draws["nu"])
 
