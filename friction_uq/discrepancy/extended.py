@@ -192,7 +192,7 @@ class Diagnoser:
 
     def resolved(self, mf: ModelFit) -> ModelFit:
         """The model with f from the cut posterior (:mod:`.nu_cut`) when ``nu_cut`` is on, made once per model
-        (kept by its label); the model as it is otherwise. Its ELPD, mode and predictions are the joint fit's;
+        (kept by its label and mode, :func:`_key`); the model as it is otherwise. Its ELPD, mode and predictions are the joint fit's;
         its draws become the cut posterior's (paired with f), the joint fit's kept as ``laplace_draws`` for the
         predictive, as calibrated."""
         if not self.nu_cut or mf.cut is not None:
