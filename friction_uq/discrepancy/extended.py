@@ -192,15 +192,14 @@ class Diagnoser:
 
     def resolved(self, mf: ModelFit) -> ModelFit:
         """The model with f from the cut posterior (:mod:`.nu_cut`) when ``nu_cut`` is on, made once per model
-        (kept by its label and mode, :func:`_key`); the model as it is otherwise. Its ELPD, mode and predictions are the joint fit's;
-        its draws become the cut posterior's (paired with f), the joint fit's kept as ``laplace_draws`` for the
-        predictive, as calibrated."""
+        (kept by its label and mode, :func:`_key`); the model as it is otherwise. Its ELPD, mode and predictions are
+        the joint fit's; its draws become the cut posterior's (paired with f), the joint fit's kept as
+        ``laplace_draws`` for the predictive, as calibrated."""
         if not self.nu_cut or mf.cut is not None:
             return mf
         key = _key(mf)
         if key in self._resolved:
             return self._resolved[key]
-        assert mf.lik is not None  # every fit made here carries its likelihood
         cut = self._cut(mf)
         params = [mf.lik.model.parameters[n] for n in cut.fit.names]
         z = np.column_stack([np.asarray(p.to_unbounded(cut.fit.draws[p.name]), float) for p in params])
@@ -218,7 +217,7 @@ class Diagnoser:
         """The cut posterior's fit (:mod:`.nu_cut`): nu from the stationary windows, every parameter free under its
         prior (the search from the joint fit's mode, the sample's modulus from its header's), then theta at that nu."""
         lik, mode, label = mf.lik, mf.fit.mode, mf.label
-        assert lik is not None
+        assert lik is not None  # every fit made here carries its likelihood
         log_prior, scales = self.log_prior(mf.variants), self._scales(mf.variants)
         nu_window = window_nu(self.prep, lik.model, log_prior, dict(mode) | {"sample_modulus": self.E0},
                               n_draws=NU_WINDOW_DRAWS, rng=stream(self.seed, "nu window", label), prior_scale=scales)
