@@ -41,6 +41,7 @@ from bench_trust import _axisymmetric, make_record  # noqa: E402
 
 from friction_uq.analysis import identify, prepare  # noqa: E402
 from friction_uq.discrepancy import record_likelihood  # noqa: E402
+from friction_uq.discrepancy.exact_model import exact_posterior  # noqa: E402
 from friction_uq.discrepancy.extended import Diagnoser  # noqa: E402
 from friction_uq.discrepancy.pipeline import f_nu_log_prior  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
@@ -59,7 +60,7 @@ def baseline_f(path: str, f_true: float) -> dict[str, float]:
     start = whole_record_start(identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3)), priors)
     scales = {p.name: p.gaussian_stand_in(priors[p.name]) for p in (F, NU)}
     dg = Diagnoser(prep, f_nu_log_prior(priors), hoop=True, seed=1, base_scales=scales, nominal=start)
-    final, _ = dg.exact_posterior(dg.fit((), start, "baseline"))
+    final, _ = exact_posterior(dg, dg.fit((), start, "baseline"))
     lf = np.log(final.f_effective)
     lo, hi = np.quantile(lf, [0.05, 0.95])
     return {"error": float(np.median(lf) - math.log(f_true)), "sd": float(np.std(lf)),

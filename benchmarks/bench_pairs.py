@@ -17,7 +17,12 @@ whole-record models' form included), by the same without the form, and by the po
 header values), and the first round's verdicts. Each record's line says how the exact posterior of the model
 with the causes was obtained and its effective sample size.
 
-    python benchmarks/bench_pairs.py [--seed 29] [--only 1d,axisymmetric] [--first 0] [--count 8]
+    python benchmarks/bench_pairs.py [--seed 29] [--only 1d,axisymmetric] [--first 0] [--count 8] [--alone]
+
+``--alone`` also makes each effect of a pair alone on the same record (the same draws of f, nu, speed and of the
+other effect, the same noise; the other effect left out) and runs diagnose's first round on it: is the effect named
+by itself at this strength? Issue 24 asks both causes of a pair named "when both are at detectable strength"; the
+last lines count the pairs whose two effects are each named alone, and how many of those the pair names both of.
 """
 
 from __future__ import annotations
@@ -55,21 +60,26 @@ PAIRS_AXISYMMETRIC = (("clearance", "velocity_friction"), ("plug_friction", "cha
                       ("plug_friction", "clearance"), ("pressure_friction", "bar_modulus"))
 
 
-def make_pair(pair: tuple[str, str], axisymmetric: bool, k: int, r: np.random.Generator):
+def make_pair(pair: tuple[str, str], axisymmetric: bool, k: int, r: np.random.Generator, keep: int | None = None):
     """The configuration simulated, the edit of its recorded strains (or None), the header's apparatus (or
-    None: the configuration's) and a note, for record ``k`` with the two effects of ``pair``."""
+    None: the configuration's) and a note, for record ``k`` with the two effects of ``pair``; with ``keep`` (0 or
+    1), the same record with that effect alone: the other is drawn (the same draws follow) but not applied."""
     cfg = clean_config(r, "A" if k % 2 == 0 else "B")
     clean_header = cfg.apparatus
     edit, header, notes = None, None, []
-    for effect in pair:
+    for j, effect in enumerate(pair):
+        applied = keep is None or keep == j
         if effect in CHAIN_FAULTS:
-            cfg, e, note = CHAIN_FAULTS[effect](cfg, r)
-            edit = e if e is not None else edit
-            header = clean_header if effect == "bar_modulus" else header
-            notes.append(note)
+            c, e, note = CHAIN_FAULTS[effect](cfg, r)
+            if applied:
+                cfg, edit = c, (e if e is not None else edit)
+                header = clean_header if effect == "bar_modulus" else header
+                notes.append(note)
         else:
-            cfg = HIDDEN[effect](cfg, r)
-            notes.append(effect)
+            c = HIDDEN[effect](cfg, r)
+            if applied:
+                cfg = c
+                notes.append(effect)
     if axisymmetric:
         cfg = _axisymmetric(cfg)
     return cfg, edit, header, " + ".join(notes)
@@ -115,6 +125,23 @@ def score(pair: tuple[str, str], dg, cfg, prep) -> dict:
             "rounds": [v.kind for v in dg.verdicts]}
 
 
+def named_alone(pair: tuple[str, str], j: int, axisymmetric: bool, k: int, state: dict, sim_seed: int, path: str,
+                priors) -> tuple[bool, str]:
+    """Effect ``j`` of the pair alone on record ``k`` (the pair's draws from ``state``, its noise from ``sim_seed``):
+    whether diagnose's first round names it as the cause, and what that round said."""
+    r = np.random.default_rng()
+    r.bit_generator.state = state
+    cfg, edit, header, _ = make_pair(pair, axisymmetric, k, r, keep=j)
+    write(cfg, path, sim_seed, edit, header)
+    try:
+        _, dg = analyse(path, priors, seed=k, max_causes=1)
+    finally:
+        os.remove(path)
+    v = dg.verdicts[0]
+    said = v.kind + (f" {v.named}" if v.named else "")
+    return bool(dg.cause is not None and dg.cause.mechanism.name == pair[j]), said
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=29)
@@ -122,6 +149,9 @@ def main() -> None:
     ap.add_argument("--first", type=int, default=0, help="first pair of each list to analyse")
     ap.add_argument("--count", type=int, default=8, help="pairs of each list to analyse")
     ap.add_argument("--sentences", action="store_true", help="print each record's diagnosis sentence")
+    ap.add_argument("--alone", action="store_true", help="also each effect of a pair alone on the same record (the "
+                    "same draws and noise, the other effect left out), through diagnose's first round: is it named "
+                    "alone at this strength?")
     a = ap.parse_args()
     priors = load_priors(default_prior_path("I1"))
     rng = np.random.default_rng(a.seed)
@@ -130,6 +160,7 @@ def main() -> None:
     secs = []
     for sim, pairs in (("1d", PAIRS_1D), ("axisymmetric", PAIRS_AXISYMMETRIC)):
         for k, pair in enumerate(pairs):
+            state = rng.bit_generator.state  # the pair's draws, for its effects alone (--alone)
             cfg, edit, header, note = make_pair(pair, sim == "axisymmetric", k, rng)
             sim_seed = int(rng.integers(2**31))  # drawn for every record: the others do not move with --only
             if sim not in a.only.split(",") or not a.first <= k < a.first + a.count:
@@ -159,6 +190,13 @@ def main() -> None:
             if a.sentences:
                 print("    " + sentence(dg, dg.baseline.f_summary()), flush=True)
             os.remove(path)
+            if a.alone:
+                alone = [named_alone(pair, j, sim == "axisymmetric", k, state, sim_seed, path, priors) for j in (0, 1)]
+                print("    alone: " + ", ".join(f"{e} {'named' if ok else 'not named'} ({said})"
+                                              for e, (ok, said) in zip(pair, alone)), flush=True)
+                if all(ok for ok, _ in alone):
+                    c["detectable"] += 1
+                    c["both_detectable"] += s["both"]
     print(f"\n{'simulator':<13} {'n':>3} {'both':>5} {'one':>4} {'wrong':>6} {'both among':>10} {'f covered':>9} "
           f"{'calibration only':>16} {'given headers':>13} {'refused':>7}  first round's verdict")
     for sim, c in tally.items():
@@ -168,6 +206,10 @@ def main() -> None:
               f"{c['refused']:>7}  {kinds}")
     print("f covered: the f to quote (the JSON's: the output bars' calibration and the whole-record models' form "
           "included); calibration only: without the form; given headers: the posterior's own 90 % interval")
+    if a.alone:
+        for sim, c in tally.items():
+            print(f"{sim}: both effects named alone on {c['detectable']} of {c['n']} pairs; both named in the pair on "
+                  f"{c['both_detectable']} of those")
     if secs:
         print(f"time per record: median {np.median(secs):.0f} s, range {min(secs):.0f}-{max(secs):.0f} s")
 

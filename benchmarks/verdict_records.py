@@ -28,6 +28,11 @@ mode (f, nu and the mechanism's parameters), the misfit decision's flagged cells
 nu).
 
     python benchmarks/verdict_records.py OUT_DIR [--clean 20] [--per 4] [--seed 17] [--only GROUP,...]
+        [--max-causes 1 | --as-run]
+
+Each record's line ends with its time, and diagnose's own (the simulation not counted); the last line, their
+median. ``--as-run`` takes every round through ``friction_uq.run`` (the stationary analysis, the whole-record check
+and the exact posterior included): the time a user of ``friction-uq diagnose`` waits, without the PDF.
 """
 
 from __future__ import annotations
@@ -45,7 +50,7 @@ import numpy as np
 from scipy import signal
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_diagnose import HIDDEN, analyse, true_f  # noqa: E402
+from bench_diagnose import HIDDEN, analyse, analyse_as_run, true_f  # noqa: E402
 from bench_misfit import clean_config  # noqa: E402
 from bench_trust import write_strains  # noqa: E402
 
@@ -207,6 +212,11 @@ def main() -> None:
     ap.add_argument("--per", type=int, default=4, help="records of each mechanism group")
     ap.add_argument("--seed", type=int, default=17)
     ap.add_argument("--only", help="comma-separated groups")
+    ap.add_argument("--max-causes", type=int, default=1,
+                    help="rounds of diagnose (1: the first round, what is stored; 4: every round, as friction-uq "
+                    "diagnose runs, to time it)")
+    ap.add_argument("--as-run", action="store_true", help="through friction_uq.run(..., diagnose=True), every round: "
+                    "the stationary analysis and the whole-record check included, as friction-uq diagnose times")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     only = set(a.only.split(",")) if a.only else None
@@ -214,6 +224,7 @@ def main() -> None:
     rng = np.random.default_rng(a.seed)
     tmp = tempfile.mkdtemp()
     jobs = [(g, k) for g in groups() for k in range(a.clean if g.startswith("clean") else a.per)]
+    seconds = []  # diagnose's own time per record (the simulation not counted)
     for g, k in jobs:
         cfg, edit, note, header = make(g, k, rng)
         sim_seed = int(rng.integers(2**31))
@@ -224,14 +235,25 @@ def main() -> None:
         t = time.perf_counter()
         try:
             write(cfg, path, sim_seed, edit, header)
-            prep, dg = analyse(path, priors, seed=k, max_causes=1)
+            t_fit = time.perf_counter()
+            if a.as_run:
+                prep, dg, _ = analyse_as_run(path, os.path.join(tmp, name), seed=k)
+            else:
+                prep, dg = analyse(path, priors, seed=k, max_causes=a.max_causes)
         except FrictionUQError as exc:
             print(f"{name}: refused: {exc}", flush=True)
             continue
+        seconds.append(time.perf_counter() - t_fit)
         dump(a.out, name, g, note, cfg, prep, dg)
         os.remove(path)
-        print(f"{name} ({note}): misfit {dg.misfits[0].detected}, named {dg.cause.mechanism.name if dg.cause else None}, "
-              f"{time.perf_counter() - t:.0f} s", flush=True)
+        causes = [v.mechanism.name for v in dg.named_causes]
+        rounds = [v.kind for v in dg.verdicts]
+        print(f"{name} ({note}): misfit {dg.misfits[0].detected}, named {causes or None}, rounds {rounds}, "
+              f"{time.perf_counter() - t:.0f} s ({seconds[-1]:.0f} s diagnose)", flush=True)
+    if seconds:
+        how = "every round, as run" if a.as_run else f"{a.max_causes} round(s) at most"
+        print(f"diagnose, {how}: median {np.median(seconds):.1f} s a record, range "
+              f"{min(seconds):.0f}-{max(seconds):.0f} s, {len(seconds)} records")
 
 
 if __name__ == "__main__":

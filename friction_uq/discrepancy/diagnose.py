@@ -34,6 +34,7 @@ import numpy as np
 from ..analysis import Prepared
 from ..stats import RULE
 from .elpd import elpd_difference
+from .exact_model import exact_posterior
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .mechanisms import Context
 from .misfit import MisfitDecision, decide, misfit_detected
@@ -111,7 +112,7 @@ class Diagnosis:
     #: the hoop gauge's calibration factor as the whole-record check reads it (f and nu free only: the model
     #: the misfit decision judges), when ``run`` made the check
     check_hoop_gain: float | None = None
-    #: the final model's normal approximation against its exact posterior (Diagnoser.exact_posterior), when a
+    #: the final model's normal approximation against its exact posterior (:func:`.exact_model.exact_posterior`), when a
     #: cause was named: Pareto k, the kept draws' effective sample size, how the exact draws were obtained
     #: (friction_uq.stats.exact: "importance", "importance (second proposal)" or "emcee") and whether they reached
     #: the floor on their effective sample size within the caps
@@ -271,7 +272,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     mixture_of = "candidates" if mix is not None else None
     if causes:
         say("the exact posterior of the model with the causes (importance sampling, emcee if it must)")
-        final, ex = dg.exact_posterior(final, workers=workers)
+        final, ex = exact_posterior(dg, final, workers=workers)
         k, ess, method, converged = ex.pareto_k, ex.ess, ex.method, ex.converged
         mix, mix_w, mix_src, mixture_of = _mixture_after_causes(final, rounds, verdicts, causes, swaps, checked,
                                                                 seed, stationary_f, dg.resolved)

@@ -25,29 +25,23 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from .._parallel import ForkedPool, can_fork, forked_map
+from .._parallel import can_fork, forked_map
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
 from ..models.measurement_chain import Reading
 from ..stats.ar1 import ar1_block_loo
-from ..stats.exact import ExactDraws, exact_draws
-from ..stats.laplace import robust_covariance
 from ..stats.streams import stream
 from .elpd import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
-from .nu_cut import CutFit, Fixed, conditional_fit, window_nu
+from .nu_cut import CutFit, conditional_fit, window_nu
 
 #: Block of the leave-one-block-out ELPD (s).
 BLOCK = 10e-6
 #: Further starting values of nu for the baseline's mode search.
 NU_STARTS = (0.33, 0.45)
 SAMPLE_MODULUS_SD_LOG = 0.1
-#: Draws of the importance stage of a named model's exact posterior (:meth:`Diagnoser.exact_posterior`).
-IMPORTANCE_DRAWS = 200
-#: Equal-weight draws of the exact (sandwich-adjusted) posterior kept for the named model.
-EXACT_DRAWS = 1000
 #: Draws of nu's normal approximation from the stationary windows (:func:`.nu_cut.window_nu`).
 NU_WINDOW_DRAWS = 2000
 
@@ -179,7 +173,7 @@ class Diagnoser:
         elpd = takeuchi_block_loo(np.concatenate(dens), fit.jacobian, fit.whitened, fit.cov_z, block_of)
         elpd = with_calibration(elpd, self._calibration(lik, fit, unit, scales["sample_modulus"]))
         mf = ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd,
-                      f_effective=self._f_of(variants, fit.draws), predicted={c: v[None] for c, v in pred.items()},
+                      f_effective=self.f_of(variants, fit.draws), predicted={c: v[None] for c, v in pred.items()},
                       lik=lik)
         return self.resolved(mf) if cut else mf
 
@@ -205,7 +199,7 @@ class Diagnoser:
         z = np.column_stack([np.asarray(p.to_unbounded(cut.fit.draws[p.name]), float) for p in params])
         draws = cut.draws(params, z, stream(self.seed, "nu cut draws", mf.label))
         fit = replace(mf.fit, draws=draws, laplace_draws=mf.fit.laplace_draws or mf.fit.draws)
-        out = replace(mf, fit=fit, f_effective=self._f_of(mf.variants, draws), cut=cut)
+        out = replace(mf, fit=fit, f_effective=self.f_of(mf.variants, draws), cut=cut)
         self._resolved[key] = out
         return out
 
@@ -225,7 +219,7 @@ class Diagnoser:
                                rng=stream(self.seed, "nu cut", label), prior_scale=scales,
                                score_blocks=lik.blocks(self.block))
 
-    def _f_of(self, variants: tuple[Variant, ...], draws: Mapping[str, np.ndarray]) -> np.ndarray:
+    def f_of(self, variants: tuple[Variant, ...], draws: Mapping[str, np.ndarray]) -> np.ndarray:
         """f_effective of each draw."""
         S = len(draws["f"])
         return np.array([self._f_effective(variants, {n: float(v[s]) for n, v in draws.items()}) for s in range(S)])
@@ -239,50 +233,6 @@ class Diagnoser:
             return out
 
         return log_prior
-
-    def exact_posterior(self, mf: ModelFit, *, n: int = IMPORTANCE_DRAWS,
-                        workers: int = 1) -> tuple[ModelFit, ExactDraws]:
-        """The model with its exact posterior, robust to a model that still misses (:mod:`friction_uq.stats.exact`).
-
-        The fit's normal approximation (robust covariance) is weighted by the exact posterior density (the
-        whole-record likelihood, the priors, the transforms' Jacobians): Pareto k says how far the normal
-        was from it; beyond the limit a second proposal or emcee samples it. The exact draws are then
-        given the robust covariance by the open-faced sandwich adjustment, which keeps their shape. The
-        returned model's draws and f_effective are these; its mode, ELPD and predictions are unchanged. Under the
-        cut (:mod:`.nu_cut`) it is theta's posterior at the windows' nu that is made exact, then moved with nu.
-        ``workers``: processes sharing the density's evaluations (forked once; the draws do not depend on it).
-        """
-        fit = mf.fit if mf.cut is None else mf.cut.fit  # under the cut: theta's posterior at the windows' nu
-        lik = mf.lik if mf.cut is None else Fixed(mf.lik, {"nu": mf.cut.nu0})
-        params = [mf.lik.model.parameters[name] for name in fit.names]
-        mode = np.array([float(p.to_unbounded(fit.mode[p.name])) for p in params])
-        cov = fit.cov_z if fit.cov_z is not None else np.eye(len(params)) * 1e-6
-        robust = robust_covariance(fit.jacobian, fit.whitened, cov, mf.lik.blocks(self.block))
-        model_prior = self.log_prior(mf.variants)
-        log_prior = model_prior if mf.cut is None else (lambda v: model_prior(dict(v) | {"nu": mf.cut.nu0}))
-
-        def log_post(z: np.ndarray) -> float:
-            vals = {p.name: float(p.from_unbounded(v)) for p, v in zip(params, z)}
-            lp = log_prior(vals)
-            if not np.isfinite(lp):
-                return -np.inf
-            try:
-                return lik.loglike(vals) + lp + sum(float(p.log_jacobian(v)) for p, v in zip(params, z))
-            except ValueError:  # parameters the simulator cannot run
-                return -np.inf
-
-        rng = stream(self.seed, "exact posterior", mf.label)
-        with ForkedPool(log_post, workers=workers) as pool:
-            ex = exact_draws(log_post, mode, cov, robust, rng=rng, n_importance=n, n_out=EXACT_DRAWS,
-                             map_rows=pool.map)
-        if mf.cut is None:
-            draws = {p.name: np.asarray(p.from_unbounded(ex.z_adjusted[:, i]), float) for i, p in enumerate(params)}
-        else:
-            draws = mf.cut.draws(params, ex.z_adjusted, stream(self.seed, "nu cut exact", mf.label))
-        f_eff = self._f_of(mf.variants, draws)
-        new_fit = replace(mf.fit, draws=draws, log_weights=np.full(EXACT_DRAWS, -math.log(EXACT_DRAWS)),
-                          pareto_k=ex.pareto_k, laplace_draws=mf.fit.laplace_draws or mf.fit.draws)
-        return replace(mf, fit=new_fit, f_effective=f_eff), ex
 
     def _calibration(self, lik: WholeRecordLikelihood, fit: WholeRecordFit, unit: Mapping[str, np.ndarray],
                      modulus_scale: tuple[float, float]) -> dict[str, tuple[float, float, float]]:

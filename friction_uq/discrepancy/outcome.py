@@ -13,7 +13,7 @@ from .diagnose import Diagnosis, ModelFit, Ranked
 from .diagnosed_f import member_variants, mixture_label
 from .diagnosis_words import baseline_hoop_gain, chain_gauge, hoop_gain_off, sentence
 from .effective_prior import log_prior_f_effective
-from .extended import IMPORTANCE_DRAWS
+from .exact_model import IMPORTANCE_DRAWS
 
 #: How the named model's posterior is obtained (the JSON's ``posterior_method`` says which route was taken).
 POSTERIOR_NOTE = ("exact posterior of the model with the named causes: 200 draws of its normal approximation (robust "
@@ -176,7 +176,7 @@ def posterior_method_of(dg: Diagnosis) -> str | None:
 
 def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
     """One group per fitted model under ``discrepancy``: the draws (posterior: the normal approximation's, and
-    for the model the headline f comes from its exact posterior's, :meth:`Diagnoser.exact_posterior`), beside
+    for the model the headline f comes from its exact posterior's, :func:`.exact_model.exact_posterior`), beside
     f_effective the log density of its prior at each draw (``log_prior_f_effective``, :mod:`.effective_prior`;
     ``f_prior``: the prior file's f prior), and the pointwise block elpd (log_likelihood)."""
     import xarray as xr
