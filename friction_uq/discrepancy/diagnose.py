@@ -112,8 +112,8 @@ class Diagnosis:
     #: the hoop gauge's calibration factor as the whole-record check reads it (f and nu free only: the model
     #: the misfit decision judges), when ``run`` made the check
     check_hoop_gain: float | None = None
-    #: the final model's normal approximation against its exact posterior (:func:`.exact_model.exact_posterior`), when a
-    #: cause was named: Pareto k, the kept draws' effective sample size, how the exact draws were obtained
+    #: the final model's normal approximation against its exact posterior (:func:`.exact_model.exact_posterior`),
+    #: when a cause was named: Pareto k, the kept draws' effective sample size, how the exact draws were obtained
     #: (friction_uq.stats.exact: "importance", "importance (second proposal)" or "emcee") and whether they reached
     #: the floor on their effective sample size within the caps
     pareto_k: float = float("nan")
