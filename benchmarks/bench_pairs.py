@@ -132,11 +132,14 @@ def named_alone(pair: tuple[str, str], j: int, axisymmetric: bool, k: int, state
     r = np.random.default_rng()
     r.bit_generator.state = state
     cfg, edit, header, _ = make_pair(pair, axisymmetric, k, r, keep=j)
-    write(cfg, path, sim_seed, edit, header)
     try:
+        write(cfg, path, sim_seed, edit, header)
         _, dg = analyse(path, priors, seed=k, max_causes=1)
+    except FrictionUQError as exc:  # refused alone as a pair may be: not named
+        return False, f"refused: {exc}"
     finally:
-        os.remove(path)
+        if os.path.exists(path):
+            os.remove(path)
     v = dg.verdicts[0]
     said = v.kind + (f" {v.named}" if v.named else "")
     return bool(dg.cause is not None and dg.cause.mechanism.name == pair[j]), said

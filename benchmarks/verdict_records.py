@@ -212,10 +212,11 @@ def main() -> None:
     ap.add_argument("--per", type=int, default=4, help="records of each mechanism group")
     ap.add_argument("--seed", type=int, default=17)
     ap.add_argument("--only", help="comma-separated groups")
-    ap.add_argument("--max-causes", type=int, default=1,
+    rounds = ap.add_mutually_exclusive_group()
+    rounds.add_argument("--max-causes", type=int, default=1,
                     help="rounds of diagnose (1: the first round, what is stored; 4: every round, as friction-uq "
                     "diagnose runs, to time it)")
-    ap.add_argument("--as-run", action="store_true", help="through friction_uq.run(..., diagnose=True), every round: "
+    rounds.add_argument("--as-run", action="store_true", help="through friction_uq.run(..., diagnose=True), every round: "
                     "the stationary analysis and the whole-record check included, as friction-uq diagnose times")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
