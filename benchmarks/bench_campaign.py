@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def campaign(records: list[Path], out: Path, *, workers: int, pdf: bool) -> tuple[float, list, dict]:
-    from friction_uq.campaign import run_campaign
+    from friction_uq.campaigns import run_campaign
 
     t0 = time.perf_counter()
     outcome = run_campaign(records, out, workers=workers, pdf=pdf, progress=True)
@@ -96,8 +96,8 @@ def simulated(args: argparse.Namespace) -> None:
 
 
 def analysis(args: argparse.Namespace) -> None:
-    from friction_uq.campaign.analysis import analyse
-    from friction_uq.campaign.job import read_result
+    from friction_uq.campaigns.analysis import analyse
+    from friction_uq.campaigns.job import read_result
 
     print(f"{'campaign':<40} {'tests':>5} {'diagnosed':>9} {'analysis s (each run)':>24} {'median s':>9}")
     for folder in args.dirs:

@@ -15,7 +15,7 @@ Laws (the simulator's, ``friction_uq/simulate/friction.py``) and the campaign la
 * ``pressure``: f = 0.09 / (1 + p / 200 MPa) (hyperbolic)     -> pressure
 * ``constant``: f = 0.05 (Coulomb)                            -> constant
 * ``slip``: f from 0.08 to 0.04 over 3 mm of slip (linear)    -> slip (read from kappa's change across each
-  test's window: the window means alone cannot tell it from velocity, ``friction_uq.campaign.laws``)
+  test's window: the window means alone cannot tell it from velocity, ``friction_uq.campaigns.laws``)
 
 Per design, simulator and law: campaigns, how often the true law carries the largest stacking weight, how
 often it is among the laws the verdict names, how often "constant" is named on a non-constant law, how
@@ -111,7 +111,7 @@ def campaign_configs(design: str, law: str, simulator: str, seed: int) -> list:
 
 def one_campaign(design: str, law: str, simulator: str, seed: int, *, workers: int, tmp: Path) -> dict:
     """Simulate and run one campaign; its verdict as the study reads it."""
-    from friction_uq.campaign import run_campaign
+    from friction_uq.campaigns import run_campaign
     from friction_uq.simulate import simulate_to_file
 
     folder = tmp / f"{design}-{law}-{simulator}-{seed}"

@@ -47,7 +47,7 @@ from friction_uq.discrepancy.whole_record import TIMING_TOLERANCE, TOLERANCE  # 
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
-from friction_uq.run.alongside import whole_record_start  # noqa: E402
+from friction_uq.record_run.alongside import whole_record_start  # noqa: E402
 
 #: Relative tolerances tried.
 RELATIVE = (0.01, 0.015, 0.02, 0.03, 0.04, 0.05, 0.07, 0.10)

@@ -49,7 +49,7 @@ from friction_uq.models.parameters import F  # noqa: E402
 from friction_uq.models.simulator import NU  # noqa: E402
 from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
-from friction_uq.run.alongside import whole_record_start  # noqa: E402
+from friction_uq.record_run.alongside import whole_record_start  # noqa: E402
 
 
 def baseline_f(path: str, f_true: float) -> dict[str, float]:

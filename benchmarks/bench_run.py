@@ -82,7 +82,7 @@ def breakdown(record: Path, pdf: bool) -> None:
     code = f"""
 import time, tempfile
 t0 = time.perf_counter()
-from friction_uq.run import run_file
+from friction_uq.record_run import run_file
 {'import friction_uq.report.pdf' if pdf else ''}
 imports = time.perf_counter() - t0
 import arviz_stats, xarray as xr

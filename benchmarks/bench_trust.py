@@ -5,7 +5,7 @@ ranges (both bundled set-ups, f, nu, striker speed, rise time and noise as ``ben
 stick-slip (a steep velocity weakening, with and without a clearance), strongly coloured gauge
 noise (lag-1 coefficient 0.9-0.995), a gauge's zero drifting through the record, an output gauge's
 gain 0.9-1.1, a gauge's sign flipped, and the hidden mechanisms of the catalogue; plus clean
-records. Each goes through ``run``'s path (:func:`friction_uq.run.pipeline.run_file`, whole-record
+records. Each goes through ``run``'s path (:func:`friction_uq.record_run.pipeline.run_file`, whole-record
 check included, no PDF); a record refused for "no stationary phase" (stick-slip breaks the
 window's steadiness test) is counted as refused and then analysed with a window given by hand over
 the plateau, as a lab would.
@@ -43,7 +43,7 @@ from bench_misfit import clean_config, with_gain  # noqa: E402
 
 from friction_uq.errors import FrictionUQError, NoStationaryPhase  # noqa: E402
 from friction_uq.record import write_record  # noqa: E402
-from friction_uq.run.pipeline import run_file  # noqa: E402
+from friction_uq.record_run.pipeline import run_file  # noqa: E402
 from friction_uq.simulate import simulate  # noqa: E402
 from friction_uq.simulate.simulation import MODEL_VERSION  # noqa: E402
 

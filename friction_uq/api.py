@@ -33,7 +33,7 @@ class Result:
     json_path, netcdf_path, pdf_path : Path or None
         The files written side by side.
     details : object or None
-        The in-process :class:`friction_uq.run.RunResult` when the result comes from :func:`run` in
+        The in-process :class:`friction_uq.record_run.RunResult` when the result comes from :func:`run` in
         this process (forces, window, draws); None when read back from files.
     """
 
@@ -129,7 +129,7 @@ def run(path: str | os.PathLike[str], *, priors: str | os.PathLike[str] | None =
     Result
         The JSON document and the files; ``details`` holds the in-process run.
     """
-    from .run import run_file
+    from .record_run import run_file
 
     rr = run_file(path, priors_path=priors, out_dir=out_dir, seed=seed, window=window, dispersion=dispersion,
                   hoop=hoop, pdf=pdf, progress=progress, table=progress, notes=progress, diagnose=diagnose)
@@ -163,11 +163,11 @@ def campaign(records: Sequence[str | os.PathLike[str]], out_dir: str | os.PathLi
 
     Returns
     -------
-    friction_uq.campaign.CampaignOutcome
+    friction_uq.campaigns.CampaignOutcome
         ``.doc`` is the campaign's JSON document, ``.outputs`` the files written; each record's
         result reads back with :func:`read_result` from ``out_dir/records``.
     """
-    from .campaign import run_campaign
+    from .campaigns import run_campaign
 
     return run_campaign(records, out_dir, workers=workers, scheduler=scheduler, seed=seed, priors_path=priors,
                         dispersion=dispersion, hoop=hoop, pdf=pdf, diagnose=diagnose, progress=progress)

@@ -331,7 +331,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         if args.output:
             _output_file(args.output, FIGURE_SUFFIXES, "figure")
         _check_results(args.results)
-        from .campaign import compare, comparison_table
+        from .campaigns import compare, comparison_table
 
         comp = compare(args.results)
         print(comparison_table(comp))
@@ -353,7 +353,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         from .priors import default_prior_path, load_priors
 
         load_priors(args.priors or default_prior_path(rec.apparatus.sample.material))
-        from .run import run_file
+        from .record_run import run_file
 
         run_file(
             args.file, priors_path=args.priors, out_dir=args.out, seed=args.seed, window=args.window,
@@ -398,7 +398,7 @@ def _add_campaign_parser(sub) -> None:
 
 
 def _campaign(args: argparse.Namespace) -> int:
-    from .campaign import run_campaign, summary_text
+    from .campaigns import run_campaign, summary_text
 
     outcome = run_campaign(args.records, args.out, workers=args.workers, scheduler=args.scheduler, seed=args.seed,
                            priors_path=args.priors, dispersion=args.dispersion, hoop=not args.no_hoop,

@@ -29,8 +29,8 @@ def test_the_interface_is_listed_and_documented():
 def test_run_and_campaign_stay_the_functions_once_their_subpackages_load():
     import inspect
 
-    import friction_uq.campaign  # noqa: F401  (binds the subpackage's name on the package)
-    import friction_uq.run  # noqa: F401
+    import friction_uq.campaigns  # noqa: F401  (binds the subpackage's name on the package)
+    import friction_uq.record_run  # noqa: F401
 
     assert callable(fu.run) and callable(fu.campaign)
     assert "priors" in inspect.signature(fu.run).parameters

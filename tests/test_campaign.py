@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from friction_uq.campaign import compare, comparison_table, fit_trend, load_result
+from friction_uq.campaigns import compare, comparison_table, fit_trend, load_result
 from friction_uq.cli import main
 from friction_uq.errors import FrictionUQError
 
@@ -42,7 +42,7 @@ def test_joint_fit_separates_velocity_from_pressure(two_campaigns):
 
 def test_weighted_fit_matches_closed_form_least_squares():
     rng = np.random.default_rng(1)
-    from friction_uq.campaign import TestResult
+    from friction_uq.campaigns import TestResult
 
     V = np.linspace(5, 12, 6)
     sd = np.full(6, 3e-4)

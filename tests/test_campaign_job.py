@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from friction_uq.campaign import RecordResult, read_result
-from friction_uq.campaign.job import SCHEMA_VERSION, _up_to_date, write_result
+from friction_uq.campaigns import RecordResult, read_result
+from friction_uq.campaigns.job import SCHEMA_VERSION, _up_to_date, write_result
 from friction_uq.cli import main
 from friction_uq.errors import FrictionUQError
 from friction_uq.synthetic import ClosedFormTest, write_closed_form_record
@@ -55,7 +55,7 @@ def test_up_to_date_needs_same_record_settings_prior_version_and_outputs(tmp_pat
     import hashlib
 
     (tmp_path / "A_A-01.nc").write_bytes(b"draws")  # the run JSON names the .nc's checksum
-    from friction_uq.run.outputs import RUN_SCHEMA_VERSION
+    from friction_uq.record_run.outputs import RUN_SCHEMA_VERSION
 
     run_json = {"schema_version": RUN_SCHEMA_VERSION, "outputs": {"netcdf": {
         "file": "A_A-01.nc", "sha256": hashlib.sha256(b"draws").hexdigest()}, "pdf": None}}

@@ -1,4 +1,4 @@
-"""How long a friction law's emcee chain runs (friction_uq.campaign.law_chain, read by laws.Fit): on from its first
+"""How long a friction law's emcee chain runs (friction_uq.campaigns.law_chain, read by laws.Fit): on from its first
 length until the part kept is TAU_MULTIPLE autocorrelation times long, up to MAX_STEPS. The time estimate is checked on an AR(1)
 chain, whose integrated autocorrelation time is (1 + rho) / (1 - rho) in closed form."""
 
@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from friction_uq.campaign.law_chain import (BURN_TAUS, MAX_STEPS, TAU_MULTIPLE, chain_length_needed,
+from friction_uq.campaigns.law_chain import (BURN_TAUS, MAX_STEPS, TAU_MULTIPLE, chain_length_needed,
                                             max_autocorr_time)
-from friction_uq.campaign.laws import Fit, LawData, Model
+from friction_uq.campaigns.laws import Fit, LawData, Model
 
 
 def _ar1_chain(rho: float, steps: int, walkers: int, dims: int, seed: int) -> np.ndarray:

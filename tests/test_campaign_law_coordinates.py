@@ -1,4 +1,4 @@
-"""The coordinates the friction laws are sampled in (friction_uq.campaign.law_coordinates): a change of variables
+"""The coordinates the friction laws are sampled in (friction_uq.campaigns.law_coordinates): a change of variables
 with its Jacobian, so the same posterior; checked by a round trip, the Jacobian against finite differences, and
 sampling the prior through the change."""
 
@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from friction_uq.campaign.law_coordinates import LawCoordinates
-from friction_uq.campaign.laws import LOG_VC_RANGE
+from friction_uq.campaigns.law_coordinates import LawCoordinates
+from friction_uq.campaigns.laws import LOG_VC_RANGE
 
 PARAMS = ("d", "s", "log_vc", "amp_p", "log_pc", "r")  # pressure+velocity's
 V = np.array([5.5, 7.0, 9.0, 12.5])

@@ -1,4 +1,4 @@
-"""The points a friction law's likelihood reads (friction_uq.campaign.law_points), stacked into one evaluation:
+"""The points a friction law's likelihood reads (friction_uq.campaigns.law_points), stacked into one evaluation:
 the law at each point set is the law evaluated there alone, and a fit's likelihood on other data reads that data's
 points (its own steps), as a fit on that data does."""
 
@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from friction_uq.campaign.law_data import LawData
-from friction_uq.campaign.law_forms import law_mean
-from friction_uq.campaign.law_points import STEP, LawPoints
-from friction_uq.campaign.law_windows import halves_points
-from friction_uq.campaign.laws import Fit, Model
+from friction_uq.campaigns.law_data import LawData
+from friction_uq.campaigns.law_forms import law_mean
+from friction_uq.campaigns.law_points import STEP, LawPoints
+from friction_uq.campaigns.law_windows import halves_points
+from friction_uq.campaigns.laws import Fit, Model
 
 
 def _data(n: int = 4) -> LawData:
@@ -60,7 +60,7 @@ def test_the_likelihood_on_other_data_reads_their_points():
 def test_the_prior_is_the_documented_one_at_and_beyond_each_support():
     """laws' docstring: levels uniform on (0, 5), amp_p on (-5, 5), log scales on their ranges, cal ~ N(0, 0.03),
     delta ~ N(0, 0.3) (both above -1), r half-normal(0.1) on [0, inf)."""
-    from friction_uq.campaign.law_forms import LOG_PC_RANGE
+    from friction_uq.campaigns.law_forms import LOG_PC_RANGE
 
     d = _data(4)
     model = Model("pressure+velocity", "B", ("B",))

@@ -8,12 +8,12 @@ import json
 import numpy as np
 import pytest
 
-from friction_uq.campaign import RecordResult
-from friction_uq.campaign.analysis import WEIGHT_RULE, RecordPosterior, analyse_tests, supported_laws, verdict
-from friction_uq.campaign.law_comparison import SLIP_CAVEAT
-from friction_uq.campaign.flags import causes_sentence, setup_flags, tally_causes
-from friction_uq.campaign.laws import Elpd, Model
-from friction_uq.campaign.outputs import campaign_doc, summary_text, write_netcdf
+from friction_uq.campaigns import RecordResult
+from friction_uq.campaigns.analysis import WEIGHT_RULE, RecordPosterior, analyse_tests, supported_laws, verdict
+from friction_uq.campaigns.law_comparison import SLIP_CAVEAT
+from friction_uq.campaigns.flags import causes_sentence, setup_flags, tally_causes
+from friction_uq.campaigns.laws import Elpd, Model
+from friction_uq.campaigns.outputs import campaign_doc, summary_text, write_netcdf
 from friction_uq.priors import PRIORS_DIR
 from friction_uq.report.campaign_pages import write_campaign_report
 
@@ -140,7 +140,7 @@ def test_f_under_the_diagnosed_model_is_read_from_the_group_the_record_names(tmp
     nothing (no diagnosis, or a version before the attribute: the law falls back to kappa)."""
     import xarray as xr
 
-    from friction_uq.campaign.analysis import read_test_posterior
+    from friction_uq.campaigns.analysis import read_test_posterior
 
     rng = np.random.default_rng(0)
     post = {k: (("chain", "draw"), rng.normal(m, 0.01 * m, (2, 500)))
@@ -170,7 +170,7 @@ def test_a_constant_friction_campaign_names_constant_and_flags_nothing():
     # or not separated from them), f is never said to vary, and nothing is flagged
     assert "constant" in WEIGHT_RULE.supported(ca.weights) and ca.flagged == []
     assert not any(s.startswith("f is not constant") for s in ca.sentences)
-    from friction_uq.campaign.analysis import f_law_draws
+    from friction_uq.campaigns.analysis import f_law_draws
 
     f = f_law_draws(ca.fits["constant"], ca.nu, seed=0)["f"]
     assert np.quantile(f, 0.05) < 0.05 < np.quantile(f, 0.95)
@@ -203,7 +203,7 @@ def test_the_verdict_reads_the_weights_and_never_defaults_to_constant():
 def _compared(pointwise: dict[str, list[float]]) -> tuple[dict[str, float], list[dict[str, object]]]:
     """Stacking weights and ranking of laws from their pointwise leave-one-test-out densities, as a campaign
     computes them."""
-    from friction_uq.campaign.laws import rank
+    from friction_uq.campaigns.laws import rank
     from friction_uq.stats import stacking_weights
 
     pw = {k: np.asarray(v, float) for k, v in pointwise.items()}
@@ -294,7 +294,7 @@ def test_the_supported_set_does_not_follow_where_stacking_put_its_weight():
     from friction_uq.stats import RULE
 
     assert RULE.min_delpd == 4.0  # the richer-law margin of supported_laws is the rule's
-    from friction_uq.campaign.analysis import supported_laws
+    from friction_uq.campaigns.analysis import supported_laws
 
     row = lambda m, d, se: {"model": m, "d_elpd": d, "d_se": se, "n_tests": 10}  # noqa: E731
     seeds = [
@@ -344,7 +344,7 @@ def test_with_two_setups_the_causes_name_the_one_that_is_off():
 
 def test_decisive_uses_students_t_for_few_tests():
     """The law chosen: constant, unless velocity (the top) is decisively ahead of it over the tests."""
-    from friction_uq.campaign.laws import LAWS, best_law
+    from friction_uq.campaigns.laws import LAWS, best_law
 
     def decisive(d: float, se: float, n: int | None = None) -> bool:
         rows = [{"model": "velocity", "d_elpd": 0.0, "d_se": 0.0}, {"model": "constant", "d_elpd": d, "d_se": se}]
@@ -360,7 +360,7 @@ def test_decisive_uses_students_t_for_few_tests():
 
 
 def _one_test_data(draws, *, scale=1.0):
-    from friction_uq.campaign.laws import LawData
+    from friction_uq.campaigns.laws import LawData
 
     x = np.asarray(draws, float)
     arr = lambda v: np.array([v], float)  # noqa: E731
@@ -371,7 +371,7 @@ def _one_test_data(draws, *, scale=1.0):
 def _constant_fit(data):
     from dataclasses import replace
 
-    from friction_uq.campaign.laws import Fit
+    from friction_uq.campaigns.laws import Fit
 
     fit_kde = Fit(Model("constant"), data, kbar=1.0, p_ref=1e8, seed=0, nsteps=2, burn=0, max_steps=2)
     fit_normal = Fit(Model("constant"), replace(data, draws=None), kbar=1.0, p_ref=1e8, seed=0, nsteps=2,

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from friction_uq.campaign import RecordResult
-from friction_uq.campaign.analysis import RecordPosterior, analyse_tests, read_test_posterior
-from friction_uq.campaign.flags import tally_causes
-from friction_uq.campaign.outputs import SCHEMA_VERSION, campaign_doc, summary_text, write_netcdf
-from friction_uq.campaign.pooling import StoredDraws, pool
+from friction_uq.campaigns import RecordResult
+from friction_uq.campaigns.analysis import RecordPosterior, analyse_tests, read_test_posterior
+from friction_uq.campaigns.flags import tally_causes
+from friction_uq.campaigns.outputs import SCHEMA_VERSION, campaign_doc, summary_text, write_netcdf
+from friction_uq.campaigns.pooling import StoredDraws, pool
 from friction_uq.priors import PRIORS_DIR, load_priors
 from friction_uq.report.campaign_pages import write_campaign_report
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from friction_uq.campaign.pooling import StoredDraws, implied_kappa_log_prior, pool
+from friction_uq.campaigns.pooling import StoredDraws, implied_kappa_log_prior, pool
 from friction_uq.priors import PRIORS_DIR, load_priors
 
 

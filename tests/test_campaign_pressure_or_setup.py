@@ -1,5 +1,5 @@
 """Two set-ups at different pressures: a pressure term and an offset of one set-up are told apart only by the
-pressures within each set-up (friction_uq.campaign.analysis, ``_Laws.offset_alternative``). A velocity-weakening
+pressures within each set-up (friction_uq.campaigns.analysis, ``_Laws.offset_alternative``). A velocity-weakening
 wall whose second set-up reads 20 % high (a plug friction the stationary analysis cannot see) is not a pressure
 law; a pressure law measured without an offset is not a set-up flag. The three campaigns' sampled law comparisons
 are slow studies (-m slow); the rule that reads them is tested here on fixed densities in the default suite."""
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from friction_uq.campaign.analysis import RecordPosterior, analyse_tests, supported_laws
+from friction_uq.campaigns.analysis import RecordPosterior, analyse_tests, supported_laws
 from friction_uq.priors import PRIORS_DIR
 
 PRIOR = str(PRIORS_DIR / "I1.toml")
@@ -81,8 +81,8 @@ def _alternative(with_offset: np.ndarray, without: np.ndarray) -> dict:
     ``without`` (another 30 nats behind), those with it, the best ``with_offset`` (another 30 behind)."""
     from types import SimpleNamespace
 
-    from friction_uq.campaign.law_comparison import LawComparison
-    from friction_uq.campaign.laws import Elpd
+    from friction_uq.campaigns.law_comparison import LawComparison
+    from friction_uq.campaigns.laws import Elpd
 
     def elpd(name, pw):
         return Elpd(name, float(np.sum(pw)), 0.0, np.asarray(pw, float), np.zeros(len(pw)), 0)

@@ -11,8 +11,8 @@ import cloudpickle
 import numpy as np
 import pytest
 
-from friction_uq.campaign import RecordResult, RecordTask, find_records, make_tasks, read_header, run_tasks
-from friction_uq.campaign.runner import Progress, check_headers
+from friction_uq.campaigns import RecordResult, RecordTask, find_records, make_tasks, read_header, run_tasks
+from friction_uq.campaigns.runner import Progress, check_headers
 from friction_uq.cli import main
 from friction_uq.errors import FrictionUQError
 from friction_uq.record import paper_apparatus

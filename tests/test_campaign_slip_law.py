@@ -8,13 +8,13 @@ import json
 import numpy as np
 import pytest
 
-from friction_uq.campaign import RecordResult
-from friction_uq.campaign.outputs import campaign_doc, summary_text
+from friction_uq.campaigns import RecordResult
+from friction_uq.campaigns.outputs import campaign_doc, summary_text
 from friction_uq.report.campaign_pages import write_campaign_report
-from friction_uq.campaign.analysis import RecordPosterior, analyse_tests, supported_laws
-from friction_uq.campaign.flags import tally_causes
-from friction_uq.campaign.law_comparison import SLIP_CAVEAT
-from friction_uq.campaign.laws import LAWS, TREND_FLOOR
+from friction_uq.campaigns.analysis import RecordPosterior, analyse_tests, supported_laws
+from friction_uq.campaigns.flags import tally_causes
+from friction_uq.campaigns.law_comparison import SLIP_CAVEAT
+from friction_uq.campaigns.laws import LAWS, TREND_FLOOR
 from friction_uq.priors import PRIORS_DIR
 from friction_uq.window_halves import WindowHalves
 
@@ -98,7 +98,7 @@ def test_without_the_windows_changes_the_slip_law_is_left_out_and_said():
 def test_laws_fitted_to_f_under_diagnosed_models_leave_the_slip_law_out():
     """A named cause (a plug friction, a clearance) changes kappa across the window by itself: the stationary change
     is not read against f under the diagnosed model."""
-    from friction_uq.campaign.analysis import _law_data
+    from friction_uq.campaigns.analysis import _law_data
 
     rng = np.random.default_rng(8)
     tests = [_test(rng, f"{s}-0{k + 1}", s, V, f_velocity) for s in ("A", "B") for k, V in enumerate((7.0, 10.0, 13.0))]
@@ -120,9 +120,9 @@ def test_the_window_term_is_a_student_t_of_the_changes_error_and_the_model_form_
     """law_windows' hand-written density against scipy's, on the velocity law at two draws."""
     from scipy import stats
 
-    from friction_uq.campaign.law_data import LawData
-    from friction_uq.campaign.law_forms import law_mean
-    from friction_uq.campaign.law_windows import TREND_DOF, TREND_REL, change_loglike, halves_points
+    from friction_uq.campaigns.law_data import LawData
+    from friction_uq.campaigns.law_forms import law_mean
+    from friction_uq.campaigns.law_windows import TREND_DOF, TREND_REL, change_loglike, halves_points
 
     halves = np.array([[[1e-3, 6.0, 1.01], [2e-3, 6.1, 0.99]], [[2e-3, 12.0, 1.0], [4e-3, 12.1, 1.0]]])
     d = LawData(["A-01", "A-02"], ["A", "A"], np.ones(2), np.full(2, 0.01), np.array([6.05, 12.05]),

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from friction_uq.campaign import run_campaign
-from friction_uq.campaign.analysis import RecordPosterior, analyse_tests, supported_laws
-from friction_uq.campaign.flags import tally_causes
+from friction_uq.campaigns import run_campaign
+from friction_uq.campaigns.analysis import RecordPosterior, analyse_tests, supported_laws
+from friction_uq.campaigns.flags import tally_causes
 from friction_uq.priors import PRIORS_DIR
 
 DATA = Path(__file__).resolve().parents[1] / "data"
@@ -32,7 +32,7 @@ def _verdict(ca) -> tuple:
 @pytest.mark.slow  # five campaigns of the ten bundled records without PDF reports, about 6.5 minutes on 2 cores
 def test_the_bundled_campaign_gives_one_verdict_over_five_seeds(tmp_path):
     """The laws' fits are sampled in coordinates where their autocorrelation time is tens of steps
-    (friction_uq/campaign/law_coordinates.py); before, it was 200-250 steps against 700 kept, the fits' tails
+    (friction_uq/campaigns/law_coordinates.py); before, it was 200-250 steps against 700 kept, the fits' tails
     followed the seed, and so did the verdict (seed 4 read pressure+velocity with no set-up flagged, the others
     named laws and flagged B). The verdict asserted is what every seed reads: f not constant, constant not among
     the laws named, and set-up B flagged (it departs from the shared law by more than its calibration allows;
@@ -40,7 +40,7 @@ def test_the_bundled_campaign_gives_one_verdict_over_five_seeds(tmp_path):
     seeds, not fixed here; the measured ELPDs and weights, which move with the law's form, are in
     docs/validation.md ("Campaigns on the bundled data"). With other numerical libraries (thirtieth session) seed 5
     fell below the flag's 4-nat line again: the fits' chains were a few autocorrelation times long; run on to 50
-    (friction_uq/campaign/law_chain.py, TAU_MULTIPLE), the flag's dELPD is 4.2-4.6 on every records and fit seed tried."""
+    (friction_uq/campaigns/law_chain.py, TAU_MULTIPLE), the flag's dELPD is 4.2-4.6 on every records and fit seed tried."""
     records = sorted(DATA.glob("[AB]/*.h5"))
     verdicts = [_verdict(run_campaign(records, tmp_path / f"s{seed}", seed=seed, pdf=False, progress=False).analysis)
                 for seed in range(1, 6)]

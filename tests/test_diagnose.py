@@ -539,7 +539,7 @@ def test_the_words_of_a_further_mixture_name_the_further_causes():
     from friction_uq.discrepancy.diagnosed_f import further, headline, unresolved
     from friction_uq.discrepancy.extended import Variant
     from friction_uq.report.quote import f_to_quote
-    from friction_uq.run.warnings import _next_step
+    from friction_uq.record_run.warnings import _next_step
 
     clearance = Variant(MECHANISMS["clearance"])
     gain = Variant(MECHANISMS["gauge_gain"], "external_output_bar")
@@ -574,7 +574,7 @@ def test_with_no_cause_named_the_f_to_quote_is_half_the_stationary_analysis():
     from friction_uq.discrepancy.diagnosed_f import _folded, folded_sd_of, headline, mixture_label
     from friction_uq.discrepancy.diagnosis_words import sentence
     from friction_uq.quoted import folded_sd
-    from friction_uq.run.warnings import _next_step
+    from friction_uq.record_run.warnings import _next_step
 
     base = SimpleNamespace(label="baseline", variants=(), f_effective=np.full(500, 0.060))
     from friction_uq.discrepancy.extended import Variant

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from friction_uq import _atomic, plausible
-from friction_uq.campaign import job, runner
+from friction_uq.campaigns import job, runner
 from friction_uq.cli import main
 from friction_uq.errors import PriorError, RecordError
 from friction_uq.priors import PRIORS_DIR, check_material_name, default_prior_path, load_priors
@@ -151,7 +151,7 @@ def test_a_killed_runs_forked_child_does_not_hold_its_lock(tmp_path):
 def test_a_record_locked_by_a_dying_worker_is_waited_for(good_record, tmp_path, monkeypatch):
     """Inside a campaign's folder only a killed campaign's worker can hold a record's lock: the job waits for
     it to end instead of failing the record."""
-    import friction_uq.run
+    import friction_uq.record_run
 
     calls = []
 
@@ -161,7 +161,7 @@ def test_a_record_locked_by_a_dying_worker_is_waited_for(good_record, tmp_path, 
             raise _atomic.LockedError("out: another friction-uq run is writing A_A-01 into this folder")
         raise job.FrictionUQError("analysed")  # the third try gets the lock (and stops here: no sampling)
 
-    monkeypatch.setattr(friction_uq.run, "run_file", locked_twice)
+    monkeypatch.setattr(friction_uq.record_run, "run_file", locked_twice)
     monkeypatch.setattr(job.time, "sleep", lambda s: None)
     r = job.run_record(job.RecordTask(path=str(good_record), seed=1, out_dir=str(tmp_path)))
     assert len(calls) == 3 and r.status == "failed" and r.message == "analysed"
@@ -170,7 +170,7 @@ def test_a_record_locked_by_a_dying_worker_is_waited_for(good_record, tmp_path, 
 def _stored(tmp_path: Path, nc: bytes = b"netcdf bytes") -> job.RecordResult:
     import hashlib
 
-    from friction_uq.run.outputs import RUN_SCHEMA_VERSION
+    from friction_uq.record_run.outputs import RUN_SCHEMA_VERSION
 
     (tmp_path / "s.nc").write_bytes(nc)
     (tmp_path / "s.json").write_text(json.dumps({"schema_version": RUN_SCHEMA_VERSION, "outputs": {"netcdf": {
@@ -465,7 +465,7 @@ def test_nothing_is_written_to_tmpdir(monkeypatch, tmp_path):
 
     import xarray as xr
 
-    from friction_uq.run import netcdf_bytes
+    from friction_uq.record_run import netcdf_bytes
 
     def refuse(*args, **kwargs):
         raise AssertionError("TMPDIR used")
@@ -540,8 +540,8 @@ def test_ctrl_c_is_one_line_exit_130_and_keeps_the_checkpoint(tmp_path):
 _CAMPAIGN_SCRIPT = """
 import sys, time
 from pathlib import Path
-from friction_uq.campaign.job import RecordResult, RecordTask
-from friction_uq.campaign.runner import run_tasks
+from friction_uq.campaigns.job import RecordResult, RecordTask
+from friction_uq.campaigns.runner import run_tasks
 
 def job(task):
     Path(task.out_dir, task.path + ".started").touch()

@@ -149,7 +149,7 @@ def test_a_forked_map_gives_in_order_the_values_of_a_map_in_line():
 
 
 def test_the_campaign_law_comparison_is_the_same_on_one_or_two_processes(monkeypatch):
-    from friction_uq.campaign import analysis, law_comparison
+    from friction_uq.campaigns import analysis, law_comparison
 
     tests = _campaign_tests()
     runs = []
@@ -162,7 +162,7 @@ def test_the_campaign_law_comparison_is_the_same_on_one_or_two_processes(monkeyp
 
 def _campaign_tests():
     """Six tests of a velocity-weakening wall on one set-up, drawn once."""
-    from friction_uq.campaign.analysis import RecordPosterior
+    from friction_uq.campaigns.analysis import RecordPosterior
     from friction_uq.priors import PRIORS_DIR
 
     rng = np.random.default_rng(2)

@@ -10,7 +10,7 @@ from scipy import stats
 from friction_uq.cli import main
 from friction_uq.errors import PriorError
 from friction_uq.priors import PRIORS_DIR, default_prior_path, load_priors, prior_files
-from friction_uq.run.inputs import alternative_nu_priors
+from friction_uq.record_run.inputs import alternative_nu_priors
 
 
 def test_shipped_priors_are_the_repositorys_top_level_folder():

@@ -324,7 +324,7 @@ def test_a_superfluous_candidate_in_the_sentence_the_f_to_quote_and_the_warning(
     from friction_uq.discrepancy.diagnose import Diagnosis, _mixture_after_causes
     from friction_uq.discrepancy.diagnosis_words import sentence
     from friction_uq.report.quote import f_to_quote
-    from friction_uq.run.warnings import _next_step
+    from friction_uq.record_run.warnings import _next_step
 
     causes, verdicts, rounds, final = _record(first_rivals=("clearance",))
     good = np.asarray(final.elpd.pointwise)

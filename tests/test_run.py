@@ -259,7 +259,7 @@ def test_a_uniform_prior_is_run_and_its_power_scaling_is_zero(paper_run, tmp_pat
 
 
 def test_run_file_can_run_silently(paper_run, tmp_path, capsys):
-    from friction_uq.run import run_file
+    from friction_uq.record_run import run_file
 
     _, _, rec = paper_run
     res = run_file(rec, out_dir=tmp_path / "o", seed=9, pdf=False, progress=False, table=False, notes=False)

@@ -154,7 +154,7 @@ def test_emcee_runs_its_chain_until_its_effective_size_reaches_the_floor_and_rep
 def test_a_short_exact_posterior_is_a_warning_that_names_its_effective_size():
     from types import SimpleNamespace
 
-    from friction_uq.run.warnings import exact_posterior_warning
+    from friction_uq.record_run.warnings import exact_posterior_warning
 
     dg = SimpleNamespace(causes=("clearance",), posterior_converged=False, posterior_method="emcee", importance_ess=64.2)
     text = exact_posterior_warning(dg)

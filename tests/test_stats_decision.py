@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from friction_uq.campaign.analysis import supported_laws
-from friction_uq.campaign.law_comparison import simplest_supported
-from friction_uq.campaign.flags import setup_flags
-from friction_uq.campaign.laws import LAWS, Elpd, best_law, rank
+from friction_uq.campaigns.analysis import supported_laws
+from friction_uq.campaigns.law_comparison import simplest_supported
+from friction_uq.campaigns.flags import setup_flags
+from friction_uq.campaigns.laws import LAWS, Elpd, best_law, rank
 from friction_uq.discrepancy.diagnose import Ranked
 from friction_uq.discrepancy.elpd import Elpd as RecordElpd, elpd_difference
 from friction_uq.shpb.diagnose import Candidate

@@ -17,7 +17,7 @@ from friction_uq.analysis import prepare
 from friction_uq.errors import SignalError
 from friction_uq.physics import cell
 from friction_uq.record import read_record, write_record
-from friction_uq.run.pipeline import run_file
+from friction_uq.record_run.pipeline import run_file
 from friction_uq.simulate import simulate
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "benchmarks"))

@@ -1,5 +1,5 @@
 """The prior of f_effective under an extended model, the prior its draws were made under: a campaign
-that pools f under each test's diagnosed model divides it out (friction_uq.campaign.pooling).
+that pools f under each test's diagnosed model divides it out (friction_uq.campaigns.pooling).
 
 A model's draws are of the base f (under the prior file's f prior), nu, the sample's modulus and the
 mechanisms' parameters theta (each under its own prior, :mod:`.mechanisms`), all independent;

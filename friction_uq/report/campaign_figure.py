@@ -12,7 +12,7 @@ import numpy as np
 from .style import RC, figure, save_figure
 
 
-#: What is drawn is friction_uq.campaign.compare.Comparison, read by its attributes: the report sits below the campaign
+#: What is drawn is friction_uq.campaigns.compare.Comparison, read by its attributes: the report sits below the campaign
 #: stage and does not import it.
 Comparison = Any
 

@@ -14,7 +14,7 @@ import numpy as np
 from .._atomic import write_bytes
 from .style import RC, figure
 
-#: What is drawn is friction_uq.campaign.analysis.CampaignAnalysis, read by its attributes: the report sits below the campaign
+#: What is drawn is friction_uq.campaigns.analysis.CampaignAnalysis, read by its attributes: the report sits below the campaign
 #: stage and does not import it.
 CampaignAnalysis = Any
 

@@ -52,7 +52,7 @@ class ReportInputs:
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
     likelihood: object | None = None  # friction_uq.likelihood.Likelihood, built once by run
-    warnings: tuple[str, ...] = ()  # the run's checks that failed (friction_uq.run.warnings), shown first
+    warnings: tuple[str, ...] = ()  # the run's checks that failed (friction_uq.record_run.warnings), shown first
     halves: WindowHalves | None = None  # kappa's change across the window (the run JSON's window_halves)
 
 

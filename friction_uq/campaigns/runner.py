@@ -88,7 +88,7 @@ def check_headers(headers: Sequence[RecordHeader]) -> None:
     """Refuse a campaign that mixes sample materials, names one record (or one test id) twice, or has two
     records whose output names collide (``A_B``/``C`` and ``A``/``B_C`` both write ``A_B_C.*``; names that
     differ only in case collide on some file systems)."""
-    from ..run import safe_stem
+    from ..record_run import safe_stem
 
     by_material: dict[str, list[str]] = {}
     for h in headers:

@@ -1,6 +1,6 @@
 """The stages of ``friction-uq run`` before its outputs: the inputs checked and the signals prepared
 (:func:`set_up`), then the stationary posterior and what is read from it (:func:`stationary_posterior`).
-:func:`friction_uq.run.pipeline.run_file` calls them in that order, between the output folder's lock and
+:func:`friction_uq.record_run.pipeline.run_file` calls them in that order, between the output folder's lock and
 the writing of the outputs.
 """
 

@@ -14,7 +14,3 @@ from .pipeline import JSON_VARIABLES, RunResult, run_file
 __all__ = ["JSON_VARIABLES", "RunResult", "alternative_nu_priors", "hoop_unusable", "netcdf_bytes", "run_file",
            "safe_stem", "sliding_velocity_summary", "summary_table"]
 
-
-from .._callable import make_callable  # noqa: E402
-
-make_callable(__name__, "run")  # friction_uq.run(...) is the interface's function even once this package is loaded

@@ -88,7 +88,7 @@ def load_result(path: str | os.PathLike[str]) -> TestResult:
         raise FrictionUQError(f"{p}: not a friction-uq result file ({exc})") from None
     if not isinstance(doc, dict):
         raise FrictionUQError(f"{p}: not a friction-uq run result (a JSON {type(doc).__name__}, not an object)")
-    from ..run.outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION
+    from ..record_run.outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION
 
     # schema 1 files carry neither key; every later one carries both
     if "schema" in doc or "schema_version" in doc:

@@ -120,7 +120,3 @@ __all__ = [
     "summary_text",
 ]
 
-
-from .._callable import make_callable  # noqa: E402
-
-make_callable(__name__, "campaign")  # friction_uq.campaign(...) is the interface's function even once this package is loaded

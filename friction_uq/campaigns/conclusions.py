@@ -1,5 +1,5 @@
 """What a campaign's analysis concludes, in one object: the tests' draws, the pooled values, the laws'
-comparison and fits, the flags and the sentences (filled by :func:`friction_uq.campaign.analysis.analyse_tests`,
+comparison and fits, the flags and the sentences (filled by :func:`friction_uq.campaigns.analysis.analyse_tests`,
 read by the outputs, the report and the law comparison)."""
 
 from __future__ import annotations

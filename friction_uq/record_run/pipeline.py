@@ -54,7 +54,7 @@ class RunResult:
     sensitivity: dict[str, FUnderPrior] = dataclasses.field(default_factory=dict)
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
-    warnings: tuple[str, ...] = ()  # the checks that failed (friction_uq.run.warnings); empty when all pass
+    warnings: tuple[str, ...] = ()  # the checks that failed (friction_uq.record_run.warnings); empty when all pass
 
 
 def run_file(

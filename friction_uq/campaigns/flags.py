@@ -3,7 +3,7 @@
 A set-up is flagged when the best law with a multiplicative offset on that set-up beats the law
 without it decisively (leave-one-test-out dELPD > 4 and > t(0.975, tests - 1) SE). With two set-ups and a
 named law with a pressure term, a set-up is also flagged when, among every law with and without its offset,
-those with it carry the stacking weight (``friction_uq.campaign.analysis``: one set-up's bars put all its
+those with it carry the stacking weight (``friction_uq.campaigns.analysis``: one set-up's bars put all its
 tests at other pressures, and a pressure term can stand for its offset). With exactly two set-ups an
 offset on one is the same model as an offset on the other: the campaign then says that the two
 disagree, by how much, and lets the per-record causes (when a diagnosis named them) say which: the

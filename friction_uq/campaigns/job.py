@@ -1,7 +1,7 @@
 """The per-record job of a campaign and its result, with a versioned JSON schema.
 
 :func:`run_record` is what a Dask worker runs for one record: it calls
-:func:`friction_uq.run.run_file` (no progress, no table), reads back the JSON it wrote and returns
+:func:`friction_uq.record_run.run_file` (no progress, no table), reads back the JSON it wrote and returns
 a :class:`RecordResult`. It prints nothing: whatever the analysis would say on the terminal
 (notes such as a hoop gauge left out) is captured into ``notes``. A record the analysis refuses
 gives a result with ``status = "failed"`` and the one-sentence refusal as ``message``; the job
@@ -176,7 +176,7 @@ def _outputs_intact(old: RecordResult, out_dir: Path) -> bool:
         if not all((out_dir / name).is_file() for name in old.outputs.values()):
             return False
         doc = json.loads((out_dir / old.outputs["json"]).read_text())
-        from ..run.outputs import RUN_SCHEMA_VERSION
+        from ..record_run.outputs import RUN_SCHEMA_VERSION
 
         if doc.get("schema_version") != RUN_SCHEMA_VERSION:  # written by an older run: its keys meant other things
             return False
@@ -209,7 +209,7 @@ def run_record(task: RecordTask) -> RecordResult:
     """Analyse one record (or find it up to date); never prints, never raises for a bad record."""
     from ..priors import default_prior_path
     from ..record import read_record
-    from ..run import run_file, safe_stem
+    from ..record_run import run_file, safe_stem
 
     import logging
 

@@ -212,7 +212,7 @@ def write_netcdf(ca: CampaignAnalysis, path: Path) -> Path:
     dt = xr.DataTree.from_dict({"/": xr.Dataset(attrs={"friction_uq_version": __version__,
                                                        "best_law": ca.best or "none"})}
                                | {f"/{k}": v for k, v in groups.items()})
-    from ..run import netcdf_bytes
+    from ..record_run import netcdf_bytes
 
     return write_bytes(path, netcdf_bytes(dt))  # built in memory (HDF5 crashes on a disk that fills mid-file)
 
