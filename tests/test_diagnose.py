@@ -6,13 +6,14 @@ many records with varied f, nu, striker speed and seed is ``benchmarks/bench_dia
 
 from __future__ import annotations
 
-from types import MappingProxyType
+from dataclasses import dataclass, field
+from types import MappingProxyType, SimpleNamespace
 
 import numpy as np
 import pytest
 
 from friction_uq.analysis import prepare
-from friction_uq.discrepancy import diagnosed_f, diagnosis_words, outcome
+from friction_uq.discrepancy import diagnosed_f, diagnosis_words, outcome, round_clauses
 from friction_uq.discrepancy.diagnose import candidates, diagnose
 from friction_uq.discrepancy.mechanisms import MECHANISMS, Mechanism, register
 from friction_uq.models.parameters import F, HOOP_GAIN, NU
@@ -444,7 +445,7 @@ def test_a_misfit_left_after_the_named_causes_is_said():
     from dataclasses import replace
     from types import SimpleNamespace
 
-    from friction_uq.discrepancy.diagnosis_words import _remaining
+    from friction_uq.discrepancy.round_clauses import remaining_clause as _remaining
 
     left = replace(_verdict("unexplained", labels=("gauge_gain[external_output_bar]", "dispersion", "clearance")),
                    weights={"reference": 0.1, "gauge_gain[external_output_bar]": 0.6, "dispersion": 0.35,
@@ -637,3 +638,91 @@ def test_candidates_fitted_in_turn_and_left_open_with_nothing_named_take_the_sta
     assert named_causes([clearance, gain], later) == [clearance]
     _, w2, _ = rival_mixture(final, [[], [rival]], later, [clearance, gain], 5, np.full(2000, 0.050))
     assert STATIONARY not in w2 and set(w2) == {"gauge_gain[input_bar]", "zero_drift"}
+
+
+@dataclass
+class _Fit:
+    """The parts of a :class:`~friction_uq.discrepancy.extended.ModelFit` that the rounds read."""
+
+    label: str
+    variants: tuple
+    elpd: object
+    f_effective: np.ndarray
+    predicted: dict = field(default_factory=dict)
+    fit: object = field(default_factory=lambda: SimpleNamespace(mode={"f": 0.05}))
+
+
+class _RoundsDiagnoser:
+    """A stand-in for :class:`~friction_uq.discrepancy.extended.Diagnoser` in :func:`diagnose._search`: each extended
+    model's blocks are the reference's plus what its last mechanism adds (``gain``: per block), its f the reference's
+    times ``shift`` (the fits are what they are resolved to)."""
+
+    def __init__(self, gain, shift):
+        self.gain, self.shift = gain, shift
+
+    def predictive(self, fit):
+        return {}
+
+    def resolved(self, fit):
+        return fit
+
+    def fit_many(self, jobs, workers, cut):
+        from friction_uq.discrepancy.elpd import Elpd
+
+        out = []
+        for variants, _, label in jobs:
+            name = variants[-1].mechanism.name
+            ref = self.reference_of(variants[:-1])
+            noise = np.random.default_rng(len(variants) * 7 + len(name)).normal(0.0, 0.3, ref.elpd.pointwise.size)
+            out.append(_Fit(label, variants, Elpd(ref.elpd.pointwise + self.gain.get(name, 0.0) + noise, float("nan")),
+                            ref.f_effective * self.shift.get(name, 1.0)))
+        self.made = {**getattr(self, "made", {}), **{o.label: o for o in out}}
+        return out
+
+    def reference_of(self, variants):
+        if not variants:
+            return self.base
+        return self.made["+".join(v.label for v in variants)]
+
+
+@pytest.mark.parametrize("later, shift, named, kept", [
+    # an input bar's gain that moves f by 1 %: in the model, not named
+    ("gauge_gain[input_bar]", 1.01, ["clearance"], ("gauge_gain[input_bar]",)),
+    # the same gain moving f by 10 %: named
+    ("gauge_gain[input_bar]", 0.90, ["clearance", "gauge_gain[input_bar]"], ()),
+    # a cell's mechanism is named by its evidence, however little it moves f (a mild velocity weakening)
+    ("velocity_friction", 1.01, ["clearance", "velocity_friction"], ()),
+])
+def test_a_later_round_within_the_checks_tolerance_names_a_chain_entry_only_if_it_moves_f(monkeypatch, later, shift,
+                                                                                          named, kept):
+    """Round 1 names a clearance of a misfit; the check does not flag the model with it, and round 2's mechanism
+    passes the rule. An entry of the measurement chain (it changes one gauge's reading) is then named only when it
+    moves f by more than the whole-record models' form term (4.1 %), otherwise kept in the model (the later rounds
+    and the swap check see it), not named; f is the same either way. A mechanism of the cell is named."""
+    from friction_uq.discrepancy import diagnose as dmod
+    from friction_uq.discrepancy.elpd import Elpd
+    from friction_uq.discrepancy.extended import Variant
+
+    def variant(label):
+        name, _, ch = label.partition("[")
+        return Variant(MECHANISMS[name], ch.rstrip("]") or None)
+
+    flags = iter([True, False, False])
+    monkeypatch.setattr(dmod, "compare_whole_record", lambda prep, predicted: None)
+    monkeypatch.setattr(dmod, "decide", lambda comparison: SimpleNamespace(detected=next(flags)))
+    monkeypatch.setattr(dmod, "candidates", lambda exclude=(): [
+        variant(m) for m in ("clearance", later, "dispersion") if m.partition("[")[0] not in exclude])
+    mech = later.partition("[")[0]
+    dg = _RoundsDiagnoser({"clearance": 2.0, mech: 1.0}, {"clearance": 0.95, mech: shift})
+    dg.base = _Fit("baseline", (), Elpd(np.zeros(300), float("nan")), np.full(50, 0.05))
+    st = dmod._search(dg, None, dmod._Search(dg.base, dg.base), max_causes=4, workers=1, seed=0,
+                      say=lambda msg: None, t0=0.0)
+    assert [v.kind for v in st.verdicts] == ["named", "named", "none"]
+    assert [v.label for v in st.causes] == ["clearance", later]  # both in the model either way
+    dgn = dmod.Diagnosis(baseline=dg.base, rounds=tuple(st.rounds), misfits=tuple(st.misfits),
+                         causes=tuple(st.causes), not_separable=(), separate_by=None, final=st.reference,
+                         verdicts=tuple(st.verdicts))
+    assert [v.label for v in dgn.named_causes] == named and dgn.within_tolerance == kept
+    assert np.median(dgn.final.f_effective) == pytest.approx(0.05 * 0.95 * shift)
+    said = round_clauses.within_tolerance_clause(dgn)
+    assert ("Also in the model, not named: " in said and "(gauge_gain), f 0.048 -> 0.048" in said) == bool(kept), said

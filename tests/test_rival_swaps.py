@@ -198,7 +198,7 @@ def test_a_model_without_the_candidate_within_the_check_s_tolerance_resolves_not
 
 def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
     from friction_uq.discrepancy.diagnose import Diagnosis
-    from friction_uq.discrepancy.diagnosis_words import _swapped
+    from friction_uq.discrepancy.round_clauses import swapped_clause as _swapped
 
     causes, verdicts, rounds, final = _record()
     good = np.asarray(final.elpd.pointwise)
@@ -221,7 +221,7 @@ def test_the_sentence_says_which_rivals_the_swaps_ruled_out():
 
 def test_the_sentence_says_when_a_rival_stood_in_for_a_later_cause_too():
     from friction_uq.discrepancy.diagnose import Diagnosis
-    from friction_uq.discrepancy.diagnosis_words import _swapped
+    from friction_uq.discrepancy.round_clauses import swapped_clause as _swapped
 
     causes, verdicts, rounds, final = _record(first_rivals=("velocity_friction",), first="clearance",
                                               second="pressure_friction")
@@ -295,7 +295,7 @@ def test_a_candidate_whose_rivals_later_rounds_all_named_must_still_earn_its_pla
 
 def test_the_sentence_says_a_superfluous_candidate_is_not_named():
     from friction_uq.discrepancy.diagnose import Diagnosis
-    from friction_uq.discrepancy.diagnosis_words import _superfluous
+    from friction_uq.discrepancy.round_clauses import superfluous_clause as _superfluous
 
     causes, verdicts, rounds, final = _record(first_rivals=("clearance",))
     good = np.asarray(final.elpd.pointwise)

@@ -73,9 +73,10 @@ def open_rivals(verdict: Verdict, causes) -> list[str]:
 
 def named_causes(causes, verdicts) -> list:
     """The causes a record names: all but the candidates fitted in turn whose rivals stay open
-    (:func:`unresolved_rounds`; ``Diagnosis.named_causes``)."""
+    (:func:`unresolved_rounds`; ``Diagnosis.named_causes``) and the mechanisms a later round kept in the model
+    within the whole-record check's tolerance (``Verdict.within_tolerance``)."""
     open_rounds = set(unresolved_rounds(causes, verdicts))
-    return [v for k, v in enumerate(causes) if k not in open_rounds]
+    return [v for k, v in enumerate(causes) if k not in open_rounds and not verdicts[k].within_tolerance]
 
 
 def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant], seed: int,

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..quoted import OUTPUT_BARS, WHOLE_RECORD_MODEL_FORM, folded_sd, quoted_summary
 from .candidates_mixture import STATIONARY, open_rounds
-from .diagnose import Diagnosis
+from .diagnosis import Diagnosis
 from .extended import Variant
 from .record_likelihood import GAIN_SD
 

@@ -1,44 +1,24 @@
-"""What ``diagnose`` says in words: the sentence for the terminal and the summary page, each cause in an
-experimentalist's words (a measurement-chain fault with its gauge and how much), and the hoop gauge's calibration
-finding. The f it quotes (the named model's or the candidates' stacking mixture): :mod:`.diagnosed_f`. The JSON
+"""What ``diagnose`` says in words: the sentence for the terminal and the summary page, in which each cause is said in
+an experimentalist's words (:mod:`.cause_words`) and the later rounds add their clauses (:mod:`.round_clauses`), and
+the hoop gauge's calibration finding. The f it quotes (the named model's or the candidates' stacking mixture): :mod:`.diagnosed_f`. The JSON
 and the DataTree groups: :mod:`.outcome`."""
 
 from __future__ import annotations
 
-
 import numpy as np
 
-from ..models.parameters import Parameter
 from .candidates_mixture import STATIONARY, open_rounds
-from .diagnose import Diagnosis
+from .cause_words import cause_words, f_steps
 from .diagnosed_f import further, headline, member_name, mixture_label, unresolved
+from .diagnosis import Diagnosis
 from .extended import Variant
-from .rival_swaps import WITHOUT
+from .round_clauses import (by_weight_clause, remaining_clause, superfluous_clause, swapped_clause,
+                            within_tolerance_clause)
 from .whole_record import CHANNEL_LABELS
 
 #: A hoop gain this far from 1 (its most probable value under its 5 % prior) is reported as a calibration finding
 #: (clean records: see benchmarks/bench_misfit.py for how often a right gauge reads this far off).
 HOOP_GAIN_FINDING = 0.02
-
-
-#: Each mechanism in an experimentalist's words (docs/glossary.md has the longer entries).
-PLAIN_NAMES = {
-    "velocity_friction": "wall friction that changes with the sliding speed",
-    "pressure_friction": "wall friction that changes with the wall pressure",
-    "slip_friction": "wall friction that changes with the distance slid",
-    "clearance": "a radial gap between sample and tube",
-    "plug_friction": "the plug rubbing on the tube",
-    "gauge_gain": "a bar gauge's calibration",
-    "dispersion": "wave dispersion in the bars",
-    "end_friction": "friction on the sample's end faces",
-    "zero_drift": "a gauge's zero drifting through the record",
-    "channel_timing": "a channel read late or early (a gauge's position, a trigger's skew)",
-    "bandwidth": "an amplifier too slow for the waves",
-    "bar_modulus": "an output bar's modulus off its header",
-}
-
-#: How a measurement-chain parameter is said: unit -> (factor, unit in words)
-CHAIN_UNITS = {"s": (1e6, "us"), "1/s": (1e3, "microstrain per ms"), "-": (1.0, "times the header's")}
 
 
 def _describe(dg: Diagnosis) -> str:
@@ -48,18 +28,6 @@ def _describe(dg: Diagnosis) -> str:
     direction = "above" if worst.relative_level > 0 else "below"
     return (f"the {CHANNEL_LABELS[worst.channel]} gauge reads {abs(worst.relative_level) * 100:.1f} % {direction} the "
             f"simple model over the {worst.phase} phase")
-
-
-def f_steps(dg: Diagnosis) -> list[tuple[Variant, float, float]]:
-    """Each named cause with the median f before and after it was added, in the order named: round k's
-    reference model is the one with the first k causes (diagnose.diagnose)."""
-    out, before = [], float(np.median(dg.baseline.f_effective))
-    for k, v in enumerate(dg.causes):
-        chosen = next((r.fit for r in dg.rounds[k] if r.fit.variants[-1] == v), None) if k < len(dg.rounds) else None
-        after = before if chosen is None else float(np.median(chosen.f_effective))
-        out.append((v, before, after))
-        before = after
-    return out
 
 
 def ordered_steps(dg: Diagnosis) -> tuple[list[tuple[Variant, float, float]], str]:
@@ -82,31 +50,6 @@ def found(order: str, steps: list[tuple[Variant, float, float]], dg: Diagnosis) 
     return "Cause found:" if n == 1 else f"Causes found, {order}:"
 
 
-def chain_gauge(v: Variant, dg: Diagnosis | None) -> tuple[str, Parameter, float] | None:
-    """For a measurement-chain fault fitted on every gauge (``per_gauge``): the gauge it names, the parameter and
-    its posterior median, from the final model's draws when it holds the fault (else the round's fit)."""
-    if dg is None or not v.mechanism.per_gauge:
-        return None
-    fit = dg.final if v in dg.final.variants else next(
-        (r.fit for rk in dg.rounds for r in rk if r.fit.variants[-1] == v), None)
-    if fit is None:
-        return None
-    medians = {k: float(np.median(d)) for k, d in fit.fit.draws.items()}
-    gauge, p = v.mechanism.departing_gauge(medians)
-    return gauge, p, medians[p.name]
-
-
-def cause_words(v: Variant, dg: Diagnosis | None = None) -> str:
-    where = f" on the {CHANNEL_LABELS.get(v.channel, v.channel)} gauge" if v.channel else ""
-    chain = chain_gauge(v, dg)
-    if chain is not None:  # say which gauge, and how much
-        gauge, p, value = chain
-        factor, unit = CHAIN_UNITS.get(p.unit, (1.0, p.unit))
-        x = f"{value * factor:.3g}" if p.unit == "-" else f"{value * factor:+.2g}"
-        where = f", mostly the {CHANNEL_LABELS.get(gauge, gauge)} gauge ({x} {unit})"
-    return f"{PLAIN_NAMES.get(v.mechanism.name, v.mechanism.name)}{where} ({v.mechanism.name})"
-
-
 def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     """One line for the terminal and the summary page, in an experimentalist's words: the causes, the one that
     moves f most first, with f before and after each; then f to quote (:func:`headline`'s); then where the simple
@@ -127,7 +70,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     opening = found(order, steps, dg)
     fitted = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
     named = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps if v in dg.named_causes)
-    spare = _superfluous(dg)
+    spare = superfluous_clause(dg) + within_tolerance_clause(dg)
     gauges = ""  # the first round's cause, a gain, about as good on another gauge
     if dg.channels_not_separable and dg.cause is dg.causes[0]:
         alt = " or ".join(f"the {CHANNEL_LABELS.get(c, c)}" for c in dg.channels_not_separable)
@@ -169,7 +112,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from "
             f"the stationary analysis {'alone' if STATIONARY in dg.mixture_weights else 'without them'}. Why: "
             f"{_describe(dg)}; the {evidence}'s evidence is "
-            f"{first.delpd:.0f} +- {first.se:.0f} nats.{_by_weight(dg)}{_swapped(dg)}{sep}{_remaining(dg)}"
+            f"{first.delpd:.0f} +- {first.se:.0f} nats.{by_weight_clause(dg)}{swapped_clause(dg)}{sep}{remaining_clause(dg)}"
             f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
 
 
@@ -178,93 +121,6 @@ def _evidence_of(dg: Diagnosis, cause: Variant):
     k = dg.causes.index(cause)
     return next((r for r in dg.rounds[k] if r.fit.variants[-1] == cause), dg.ranking[0]) if k < len(dg.rounds) \
         else dg.ranking[0]
-
-
-def _by_weight(dg: Diagnosis) -> str:
-    """' X was preferred to Y, Z by the stacking weight ...' for each named cause that ruled rivals out only by the
-    naming rule's weight route (:mod:`.verdict`, 3.); '' when none did."""
-    out = []
-    for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
-        if v.kind != "named" or not v.by_weight or dg.causes[k] not in dg.named_causes:
-            continue
-        by = {c.label: c.variant for c in v.candidates}
-        out.append(f" {dg.causes[k].label} was preferred to {', '.join(by[x] for x in v.by_weight)} by the stacking "
-                   f"weight, not by 2 SE of the evidence: each stays more than 4 nats behind it with the blocks that "
-                   f"favour it most left out, and carries under 0.1 of the weight with the models that predict alike "
-                   f"with it.")
-    return "".join(out)
-
-
-def _superfluous(dg: Diagnosis) -> str:
-    """' Fitted in turn among the candidates of its round: X; with Y in the model the record does not need it (...):
-    not named.' for each candidate fitted in turn that the swap check found superfluous (:mod:`.rival_swaps`); ''
-    when none."""
-    out = []
-    steps = f_steps(dg)  # in the causes' order
-    for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
-        without = next((s for s in dg.swaps if s.round == k and s.rival == WITHOUT), None)
-        if not v.superfluous or without is None:
-            continue
-        cause, a, b = steps[k]
-        others = _other_causes(dg, k)
-        d = without.delpd
-        gap = f"the model without it is {abs(d):.0f} +- {without.se:.0f} nats {'worse' if d >= 0 else 'better'}"
-        why = (f"{gap}, not decisive by the naming rule" if without.ruling is None else
-               f"{gap}, but within what two simulators of the same test differ by: the whole-record check does not "
-               f"flag it")
-        out.append(f" Fitted in turn among the candidates of its round: {cause_words(cause, dg)}, f {a:.3f} -> "
-                   f"{b:.3f}; with {others} in the model the record does not need it ({why}): not named.")
-    return "".join(out)
-
-
-def _other_causes(dg: Diagnosis, k: int) -> str:
-    """'clearance, plug_friction': the mechanisms of the final model besides round ``k``'s candidate fitted in turn."""
-    return ", ".join(c.mechanism.name for j, c in enumerate(dg.causes) if j != k)
-
-
-def _swapped(dg: Diagnosis) -> str:
-    """' X was one of the candidates of its round; with the other causes in the model, each of its rivals explains the
-    record worse (...).' for each named cause whose round's rivals the swap check resolved
-    (:mod:`.rival_swaps`); '' when none."""
-    out = []
-    for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
-        done = [s for s in dg.swaps if s.round == k and s.ruling is not None and s.rival in v.resolved]
-        if not done or dg.causes[k] not in dg.named_causes:
-            continue
-        by = {c.label: c.variant for c in v.candidates}
-        others = _other_causes(dg, k)
-        worse = ", ".join(f"{by[s.rival]}{_standing_in(dg, k, s)} {s.delpd:.0f} +- {s.se:.0f} nats"
-                          + (" (by the weight)" if s.ruling == "weight" else "") for s in done)
-        alone = next((f"; without it, {s.delpd:.0f} +- {s.se:.0f} nats worse"
-                      f"{' (by the weight)' if s.ruling == 'weight' else ''}"
-                      f"{', and a misfit the whole-record check flags' if s.flagged else ''}"
-                      for s in dg.swaps if s.round == k and s.rival == WITHOUT), "")
-        out.append(f" {dg.causes[k].mechanism.name} was one of the candidates of its round; with {others} in the model, "
-                   f"each of its rivals explains the record worse ({worse}{alone}).")
-    return "".join(out)
-
-
-def _standing_in(dg: Diagnosis, k: int, s) -> str:
-    """', which replaces Y too (one law of a group at a time),' when the swap took out a later cause of the rival's
-    group as well (a second friction law: :func:`~.rival_swaps.swapped`); '' otherwise."""
-    kept = set(s.model.split("+"))
-    gone = [c.label for j, c in enumerate(dg.causes) if j != k and c.label not in kept]
-    return f", which replaces {', '.join(gone)} too (one law of a group at a time)," if gone else ""
-
-
-def _remaining(dg: Diagnosis) -> str:
-    """' A misfit remains with them (on the ... gauge, ... phase) that no further cause explains clearly (candidates:
-    ...).' when the round after the last cause found the misfit the check still flags unexplained; '' otherwise."""
-    last = dg.verdicts[-1] if len(dg.verdicts) > 1 else None
-    if last is None or last.kind != "unexplained":
-        return ""
-    cells = dg.misfits[-1].flagged() if dg.misfits else []
-    where = f" on the {CHANNEL_LABELS.get(cells[0].channel, cells[0].channel)} gauge, {cells[0].phase} phase" \
-        if cells else ""
-    by = {c.label: c.variant for c in last.candidates}
-    listed = [by[label] for label in last.supported if label in by]
-    return (f" A misfit remains with them{where} that no further cause explains clearly"
-            f"{' (candidates: ' + ', '.join(listed) + ')' if listed else ''}.")
 
 
 def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:

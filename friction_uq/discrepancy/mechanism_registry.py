@@ -49,6 +49,13 @@ class Mechanism:
     per_gauge: tuple[str, ...] = ()  # a measurement-chain fault fitted on every gauge at once: parameter i is gauge i's
     neutral: float = 0.0  # per_gauge: the parameter's value where its gauge reads right
 
+    @property
+    def measurement_chain(self) -> bool:
+        """An entry of the measurement chain: it changes how one gauge reads the test (a gain, a zero, a delay, a
+        low-pass, a bar's modulus), not the test itself, so it can take up any departure of that gauge's waveform
+        from the 1-D model's, where the cell's mechanisms act through the physics on every gauge at once."""
+        return bool(self.channels or self.per_gauge)
+
     def prior_z(self) -> dict[str, tuple[float, float]]:
         """Gaussian stand-ins of the priors in each parameter's unbounded coordinate (centre, sd), from the
         prior's 16 % and 84 % quantiles: what the mode search uses (the exact prior weighs the draws)."""

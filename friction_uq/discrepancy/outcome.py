@@ -9,9 +9,10 @@ from ..models.parameters import effective_sample_size, summarize_draws
 from ..stats import khat_threshold
 from ..stats.streams import stream
 from .candidates_mixture import STATIONARY
-from .diagnose import Diagnosis, ModelFit, Ranked
+from .diagnosis import Diagnosis, ModelFit, Ranked
 from .diagnosed_f import member_variants, mixture_label
-from .diagnosis_words import baseline_hoop_gain, chain_gauge, hoop_gain_off, sentence
+from .cause_words import chain_gauge
+from .diagnosis_words import baseline_hoop_gain, hoop_gain_off, sentence
 from .effective_prior import log_prior_f_effective
 from .exact_model import IMPORTANCE_DRAWS
 
@@ -83,6 +84,9 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         # candidates fitted in turn the later causes made superfluous (the model without them not ruled out, or, where
         # their round left a rival open, not flagged by the whole-record check): not named
         "superfluous": list(dg.superfluous),
+        # entries of the measurement chain a later round kept in the model while the whole-record check no longer
+        # flagged its reference, and that move f by less than the whole-record models' form term: not named
+        "within_tolerance": list(dg.within_tolerance),
         # the candidates fitted in turn against their rounds' open rivals, with the later causes in the model (a rival
         # of a later cause's group replaces that cause too)
         "swaps": [{"round": sw.round + 1, "rival": sw.rival, "model": sw.model, "delpd": sw.delpd, "se": sw.se,
@@ -125,7 +129,10 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                 "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
                 "left open by the same rule, and the model without it, which the whole-record check must then flag "
                 "(where its round left no rival open, by the rule alone; swaps); else it is superfluous and not "
-                "named",
+                "named; a later round whose reference the whole-record check does not flag names an entry of the "
+                "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
+                "f's median by more than the whole-record models' form term allows (4.1 %), else the entry stays in "
+                "the model within the check's tolerance (within_tolerance), not named",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "

@@ -61,7 +61,7 @@ def reproducible(dt):
 #: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
-RUN_SCHEMA_VERSION = 7
+RUN_SCHEMA_VERSION = 8
 
 
 def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],

@@ -103,6 +103,8 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
     fx = headline(diagnosis)[1]  # the JSON's f: the named model's, with the bars' calibration
     names = ", ".join(v.label for v in diagnosis.named_causes)
+    if diagnosis.within_tolerance:  # in the model, not named: f is that model's
+        names += f" (with {', '.join(diagnosis.within_tolerance)} in the model within the check's tolerance, not named)"
     return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "
             "(the JSON's f), which is the f to quote.")
 

@@ -14,7 +14,7 @@ import textwrap
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..discrepancy.diagnose import Diagnosis
+from ..discrepancy.diagnosis import Diagnosis
 from ..stats import RULE
 from ..discrepancy.outcome import kappa_draws
 from ..discrepancy.whole_record import CHANNEL_LABELS
@@ -90,7 +90,9 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
              *_nu_source_line(dg),
              f"hoop gauge gain (final model, most probable under its 5 % prior): {dg.final.hoop_gain:.3f}", ""]
     for v in dg.causes:
-        turn = "" if v in dg.named_causes else " (a candidate fitted in turn, not named)"
+        turn = "" if v in dg.named_causes else (" (in the model within the check's tolerance, not named)"
+                                                if v.label in dg.within_tolerance else
+                                                " (a candidate fitted in turn, not named)")
         lines.append(f"{v.mechanism.name}{' (' + v.channel + ')' if v.channel else ''}{turn}: {v.mechanism.meaning}")
         for p in v.mechanism.parameters:
             x = dg.final.fit.draws[p.name]
@@ -110,7 +112,9 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
                   "after a named cause the search goes on with it in the model; a candidate fitted in turn is "
                   "named when, with the later causes in the model, it rules out so each rival of its round left "
                   "open and the model without it, which the whole-record check must then flag (where no rival was "
-                  "left open, by the rule alone); else it is superfluous and not named."]
+                  "left open, by the rule alone); else it is superfluous and not named. A later round whose "
+                  "reference the check no longer flags names an entry of the measurement chain only if it moves f "
+                  "by more than 4.1 % (the whole-record models' form); else it stays in the model, not named."]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")

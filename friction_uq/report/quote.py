@@ -40,6 +40,10 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
                 return (f"the stationary analysis and the candidates diagnose could not tell apart, in equal parts "
                         f"({label})"), fx
             return f"the {label}, candidates diagnose could not tell apart", fx
+        if diagnosis.within_tolerance:  # a later round's mechanism kept in the model, not named
+            named = ", ".join(v.label for v in diagnosis.named_causes)
+            return (f"the model with the causes diagnose named ({named}) and "
+                    f"{', '.join(diagnosis.within_tolerance)} within the check's tolerance, not named ({label})"), fx
         return f"the model with the causes diagnose named ({label})", fx
     return ("the stationary analysis (eq. 17 and the hoop gauge)" if hoop else
             "the stationary analysis (eq. 17; the hoop gauge left out)"), f_stationary
