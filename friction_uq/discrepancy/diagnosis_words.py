@@ -47,6 +47,8 @@ def found(order: str, steps: list[tuple[Variant, float, float]], dg: Diagnosis) 
     """The sentence's opening on the named causes: "Cause found:" for one (an order says nothing then), else
     "Causes found, <order>:" (:func:`ordered_steps`)."""
     n = sum(v in dg.named_causes for v, _, _ in steps)
+    if n == 0:  # every mechanism of the model superfluous or within the check's tolerance
+        return "No cause named; in the model:"
     return "Cause found:" if n == 1 else f"Causes found, {order}:"
 
 
@@ -91,7 +93,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         evidence = "first cause" if named else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     elif more := further(dg):  # the last round's weight lies on further mechanisms it did not name: their mixture
-        lead = f"{opening} {named}{gauges}.{spare}"
+        lead = f"{opening} {named or fitted}{gauges}.{spare}"
         shares = ", ".join(f"{'them' if k == dg.final.label else '+ ' + more[k]} {100 * w:.0f} %"
                            for k, w in dg.mixture_weights.items())
         with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
@@ -101,7 +103,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
     else:
-        lead = f"{opening} {named}{gauges}.{spare}"
+        lead = f"{opening} {named or fitted}{gauges}.{spare}"
         quote = "with them (the f to quote)" if dg.mixture_of != "superfluous" else (
             f"from the {mixture_label(dg)}: the model with every mechanism fitted and the same without the one not "
             "named, weighted by how well each predicts the record (the f to quote)")

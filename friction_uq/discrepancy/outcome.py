@@ -15,6 +15,7 @@ from .cause_words import chain_gauge
 from .diagnosis_words import baseline_hoop_gain, hoop_gain_off, sentence
 from .effective_prior import log_prior_f_effective
 from .exact_model import IMPORTANCE_DRAWS
+from .verdict import FORM_SHIFT
 
 #: How the named model's posterior is obtained (the JSON's ``posterior_method`` says which route was taken).
 POSTERIOR_NOTE = ("exact posterior of the model with the named causes: 200 draws of its normal approximation (robust "
@@ -67,7 +68,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         # when none is but a candidate was fitted in turn (`fitted_in_turn`; `open_candidates`, f is `mixture`'s)
         "verdict": ("named" if dg.named_causes else "candidates" if dg.causes
                     else (v.kind if v is not None else None)),
-        "round_verdicts": [r.kind for r in dg.verdicts],
+        # a round whose chain entry stayed in the model within the check's tolerance says so (its kind is "named")
+        "round_verdicts": ["within_tolerance" if r.within_tolerance else r.kind for r in dg.verdicts],
         "stacking_weights": dict(v.weights) if v is not None else {},
         "mixture": None if dg.mixture_f is None else {"weights": dict(dg.mixture_weights),
                                                       "f": summarize_draws(dg.mixture_f), "of": dg.mixture_of},
@@ -131,8 +133,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                 "(where its round left no rival open, by the rule alone; swaps); else it is superfluous and not "
                 "named; a later round whose reference the whole-record check does not flag names an entry of the "
                 "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
-                "f's median by more than the whole-record models' form term allows (4.1 %), else the entry stays in "
-                "the model within the check's tolerance (within_tolerance), not named",
+                f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
+                "the entry stays in the model within the check's tolerance (within_tolerance), not named",
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
         "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "

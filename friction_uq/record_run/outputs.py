@@ -54,7 +54,9 @@ def reproducible(dt):
 
 
 
-#: The run's JSON: its schema name and version (6: a diagnosed model's f and ``nu_extended`` are the cut posterior's,
+#: The run's JSON: its schema name and version (8: ``discrepancy.causes`` leaves out a later round's chain entry kept
+#: in the model within the whole-record check's tolerance, listed in ``discrepancy.within_tolerance``; 7: a ranking
+#: entry's ``f_from`` says whether its f is the cut posterior's or the whole-record fit's; 6: a diagnosed model's f and ``nu_extended`` are the cut posterior's,
 #: nu from the stationary windows (``discrepancy.nu_source``), the whole record's own reading ``nu_whole_record``;
 #: 5: ``window_halves``, kappa's change across the window; 4: ``f``'s interval carries the output bars' calibration, the
 #: posterior's own is ``f.given_bar_headers``; 3: ``discrepancy.causes`` holds only the named causes, beside

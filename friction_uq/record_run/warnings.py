@@ -76,7 +76,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
 
     if more := further(diagnosis):  # causes named, and further ones the record leans to without naming one
         fm = headline(diagnosis)[1]
-        names = ", ".join(v.label for v in diagnosis.named_causes)
+        names = ", ".join(v.label for v in diagnosis.named_causes) or "none"
         return (f"`diagnose` names {names}, and the record leans to a further cause without naming one "
                 f"({', '.join(more.values())}); "
                 f"f from the stacking mixture is {fm['q50']:.4g} [{fm['q05']:.4g}, {fm['q95']:.4g}] (the JSON's f), "
@@ -102,7 +102,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
     if not diagnosis.causes:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
     fx = headline(diagnosis)[1]  # the JSON's f: the named model's, with the bars' calibration
-    names = ", ".join(v.label for v in diagnosis.named_causes)
+    names = ", ".join(v.label for v in diagnosis.named_causes) or "none"
     if diagnosis.within_tolerance:  # in the model, not named: f is that model's
         names += f" (with {', '.join(diagnosis.within_tolerance)} in the model within the check's tolerance, not named)"
     return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "

@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 from ..discrepancy.diagnosis import Diagnosis
 from ..stats import RULE
 from ..discrepancy.outcome import kappa_draws
+from ..discrepancy.verdict import FORM_SHIFT
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from .style import figure
 
@@ -114,7 +115,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
                   "open and the model without it, which the whole-record check must then flag (where no rival was "
                   "left open, by the rule alone); else it is superfluous and not named. A later round whose "
                   "reference the check no longer flags names an entry of the measurement chain only if it moves f "
-                  "by more than 4.1 % (the whole-record models' form); else it stays in the model, not named."]
+                  f"by more than {100 * FORM_SHIFT:.1f} % (the whole-record models' form); else it stays in the "
+                  "model, not named."]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")

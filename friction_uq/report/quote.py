@@ -22,13 +22,13 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
     if named is not None:
         label, fx = named
         if more := further(diagnosis):  # the causes named, and further ones the last round leaned to unnamed
-            named = ", ".join(v.label for v in diagnosis.named_causes)
+            named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
             shares = ", ".join(f"{'no further cause' if k == diagnosis.final.label else '+ ' + more[k]} {w:.2f}"
                                for k, w in diagnosis.mixture_weights.items())
             return (f"the causes diagnose named ({named}) mixed with the further causes the record leans to "
                     f"without naming one ({shares})", fx)
         if diagnosis.mixture_of == "superfluous":  # a candidate fitted in turn the later causes did not need
-            named = ", ".join(v.label for v in diagnosis.named_causes)
+            named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
             said = (f"the {label}: the causes diagnose named ({named}) with and without "
                     f"{', '.join(diagnosis.superfluous)}, fitted in turn and not needed")
             return said, fx
@@ -41,7 +41,7 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
                         f"({label})"), fx
             return f"the {label}, candidates diagnose could not tell apart", fx
         if diagnosis.within_tolerance:  # a later round's mechanism kept in the model, not named
-            named = ", ".join(v.label for v in diagnosis.named_causes)
+            named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
             return (f"the model with the causes diagnose named ({named}) and "
                     f"{', '.join(diagnosis.within_tolerance)} within the check's tolerance, not named ({label})"), fx
         return f"the model with the causes diagnose named ({label})", fx
