@@ -23,9 +23,10 @@ each round's verdict with the naming rule of :mod:`.verdict`.
   (``Verdict.within_tolerance``): it changes one gauge's reading, so within the check's tolerance it takes up
   where the record's waveform on that gauge departs from the 1-D model's (an input bar's gain on a clean
   axisymmetric cell), while the cell's mechanisms act on every gauge at once and are named by their evidence
-  (a mild velocity weakening behind a clearance that moves f by 1 %, the bundled B-02's fourth cause). When that round's stacking weight lies on further mechanisms none of
-  which it names, f is the mixture of them and the model with the causes (``further_mixture``): the final
-  model alone would be quoted as if nothing more were there (on the bundled B-05 its interval sat 5 % above
+  (a mild velocity weakening behind a clearance that moves f by 1 %, the bundled B-02's fourth cause).
+  When that round's stacking weight lies on further mechanisms none of which it names, f is the mixture of them
+  and the model with the causes (``further_mixture``): the final model alone would be quoted as if nothing more
+  were there (on the bundled B-05 its interval sat 5 % above
   the true f, while the weight lay on the plug friction and the velocity weakening it hides).
 """
 
