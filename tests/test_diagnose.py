@@ -511,15 +511,24 @@ def test_the_last_rounds_weight_on_further_mechanisms_gives_f_their_mixture():
     assert len(x) == MIXTURE_DRAWS and np.mean(x == 0.040) == pytest.approx(0.45 / 0.95, abs=1.0 / MIXTURE_DRAWS)
     value = {"clearance": 0.050} | fits
     assert np.all(x == np.array([value[list(w)[i]] for i in which]))  # each draw from the model it says
-    # a supported model whose evidence over the final model is not decisive (stacking shares the weight at random
-    # among models that predict alike) is left out; with none decisive, the final model's f stands
-    not_decisive = replace(last, candidates=tuple(replace(c, decisive=c.label != "clearance+plug_friction")
-                                                  for c in last.candidates))
-    _, w2, _ = further_mixture(final, [[], last_round], [_verdict("named", "clearance"), not_decisive], causes, 3)
-    assert set(w2) == {"clearance", "clearance+velocity_friction"}
-    none_decisive = replace(last, candidates=tuple(replace(c, decisive=False) for c in last.candidates))
-    assert further_mixture(final, [[], last_round], [_verdict("named", "clearance"), none_decisive], causes, 3)[0] \
-        is None
+    # without decisive evidence a supported model stays a member only if it moves f's median beyond the form term
+    # (4.1 %): the plug friction (-20 %) does, and keeps its own share; a member that gives the final model's f
+    # (stacking shares the weight at random among models that predict alike) gives its weight to the final model
+    not_decisive = replace(last, candidates=tuple(replace(c, decisive=False) for c in last.candidates))
+    alike = {"clearance+plug_friction": 0.040, "clearance+velocity_friction": 0.0490, "clearance+dispersion": 0.051}
+    alike_round = [SimpleNamespace(fit=SimpleNamespace(label=k, f_effective=np.full(500, v))) for k, v in alike.items()]
+    _, w2, _ = further_mixture(final, [[], alike_round], [_verdict("named", "clearance"), not_decisive], causes, 3)
+    assert w2 == pytest.approx({"clearance": 0.50 / 0.95, "clearance+plug_friction": 0.45 / 0.95})
+    # none decisive and none moving f (the plug friction's f now the final model's within 2 %): the final f stands
+    close_round = [SimpleNamespace(fit=SimpleNamespace(label=k, f_effective=np.full(500, 0.049))) for k in fits]
+    assert further_mixture(final, [[], close_round], [_verdict("named", "clearance"), not_decisive], causes,
+                           3)[0] is None
+    # a model the record rules out against the final one (dELPD decisively negative) is no member, whatever its
+    # stacking weight (it predicts a few blocks alone) and however far its f
+    ruled_out = replace(last, candidates=tuple(replace(c, delpd=-5000.0, se=1400.0, decisive=False)
+                                               if c.label == "clearance+plug_friction" else c for c in last.candidates))
+    _, w3, _ = further_mixture(final, [[], last_round], [_verdict("named", "clearance"), ruled_out], causes, 3)
+    assert set(w3) == {"clearance", "clearance+velocity_friction"}
     # the final model carries the weight alone: its f stands
     alone = replace(last, weights={"reference": 0.95, "clearance+plug_friction": 0.05})
     assert further_mixture(final, [[], last_round], [_verdict("named", "clearance"), alone], causes, 3)[0] is None
@@ -726,3 +735,34 @@ def test_a_later_round_within_the_checks_tolerance_names_a_chain_entry_only_if_i
     assert np.median(dgn.final.f_effective) == pytest.approx(0.05 * 0.95 * shift)
     said = round_clauses.within_tolerance_clause(dgn)
     assert ("Also in the model, not named: " in said and "(gauge_gain), f 0.048 -> 0.048" in said) == bool(kept), said
+
+
+def test_a_model_the_record_rules_out_gives_no_f_to_the_first_rounds_mixture():
+    """Stacking may give weight to a model decisively worse than the reference (it alone predicts a few blocks: a
+    bars' dispersion at sharp fronts, 5000 nats worse over the record, with its f near 0); it is no member of f's
+    mixture, whose other members keep their proportions; when every model that carries weight is ruled out, the
+    reference stands."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.candidates_mixture import members, mixture
+    from friction_uq.discrepancy.extended import Variant
+
+    base = SimpleNamespace(label="baseline", variants=(), f_effective=np.full(500, 0.060))
+    fits = {"clearance": 0.070, "dispersion": 0.008}
+    ranked = [SimpleNamespace(fit=SimpleNamespace(label=k, variants=(Variant(MECHANISMS[k]),),
+                                                  f_effective=np.full(500, v))) for k, v in fits.items()]
+    v = replace(_verdict("unexplained", labels=tuple(fits)), weights={"reference": 0.1, "clearance": 0.6,
+                                                                       "dispersion": 0.3})
+    v = replace(v, candidates=tuple(replace(c, delpd=-5373.0, se=1435.0, decisive=False, spread=False)
+                                    if c.label == "dispersion" else c for c in v.candidates))
+    assert members(v) == ["clearance", "reference"]
+    x, w, _ = mixture(base, ranked, v, 5)
+    assert w == pytest.approx({"clearance": 0.6 / 0.7, "reference": 0.1 / 0.7}) and not np.any(x == 0.008)
+    # a dELPD below the reference's but not decisively (-3 +- 2 nats): still a member
+    close = replace(v, candidates=tuple(replace(c, delpd=-3.0, se=2.0) if c.label == "dispersion" else c
+                                        for c in v.candidates))
+    assert "dispersion" in members(close)
+    only = replace(v, weights={"reference": 0.0, "clearance": 0.0, "dispersion": 1.0})
+    x, w, _ = mixture(base, ranked, only, 5)
+    assert w == {"reference": 1.0} and np.all(x == 0.060)

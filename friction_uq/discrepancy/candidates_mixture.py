@@ -5,10 +5,12 @@ the models that carry its stacking weight; a round of candidates whose best was 
 second cause) but whose rivals no later round put in the model leaves them open: f is then the mixture of the
 final model and those rivals (:func:`rival_mixture`), and the candidate fitted in turn is not named
 (``Diagnosis.named_causes``). After the last cause, a round that names nothing more may still find that the
-record's stacking weight lies on further mechanisms decisively better than the model with the causes, none of
-which passes the naming rule (their evidence sits in a few blocks): f is then the mixture of the final model and those
-mechanisms (:func:`further_mixture`), not the final model's alone, whose interval would hold the truth only if
-nothing more were there.
+record's stacking weight lies on further mechanisms, none of which passes the naming rule, that are decisively
+better than the model with the causes (their evidence sits in a few blocks) or that would move f beyond the
+whole-record models' form term: f is then the mixture of the final model and those mechanisms
+(:func:`further_mixture`), not the final model's alone, whose interval would hold the truth only if nothing more
+were there. A model the record rules out against its round's reference is never a member of a mixture
+(:func:`members`), whatever stacking weight its few blocks earn it.
 
 When no cause is named at all (the first round's candidates, unexplained or unconfirmed, or candidates fitted
 in turn whose rivals stay open and no cause besides), the whole-record models
@@ -29,7 +31,7 @@ import numpy as np
 
 from ..stats.streams import stream
 from .extended import ModelFit, Variant
-from .verdict import Verdict, mixture_draws, round_weights
+from .verdict import WEIGHT_RULE, Verdict, mixture_draws, moves_f, round_weights, ruled_out
 
 #: Draws of the stacking mixture that gives f when no single cause is named.
 MIXTURE_DRAWS = 1000
@@ -117,29 +119,55 @@ def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int,
     return _draw_mixture(draws, w, seed)
 
 
+def members(verdict: Verdict) -> list[str]:
+    """The labels (``reference`` among them) that may give f in a round's stacking mixture: those that carry its
+    weight (:class:`~friction_uq.stats.WeightRule`), heaviest first, once the models the record rules out against
+    the round's reference (:func:`~.verdict.ruled_out`) are set aside: their weight comes from a few blocks they
+    alone predict, and it neither gives them a share of f nor pushes another model out of the mass that carries
+    the weight."""
+    by = {c.label: c for c in verdict.candidates}
+    kept = {k: w for k, w in verdict.weights.items() if not (k in by and ruled_out(by[k]))}
+    total = sum(kept.values())
+    if total <= 0.0:
+        return []
+    return [k for k in WEIGHT_RULE.supported({k: w / total for k, w in kept.items()}) if kept[k] > 0.0]
+
+
 def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
                     seed: int, resolve: Resolve = _as_fitted
                     ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """After at least one cause, when the last round named nothing (none, unexplained or unconfirmed) and the
-    models that carry its stacking weight (:class:`~friction_uq.stats.WeightRule`) include further mechanisms
-    whose evidence over the model with the causes is decisive by the package's rule (they fail the naming rule
-    on its spread or on their rivals; a model only as good as the final one, among which stacking shares the
-    weight at random, does not count):
-    f's draws from the mixture of those mechanisms' fits and, when it is among them, the final model (its exact
-    posterior; the round's reference), weighted by the round's stacking weights; (None, {}, None) when the final model carries the
-    weight alone, or when the last round named a cause."""
+    models that carry its stacking weight (:func:`members`) include further mechanisms that either have evidence
+    over the model with the causes decisive by the package's rule (they fail the naming rule on its spread or on
+    their rivals) or, without it, move f's median by more than the whole-record models' form term
+    (:func:`~.verdict.moves_f`: the record cannot tell whether they are there, and f depends on it; on an
+    axisymmetric pair record a plug friction behind a named slip law, 75 +- 43 nats, f 15 % lower and right): f's
+    draws from the mixture of those mechanisms' fits and, when it is among them, the final model (its exact
+    posterior; the round's reference), weighted by the round's stacking weights; (None, {}, None) when the final
+    model carries the weight alone, when the models that share it with no decisive evidence give the final model's f
+    (among models that predict alike stacking shares the weight at random), or when the last round named a cause.
+    The weight of a member with neither (it predicts alike with the final model and gives its f) goes to the final
+    model, so that a member that moves f keeps its own share and no more."""
     if not causes or len(verdicts) <= len(causes) or verdicts[-1].kind not in ("none", "unexplained", "unconfirmed"):
         return None, {}, None
     verdict = verdicts[-1]
     decisive = {c.label for c in verdict.candidates if c.decisive}
-    further = [k for k in verdict.supported if k in decisive and verdict.weights[k] > 0.0]
-    if not further:
-        return None, {}, None
     fits = {r.fit.label: r.fit for r in rounds[-1]}
-    draws = {label: resolve(fits[label]).f_effective for label in further}  # heaviest first, as the weights
-    if "reference" in verdict.supported and verdict.weights["reference"] > 0.0:  # the final model carries weight
-        draws = {final.label: final.f_effective} | draws
-    w = {k: verdict.weights["reference" if k == final.label else k] for k in draws}
+    draws, alike = {}, 0.0  # heaviest first, as the weights; the weight of the members that give the final f
+    for label in members(verdict):
+        if label == "reference":
+            alike += verdict.weights[label]
+            continue
+        f = resolve(fits[label]).f_effective
+        if label in decisive or moves_f(final.f_effective, f):
+            draws[label] = f
+        else:  # it predicts alike with the final model and gives its f: the final model's exact posterior stands for it
+            alike += verdict.weights[label]
+    if not draws:
+        return None, {}, None
+    w = {label: verdict.weights[label] for label in draws}
+    if alike > 0.0:
+        draws, w = {final.label: final.f_effective} | draws, {final.label: alike} | w
     return _draw_mixture(draws, w, seed)
 
 
@@ -152,8 +180,8 @@ def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stati
     if verdict.kind not in ("candidates", "unexplained", "unconfirmed"):
         return None, {}, None
     fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
-    keep = [k for k in verdict.supported if verdict.weights[k] > 0.0]
-    w = {k: verdict.weights[k] for k in keep}
+    keep = members(verdict) or ["reference"]  # every model that carries weight ruled out: the reference stands
+    w = {k: verdict.weights[k] or 1.0 for k in keep}
     draws, w = _with_stationary({k: resolve(fits[k]).f_effective for k in keep}, w, stationary_f)
     return _draw_mixture(draws, w, seed)
 

@@ -149,8 +149,7 @@ class NamingRule:
         takes up that gauge's departure from the 1-D model: on records of the axisymmetric simulation such entries
         moved f by 0.5-2 % and were not there, where real second causes moved it by 16-41 % (docs/trust.md). One
         that does not matter for f stays in the model, not named (:attr:`Verdict.within_tolerance`)."""
-        ref = float(np.median(reference_f))
-        return abs(float(np.median(f)) / ref - 1.0) > self.form_shift
+        return moves_f(reference_f, f, self.form_shift)
 
     def candidate(self, fit, reference, delpd: float, se: float, weight: float) -> Candidate:
         """One model against the reference, with the spread test."""
@@ -225,6 +224,22 @@ class NamingRule:
             return None
         rest = elpd_difference(best, other, drop=drop)[0] if self.by_weight else None
         return "weight" if WEIGHT_RULE.ruled_out(weight, d, se, d_rest=rest) else None
+
+
+def moves_f(reference_f: np.ndarray, f: np.ndarray, shift: float = FORM_SHIFT) -> bool:
+    """Whether a model's draws of f (``f``) put its median further from the reference's (``reference_f``) than
+    ``shift``, relative: by default more than the 90 % half-width of the whole-record models' form term in f
+    (:data:`FORM_SHIFT`), what two simulators of the same test may differ by."""
+    ref = float(np.median(reference_f))
+    return abs(float(np.median(f)) / ref - 1.0) > shift
+
+
+def ruled_out(candidate: Candidate) -> bool:
+    """The record rules the model out against its round's reference: its dELPD is decisively negative by the
+    package's rule. Stacking may still give such a model weight, from the few blocks it alone predicts (a bars'
+    dispersion at sharp fronts, 5000 nats worse over the record), but its f, fitted to a record it misses, is no
+    answer for the record, and it is no member of f's mixture (:mod:`.candidates_mixture`)."""
+    return RULE.decisive(-candidate.delpd, candidate.se)
 
 
 def round_weights(reference, fits: Sequence, seed: int) -> dict[str, float]:
