@@ -456,6 +456,11 @@ def test_a_misfit_left_after_the_named_causes_is_said():
     said = _remaining(dg)
     assert said.startswith(" A misfit remains with them on the external transmitted gauge, stationary phase"), said
     assert "(candidates: gauge_gain[external_output_bar], dispersion)" in said, said
+    # a model the record rules out against the round's reference is no candidate, whatever its stacking weight
+    out = replace(left, candidates=tuple(replace(c, delpd=-5000.0, se=1400.0) if c.label == "dispersion" else c
+                                         for c in left.candidates))
+    said = _remaining(SimpleNamespace(verdicts=(_verdict("named", "plug_friction"), out), misfits=misfits))
+    assert "(candidates: gauge_gain[external_output_bar])" in said, said
     assert _remaining(SimpleNamespace(verdicts=(_verdict("named", "plug_friction"), _verdict("none")),
                                       misfits=misfits)) == ""
     assert _remaining(SimpleNamespace(verdicts=(left,), misfits=misfits[:1])) == ""  # no cause named before it
@@ -564,7 +569,8 @@ def test_the_words_of_a_further_mixture_name_the_further_causes():
     assert not unresolved(dg) and further(dg) == {extra.label: "gauge_gain[external_output_bar]"}
     source, fx = f_to_quote({"q05": 0.0, "q50": 0.0, "q95": 0.0}, dg)
     assert source.startswith("the causes diagnose named (clearance) mixed with the further causes"), source
-    assert "(no further cause 0.60, + gauge_gain[external_output_bar] 0.40)" in source, source
+    assert "(no further cause, or one that leaves f as it is, 0.60, + gauge_gain[external_output_bar] 0.40)" \
+        in source, source
     assert fx == headline(dg)[1] and fx["q05"] < 0.044 and fx["q95"] > 0.050  # the mixture, the calibration folded in
     said = _next_step(dg, None)
     assert "names clearance, and the record leans to a further cause" in said and "gauge_gain[external_output_bar]" \
@@ -766,3 +772,13 @@ def test_a_model_the_record_rules_out_gives_no_f_to_the_first_rounds_mixture():
     only = replace(v, weights={"reference": 0.0, "clearance": 0.0, "dispersion": 1.0})
     x, w, _ = mixture(base, ranked, only, 5)
     assert w == {"reference": 1.0} and np.all(x == 0.060)
+
+
+def test_a_final_median_of_zero_is_moved_by_any_other_f():
+    """How far a model moves f is relative to the final model's median; a median of 0 (a law clipped there) is moved
+    by any other, and not by another 0, with no division by it."""
+    from friction_uq.discrepancy.verdict import FORM_SHIFT, moves_f
+
+    assert moves_f(np.zeros(5), np.full(5, 0.01)) and not moves_f(np.zeros(5), np.zeros(5))
+    assert moves_f(np.full(5, 0.05), np.full(5, 0.05 * (1 + 1.01 * FORM_SHIFT)))
+    assert not moves_f(np.full(5, 0.05), np.full(5, 0.05 * (1 - 0.99 * FORM_SHIFT)))

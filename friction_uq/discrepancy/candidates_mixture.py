@@ -142,10 +142,11 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
     their rivals) or, without it, move f's median by more than the whole-record models' form term
     (:func:`~.verdict.moves_f`: the record cannot tell whether they are there, and f depends on it; on an
     axisymmetric pair record a plug friction behind a named slip law, 75 +- 43 nats, f 15 % lower and right): f's
-    draws from the mixture of those mechanisms' fits and, when it is among them, the final model (its exact
-    posterior; the round's reference), weighted by the round's stacking weights; (None, {}, None) when the final
-    model carries the weight alone, when the models that share it with no decisive evidence give the final model's f
-    (among models that predict alike stacking shares the weight at random), or when the last round named a cause.
+    draws from the mixture of those mechanisms' fits and, where it carries weight (its own or lent, below), the
+    final model (its exact posterior; the round's reference), weighted by the round's stacking weights; (None, {},
+    None) when the final model carries the weight alone, when the models that share it with no decisive evidence
+    give the final model's f (among models that predict alike stacking shares the weight at random), or when the
+    last round named a cause.
     The weight of a member with neither (it predicts alike with the final model and gives its f) goes to the final
     model, so that a member that moves f keeps its own share and no more."""
     if not causes or len(verdicts) <= len(causes) or verdicts[-1].kind not in ("none", "unexplained", "unconfirmed"):
@@ -173,7 +174,8 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
 
 def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stationary_f: np.ndarray | None = None,
             resolve: Resolve = _as_fitted) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
-    """f's draws from the stacking mixture of the models that carry the weight (:mod:`.verdict`), their weights
+    """f's draws from the stacking mixture of the models that carry the weight (:func:`members`: not those the record
+    rules out), their weights
     and each draw's model, when the first round named no single cause but found candidates, an unexplained
     misfit or an unconfirmed mechanism; (None, {}, None) otherwise. ``stationary_f``: the stationary analysis'
     draws of f, given :data:`STATIONARY_SHARE` of the weight beside the candidates' (module docstring)."""

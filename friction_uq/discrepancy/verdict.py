@@ -34,8 +34,9 @@ Verdicts (:class:`Verdict`): ``named`` (one mechanism passes all three, of a mis
 misses the record, no mechanism passes); ``unconfirmed`` (a mechanism passes, but the check finds no
 misfit: not named); ``none`` (no mechanism passes, no misfit: the simple model stands). Under
 ``candidates``, ``unexplained`` and ``unconfirmed`` the f to quote is the stacking mixture of the models
-that carry the weight (:func:`mixture_draws`), mixed in equal parts with the stationary analysis' f when ``run``
-gives its draws (:mod:`.candidates_mixture`): its interval holds the truth whichever of them is right.
+that carry the weight, less those the record rules out (:func:`ruled_out`; :func:`mixture_draws`), mixed in
+equal parts with the stationary analysis' f when ``run`` gives its draws (:mod:`.candidates_mixture`): its
+interval holds the truth whichever of them is right.
 """
 
 from __future__ import annotations
@@ -231,7 +232,7 @@ def moves_f(reference_f: np.ndarray, f: np.ndarray, shift: float = FORM_SHIFT) -
     ``shift``, relative: by default more than the 90 % half-width of the whole-record models' form term in f
     (:data:`FORM_SHIFT`), what two simulators of the same test may differ by."""
     ref = float(np.median(reference_f))
-    return abs(float(np.median(f)) / ref - 1.0) > shift
+    return abs(float(np.median(f)) - ref) > shift * abs(ref)
 
 
 def ruled_out(candidate: Candidate) -> bool:

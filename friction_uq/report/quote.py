@@ -23,7 +23,8 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
         label, fx = named
         if more := further(diagnosis):  # the causes named, and further ones the last round leaned to unnamed
             named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
-            shares = ", ".join(f"{'no further cause' if k == diagnosis.final.label else '+ ' + more[k]} {w:.2f}"
+            alike = "no further cause, or one that leaves f as it is,"  # a member giving the final f lends its weight
+            shares = ", ".join(f"{alike if k == diagnosis.final.label else '+ ' + more[k]} {w:.2f}"
                                for k, w in diagnosis.mixture_weights.items())
             return (f"the causes diagnose named ({named}) mixed with the further causes the record leans to "
                     f"without naming one ({shares})", fx)
