@@ -751,7 +751,7 @@ def test_a_model_the_record_rules_out_gives_no_f_to_the_first_rounds_mixture():
     from dataclasses import replace
     from types import SimpleNamespace
 
-    from friction_uq.discrepancy.candidates_mixture import members, mixture
+    from friction_uq.discrepancy.candidates_mixture import mixture
     from friction_uq.discrepancy.extended import Variant
 
     base = SimpleNamespace(label="baseline", variants=(), f_effective=np.full(500, 0.060))
@@ -762,13 +762,13 @@ def test_a_model_the_record_rules_out_gives_no_f_to_the_first_rounds_mixture():
                                                                        "dispersion": 0.3})
     v = replace(v, candidates=tuple(replace(c, delpd=-5373.0, se=1435.0, decisive=False, spread=False)
                                     if c.label == "dispersion" else c for c in v.candidates))
-    assert members(v) == ["clearance", "reference"]
+    assert v.members == ["clearance", "reference"]
     x, w, _ = mixture(base, ranked, v, 5)
     assert w == pytest.approx({"clearance": 0.6 / 0.7, "reference": 0.1 / 0.7}) and not np.any(x == 0.008)
     # a dELPD below the reference's but not decisively (-3 +- 2 nats): still a member
     close = replace(v, candidates=tuple(replace(c, delpd=-3.0, se=2.0) if c.label == "dispersion" else c
                                         for c in v.candidates))
-    assert "dispersion" in members(close)
+    assert "dispersion" in close.members
     only = replace(v, weights={"reference": 0.0, "clearance": 0.0, "dispersion": 1.0})
     x, w, _ = mixture(base, ranked, only, 5)
     assert w == {"reference": 1.0} and np.all(x == 0.060)

@@ -10,7 +10,7 @@ better than the model with the causes (their evidence sits in a few blocks) or t
 whole-record models' form term: f is then the mixture of the final model and those mechanisms
 (:func:`further_mixture`), not the final model's alone, whose interval would hold the truth only if nothing more
 were there. A model the record rules out against its round's reference is never a member of a mixture
-(:func:`members`), whatever stacking weight its few blocks earn it.
+(``Verdict.members``), whatever stacking weight its few blocks earn it.
 
 When no cause is named at all (the first round's candidates, unexplained or unconfirmed, or candidates fitted
 in turn whose rivals stay open and no cause besides), the whole-record models
@@ -31,7 +31,7 @@ import numpy as np
 
 from ..stats.streams import stream
 from .extended import ModelFit, Variant
-from .verdict import WEIGHT_RULE, Verdict, mixture_draws, moves_f, round_weights, ruled_out
+from .verdict import Verdict, mixture_draws, moves_f, round_weights
 
 #: Draws of the stacking mixture that gives f when no single cause is named.
 MIXTURE_DRAWS = 1000
@@ -119,25 +119,11 @@ def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int,
     return _draw_mixture(draws, w, seed)
 
 
-def members(verdict: Verdict) -> list[str]:
-    """The labels (``reference`` among them) that may give f in a round's stacking mixture: those that carry its
-    weight (:class:`~friction_uq.stats.WeightRule`), heaviest first, once the models the record rules out against
-    the round's reference (:func:`~.verdict.ruled_out`) are set aside: their weight comes from a few blocks they
-    alone predict, and it neither gives them a share of f nor pushes another model out of the mass that carries
-    the weight."""
-    by = {c.label: c for c in verdict.candidates}
-    kept = {k: w for k, w in verdict.weights.items() if not (k in by and ruled_out(by[k]))}
-    total = sum(kept.values())
-    if total <= 0.0:
-        return []
-    return [k for k in WEIGHT_RULE.supported({k: w / total for k, w in kept.items()}) if kept[k] > 0.0]
-
-
 def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
                     seed: int, resolve: Resolve = _as_fitted
                     ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """After at least one cause, when the last round named nothing (none, unexplained or unconfirmed) and the
-    models that carry its stacking weight (:func:`members`) include further mechanisms that either have evidence
+    models that carry its stacking weight (``Verdict.members``) include further mechanisms that either have evidence
     over the model with the causes decisive by the package's rule (they fail the naming rule on its spread or on
     their rivals) or, without it, move f's median by more than the whole-record models' form term
     (:func:`~.verdict.moves_f`: the record cannot tell whether they are there, and f depends on it; on an
@@ -155,7 +141,7 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
     decisive = {c.label for c in verdict.candidates if c.decisive}
     fits = {r.fit.label: r.fit for r in rounds[-1]}
     draws, alike = {}, 0.0  # heaviest first, as the weights; the weight of the members that give the final f
-    for label in members(verdict):
+    for label in verdict.members:
         if label == "reference":
             alike += verdict.weights[label]
             continue
@@ -174,17 +160,17 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
 
 def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stationary_f: np.ndarray | None = None,
             resolve: Resolve = _as_fitted) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
-    """f's draws from the stacking mixture of the models that carry the weight (:func:`members`: not those the record
-    rules out), their weights
-    and each draw's model, when the first round named no single cause but found candidates, an unexplained
-    misfit or an unconfirmed mechanism; (None, {}, None) otherwise. ``stationary_f``: the stationary analysis'
-    draws of f, given :data:`STATIONARY_SHARE` of the weight beside the candidates' (module docstring)."""
+    """f's draws from the stacking mixture of the models that carry the weight (``Verdict.members``: not those the
+    record rules out), their weights and each draw's model, when the first round named no single cause but found
+    candidates, an unexplained misfit or an unconfirmed mechanism; (None, {}, None) otherwise. ``stationary_f``:
+    the stationary analysis' draws of f, given :data:`STATIONARY_SHARE` of the weight beside the candidates' (module
+    docstring)."""
     if verdict.kind not in ("candidates", "unexplained", "unconfirmed"):
         return None, {}, None
     fits = {"reference": base} | {r.fit.label: r.fit for r in ranked}
-    keep = members(verdict) or ["reference"]  # every model that carries weight ruled out: the reference stands
-    w = {k: verdict.weights[k] or 1.0 for k in keep}
-    draws, w = _with_stationary({k: resolve(fits[k]).f_effective for k in keep}, w, stationary_f)
+    keep = verdict.members
+    w = {k: verdict.weights[k] for k in keep} if keep else {"reference": 1.0}  # all ruled out: the reference stands
+    draws, w = _with_stationary({k: resolve(fits[k]).f_effective for k in w}, w, stationary_f)
     return _draw_mixture(draws, w, seed)
 
 

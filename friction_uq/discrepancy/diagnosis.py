@@ -72,7 +72,7 @@ class Diagnosis:
     verdicts: tuple[Verdict, ...] = ()
     #: no cause named but candidates or an unexplained misfit, a cause fitted in turn whose rivals stay open, or
     #: further mechanisms carrying the last round's weight: f's draws from the stacking mixture of the models that
-    #: carry the weight less those the record rules out (``candidates_mixture.members``), their labels and weights
+    #: carry the weight less those the record rules out (``Verdict.members``), their labels and weights
     #: ("reference": the model without causes; "stationary": the stationary analysis' draws, half the weight when
     #: nothing is named and run gave them)
     mixture_f: np.ndarray | None = None

@@ -5,7 +5,6 @@ when it has nothing to say."""
 
 from __future__ import annotations
 
-from .candidates_mixture import members
 from .cause_words import cause_words, f_steps
 from .diagnosis import Diagnosis
 from .rival_swaps import WITHOUT
@@ -107,6 +106,6 @@ def remaining_clause(dg: Diagnosis) -> str:
     where = f" on the {CHANNEL_LABELS.get(cells[0].channel, cells[0].channel)} gauge, {cells[0].phase} phase" \
         if cells else ""
     by = {c.label: c.variant for c in last.candidates}
-    listed = [by[label] for label in members(last) if label in by]  # not a model the record rules out
+    listed = [by[label] for label in last.members if label in by]  # not a model the record rules out
     return (f" A misfit remains with them{where} that no further cause explains clearly"
             f"{' (candidates: ' + ', '.join(listed) + ')' if listed else ''}.")

@@ -34,7 +34,7 @@ Verdicts (:class:`Verdict`): ``named`` (one mechanism passes all three, of a mis
 misses the record, no mechanism passes); ``unconfirmed`` (a mechanism passes, but the check finds no
 misfit: not named); ``none`` (no mechanism passes, no misfit: the simple model stands). Under
 ``candidates``, ``unexplained`` and ``unconfirmed`` the f to quote is the stacking mixture of the models
-that carry the weight, less those the record rules out (:func:`ruled_out`; :func:`mixture_draws`), mixed in
+that carry the weight, less those the record rules out (:attr:`Verdict.members`; :func:`mixture_draws`), mixed in
 equal parts with the stationary analysis' f when ``run`` gives its draws (:mod:`.candidates_mixture`): its
 interval holds the truth whichever of them is right.
 """
@@ -86,6 +86,14 @@ class Candidate:
         return self.decisive and self.spread
 
     @property
+    def decisively_worse(self) -> bool:
+        """The record rules the model out against the round's reference: its dELPD is decisively negative by the
+        package's rule. Stacking may still give such a model weight, from the few blocks it alone predicts (a bars'
+        dispersion at sharp fronts, 5000 nats worse over the record), but its f, fitted to a record it misses, is no
+        answer for the record: it is no member of f's mixture (:attr:`Verdict.members`)."""
+        return RULE.decisive(-self.delpd, self.se)
+
+    @property
     def variant(self) -> str:
         """The mechanism as fitted, a gain with its gauge (``gauge_gain[input_bar]``; ``Variant.label``'s form)."""
         return self.mechanism + (f"[{self.channel}]" if self.channel else "")
@@ -119,6 +127,20 @@ class Verdict:
     def supported(self) -> list[str]:
         """The labels (``reference`` included) that carry the stacking weight (:class:`WeightRule`)."""
         return WEIGHT_RULE.supported(self.weights)
+
+    @property
+    def members(self) -> list[str]:
+        """The labels (``reference`` among them) that may give f in the round's stacking mixture
+        (:mod:`.candidates_mixture`): those that carry its weight, heaviest first, once the models the record rules
+        out against the reference (:attr:`Candidate.decisively_worse`) are set aside: their weight comes from a few
+        blocks they alone predict, and it neither gives them a share of f nor pushes another model out of the mass
+        that carries the weight."""
+        worse = {c.label for c in self.candidates if c.decisively_worse}
+        kept = {k: w for k, w in self.weights.items() if k not in worse}
+        total = sum(kept.values())
+        if total <= 0.0:
+            return []
+        return [k for k in WEIGHT_RULE.supported({k: w / total for k, w in kept.items()}) if kept[k] > 0.0]
 
 
 def _points(elpd) -> np.ndarray:
@@ -233,14 +255,6 @@ def moves_f(reference_f: np.ndarray, f: np.ndarray, shift: float = FORM_SHIFT) -
     (:data:`FORM_SHIFT`), what two simulators of the same test may differ by."""
     ref = float(np.median(reference_f))
     return abs(float(np.median(f)) - ref) > shift * abs(ref)
-
-
-def ruled_out(candidate: Candidate) -> bool:
-    """The record rules the model out against its round's reference: its dELPD is decisively negative by the
-    package's rule. Stacking may still give such a model weight, from the few blocks it alone predicts (a bars'
-    dispersion at sharp fronts, 5000 nats worse over the record), but its f, fitted to a record it misses, is no
-    answer for the record, and it is no member of f's mixture (:mod:`.candidates_mixture`)."""
-    return RULE.decisive(-candidate.delpd, candidate.se)
 
 
 def round_weights(reference, fits: Sequence, seed: int) -> dict[str, float]:
