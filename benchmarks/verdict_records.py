@@ -31,7 +31,8 @@ nu).
         [--max-causes 1 | --as-run]
 
 Each record's line ends with its time, and diagnose's own (the simulation not counted); the last line, their
-median. ``--as-run`` takes every round through ``friction_uq.run`` (the stationary analysis, the whole-record check
+median. Under ``--as-run`` the line also gives the JSON's f (the f a user reads) and whether its 90 % interval
+holds the truth. ``--as-run`` takes every round through ``friction_uq.run`` (the stationary analysis, the whole-record check
 and the exact posterior included): the time a user of ``friction-uq diagnose`` waits, without the PDF.
 """
 
@@ -238,9 +239,10 @@ def main() -> None:
             write(cfg, path, sim_seed, edit, header)
             t_fit = time.perf_counter()
             if a.as_run:
-                prep, dg, _ = analyse_as_run(path, os.path.join(tmp, name), seed=k)
+                prep, dg, f_json = analyse_as_run(path, os.path.join(tmp, name), seed=k)
             else:
                 prep, dg = analyse(path, priors, seed=k, max_causes=a.max_causes)
+                f_json = None
         except FrictionUQError as exc:
             print(f"{name}: refused: {exc}", flush=True)
             continue
@@ -249,7 +251,12 @@ def main() -> None:
         os.remove(path)
         causes = [v.mechanism.name for v in dg.named_causes]
         rounds = [v.kind for v in dg.verdicts]
-        print(f"{name} ({note}): misfit {dg.misfits[0].detected}, named {causes or None}, rounds {rounds}, "
+        quoted = ""
+        if f_json is not None:  # the JSON's f against the truth: whether the f a user reads holds it
+            tf = true_f(cfg, prep)
+            held = "held" if f_json["q05"] <= tf <= f_json["q95"] else "MISSED"
+            quoted = f"f {f_json['q50']:.4f} [{f_json['q05']:.4f}, {f_json['q95']:.4f}] truth {tf:.4f} {held}, "
+        print(f"{name} ({note}): misfit {dg.misfits[0].detected}, named {causes or None}, rounds {rounds}, {quoted}"
               f"{time.perf_counter() - t:.0f} s ({seconds[-1]:.0f} s diagnose)", flush=True)
     if seconds:
         how = "every round, as run" if a.as_run else f"{a.max_causes} round(s) at most"
