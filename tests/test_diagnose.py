@@ -156,6 +156,37 @@ def test_a_rival_behind_over_the_whole_record_with_no_weight_is_ruled_out_and_on
     assert v.kind == "candidates" and v.rivals == ("bandwidth",) and v.by_weight == ()
 
 
+def test_a_model_the_record_rules_out_pushes_no_rival_out_of_the_mass_the_weight_guards(monkeypatch):
+    """The weight route never rules out a model among those that carry 90 % of the stacking weight. A model the
+    record rules out against the reference (a bars' dispersion, 200 nats behind it) may still take weight from a few
+    blocks it alone predicts; that weight is set aside first (verdict.weights_kept), as for f's mixture, or it would
+    push a rival out of the guarded mass and let the weight rule the rival out."""
+    from friction_uq.discrepancy import verdict as vmod
+
+    base = _fit("reference", None, _noise())
+    best = _noise(seed=5) + 1.0  # 200 nats over the reference, every block
+    lead = np.full(best.size, 0.1)
+    lead[:2] += 40.0  # 100 nats ahead of the rival, within 2 SE, still 20 ahead with the spread test's blocks out
+    weights = {"reference": 0.02, "velocity_friction": 0.75, "dispersion": 0.15, "bandwidth": 0.08}
+    monkeypatch.setattr(vmod, "round_weights", lambda reference, fits, seed: dict(weights))
+
+    def judged(third):
+        fits = [_fit("velocity_friction", None, best), _fit("bandwidth", None, best - lead),
+                _fit("dispersion", None, third)]
+        return vmod.NamingRule().judge(base, _round(base, fits), misfit=True)
+
+    v = judged(_noise(seed=7) - 1.0)  # ruled out: without its 0.15 the rival carries 0.09 of 0.85, inside the mass
+    assert [c.label for c in v.candidates if c.decisively_worse] == ["dispersion"]
+    assert vmod.weights_kept(v.weights, ["dispersion"]) == pytest.approx(
+        {"reference": 0.02 / 0.85, "velocity_friction": 0.75 / 0.85, "bandwidth": 0.08 / 0.85})
+    assert v.kind == "candidates" and v.rivals == ("bandwidth",) and v.by_weight == ()
+    # the same weights with the third model as good as the reference: its weight counts, the rival falls outside
+    # the mass and, light, is ruled out by the weight
+    v = judged(_noise(seed=7) * 0.1)
+    assert not any(c.decisively_worse for c in v.candidates)
+    assert v.kind == "named" and v.named == "velocity_friction" and v.by_weight == ("bandwidth",)
+
+
 def test_the_mixture_takes_each_model_in_proportion_to_its_weight():
     from friction_uq.discrepancy.verdict import mixture_draws
 

@@ -5,6 +5,7 @@ from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from friction_uq.discrepancy.candidates_mixture import named_causes, unresolved_rounds
 from friction_uq.discrepancy.elpd import Elpd
@@ -170,6 +171,30 @@ def test_a_rival_the_final_model_rules_out_is_resolved_and_the_candidate_named_o
     assert [v.mechanism.name for v in named_causes(causes, out)] == ["clearance"]
 
 
+def test_a_swap_the_final_model_rules_out_pushes_no_other_out_of_the_mass_the_weight_guards(monkeypatch):
+    """As in a round (verdict.weights_kept): the swaps the final model rules out by the ELPD rule are set aside before
+    the 90 % of the stacking weight the weight route never rules out is counted."""
+    from friction_uq.discrepancy import rival_swaps
+
+    causes, verdicts, rounds, final = _record()
+    good = np.asarray(final.elpd.pointwise)
+    lead = np.full(N, 0.1)
+    lead[:2] += 40.0  # 100 nats behind the final model, within 2 SE; 20 with the spread test's blocks left out
+    weights = {"reference": 0.6, "clearance": 0.2, "bandwidth+clearance": 0.12, "channel_timing+clearance": 0.08}
+    monkeypatch.setattr(rival_swaps, "round_weights", lambda reference, fits, seed: dict(weights))
+    fitter = _Fitter({"clearance": good - 1.0, "channel_timing": good - lead, "bandwidth": good - 1.0})
+    out, swaps, _ = check_swaps(fitter, final, causes, verdicts, rounds, rule=NamingRule(), workers=1, seed=0,
+                                flagged=lambda fit: True)
+    # without the 0.32 of the two swaps ruled out, the timing swap is inside the guarded mass: it stays open
+    assert [s.ruling for s in swaps] == ["elpd", None, "elpd"]
+    assert out[0].resolved == ("bandwidth",) and unresolved_rounds(causes, out) == (0,)
+    # counted with their weight, the same comparison would rule it out by the weight and name the dispersion
+    timing = next(s for s in swaps if s.rival == "channel_timing")
+    behind = {"reference": 0.0, timing.model: timing.delpd}
+    assert NamingRule().rulings(final.elpd, {timing.model: Elpd(good - lead, float("nan"))}, weights, behind,
+                                10)[timing.model] == "weight"
+
+
 def test_a_model_without_the_candidate_within_the_check_s_tolerance_resolves_nothing():
     """The ELPD rule sees a flexible transient that absorbs model form as evidence; the whole-record check's tolerance
     (what two simulators differ by) forgives it. Without the candidate the model must miss by more than that."""
@@ -291,6 +316,24 @@ def test_a_candidate_whose_rivals_later_rounds_all_named_must_still_earn_its_pla
     causes, verdicts, rounds, _ = _record(first_rivals=("clearance",))
     last = [replace(verdicts[0], kind="named", rivals=()), replace(verdicts[1], kind="candidates", rivals=())]
     assert swap_jobs(causes, last, rounds) == []
+
+
+def test_a_superfluous_candidate_s_mixture_has_no_swap_the_final_model_rules_out(monkeypatch):
+    """As in a round (verdict.Verdict.members): a swapped model 200 nats worse than the final model, whatever stacking
+    weight its few blocks earn it, gives f no share; the others keep their proportions."""
+    from friction_uq.discrepancy import candidates_mixture
+
+    _, _, _, final = _record()
+    final.f_effective = np.full(50, 0.04)
+    good = np.asarray(final.elpd.pointwise)
+    without = _fit("clearance", good + np.random.default_rng(1).normal(0, 0.05, N))  # as good: f 0.05
+    worse = _fit("bandwidth+clearance", good - 1.0)
+    worse.f_effective = np.full(50, 0.2)
+    monkeypatch.setattr(candidates_mixture, "round_weights", lambda reference, fits, seed: {
+        "reference": 0.4, "clearance": 0.3, "bandwidth+clearance": 0.3})
+    x, w, _ = candidates_mixture.superfluous_mixture(final, [without, worse], seed=0)
+    assert w == pytest.approx({final.label: 4 / 7, "clearance": 3 / 7})
+    assert set(np.unique(x)) <= {0.04, 0.05}
 
 
 def test_the_sentence_says_a_superfluous_candidate_is_not_named():

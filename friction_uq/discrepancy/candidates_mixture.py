@@ -29,9 +29,11 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from ..stats import RULE
 from ..stats.streams import stream
+from .elpd import elpd_difference
 from .extended import ModelFit, Variant
-from .verdict import Verdict, mixture_draws, moves_f, round_weights
+from .verdict import Verdict, mixture_draws, moves_f, round_weights, weights_kept
 
 #: Draws of the stacking mixture that gives f when no single cause is named.
 MIXTURE_DRAWS = 1000
@@ -108,15 +110,18 @@ def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int,
     """When a candidate fitted in turn is superfluous (:mod:`.rival_swaps`) and no round leaves a rival open: f's
     draws from the stacking mixture of the final model and ``checked``, the swap check's models of that round (the
     final model without the candidate, and the rivals swapped in), holding the later causes (a rival of a later
-    cause's group replaces that cause too), weighted by one stacking over them; (None, {}, None) without them."""
+    cause's group replaces that cause too), weighted by one stacking over them, less the models the final model
+    rules out by the package's rule (as :attr:`~.verdict.Verdict.members`: their weight from a few blocks gives them
+    no share of f); (None, {}, None) without them."""
     if not checked:
         return None, {}, None
-    weights = round_weights(final, list(checked), seed)
-    draws = {final.label: final.f_effective} | {f.label: resolve(f).f_effective for f in checked}
-    w = {final.label: weights["reference"]} | {f.label: weights[f.label] for f in checked}
-    if sum(w.values()) <= 0.0:
-        w = {label: 1.0 for label in w}
-    return _draw_mixture(draws, w, seed)
+    worse = [f.label for f in checked if RULE.decisive(*elpd_difference(final.elpd, f.elpd))]
+    kept = weights_kept(round_weights(final, list(checked), seed), worse)
+    kept = {final.label if k == "reference" else k: w for k, w in kept.items()}
+    if sum(kept.values()) <= 0.0:
+        kept = {final.label: 1.0} | {f.label: 1.0 for f in checked if f.label not in worse}
+    draws = {final.label: final.f_effective} | {f.label: resolve(f).f_effective for f in checked if f.label in kept}
+    return _draw_mixture(draws, kept, seed)
 
 
 def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],

@@ -27,7 +27,8 @@ where the axisymmetric cell's hoop strain departs from the 1-D model's, which th
 check's tolerance forgives.
 
 Asked only of a round followed by a later cause: for the last cause's round the swap is the round's own
-comparison, already judged. The weight route is the naming rule's own, its 90 % guard included. A rival of the
+comparison, already judged. The weight route is the naming rule's own, its 90 % guard included (the weight of the
+swaps the final model rules out set aside first, :func:`.verdict.weights_kept`). A rival of the
 same group as a later cause (a second friction law) cannot join the model beside it: it is swapped in for the
 candidate *and* that cause, and must stand in for both (on the bundled B-02, the slip law, a rival of the first
 round's dispersion, against the velocity law named later). Before, such a rival could not be asked and kept its
@@ -51,11 +52,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
+from ..stats import RULE
 from ..stats.trimmed import points_to_drop
 from .candidates_mixture import open_rivals
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant
-from .verdict import NamingRule, Verdict, round_weights
+from .verdict import NamingRule, Verdict, round_weights, weights_kept
 
 #: The ``rival`` of the swap that leaves the candidate out (the final model without it).
 WITHOUT = "(without it)"
@@ -130,12 +132,16 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
                          "+".join(v.label for v in variants)) for k, label, variants in jobs], workers=workers,
                        cut=False)  # the cut for a swap's model only where a mixture reports its f
     weights = round_weights(final, fits, seed)
-    behind = {"reference": 0.0} | {f.label: elpd_difference(final.elpd, f.elpd)[0] for f in fits}
+    against = {f.label: elpd_difference(final.elpd, f.elpd) for f in fits}  # the final model's lead on each swap
+    behind = {"reference": 0.0} | {label: d for label, (d, _) in against.items()}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
-    how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits}, weights, behind, drop)
+    # as in a round: a swap the final model rules out pushes no other out of the mass the weight guards
+    worse = [label for label, (d, se) in against.items() if RULE.decisive(d, se)]
+    how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits}, weights_kept(weights, worse) or weights,
+                            behind, drop)
     swaps = []
     for (k, label, _), f in zip(jobs, fits):
-        d, se = elpd_difference(final.elpd, f.elpd)
+        d, se = against[f.label]
         how = how_each[f.label]
         misfit = flagged(f) if label == WITHOUT and how is not None else None
         swaps.append(Swap(k, label, f.label, d, se, weights[f.label], how, misfit))

@@ -15,7 +15,8 @@ answers each before it names a mechanism:
    beat it by the same rule, or (``by_weight``) lead it by more than 4 nats with the blocks that favour the
    best most left out (the spread test's share) while the rival, with the mechanisms as far behind that
    predict alike with it, carries less than 0.1 of the stacking weight and is not among the models that carry
-   90 % of it (:meth:`friction_uq.stats.WeightRule.ruled_out`, the route the campaign's law comparison takes).
+   90 % of it (:meth:`friction_uq.stats.WeightRule.ruled_out`, the route the campaign's law comparison takes),
+   the weight of the models the record rules out against the reference set aside (:func:`weights_kept`).
    Otherwise the record does not separate them.
    The SE of a sum over hundreds of blocks is dominated by the few where two mechanisms part (a front, the
    unloading): a second cause behind a first one leads its rivals by tens of nats spread over the record and
@@ -41,7 +42,7 @@ interval holds the truth whichever of them is right.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -132,15 +133,21 @@ class Verdict:
     def members(self) -> list[str]:
         """The labels (``reference`` among them) that may give f in the round's stacking mixture
         (:mod:`.candidates_mixture`): those that carry its weight, heaviest first, once the models the record rules
-        out against the reference (:attr:`Candidate.decisively_worse`) are set aside: their weight comes from a few
-        blocks they alone predict, and it neither gives them a share of f nor pushes another model out of the mass
-        that carries the weight."""
-        worse = {c.label for c in self.candidates if c.decisively_worse}
-        kept = {k: w for k, w in self.weights.items() if k not in worse}
-        total = sum(kept.values())
-        if total <= 0.0:
-            return []
-        return [k for k in WEIGHT_RULE.supported({k: w / total for k, w in kept.items()}) if kept[k] > 0.0]
+        out against the reference (:attr:`Candidate.decisively_worse`) are set aside (:func:`weights_kept`)."""
+        kept = weights_kept(self.weights, (c.label for c in self.candidates if c.decisively_worse))
+        return [k for k in WEIGHT_RULE.supported(kept) if kept[k] > 0.0]
+
+
+def weights_kept(weights: Mapping[str, float], worse: Iterable[str]) -> dict[str, float]:
+    """A round's stacking weights without the models the record rules out against the round's reference
+    (``worse``: their labels, :attr:`Candidate.decisively_worse`), the rest scaled to sum to 1 (empty if nothing is
+    left). Such a model's weight comes from a few blocks it alone predicts: it neither gives it a share of f
+    (:attr:`Verdict.members`) nor pushes another model out of the mass that carries the weight, where the naming rule
+    would no longer guard it (:meth:`NamingRule.rulings`)."""
+    worse = set(worse)
+    kept = {k: w for k, w in weights.items() if k not in worse}
+    total = sum(kept.values())
+    return {k: w / total for k, w in kept.items()} if total > 0.0 else {}
 
 
 def _points(elpd) -> np.ndarray:
@@ -212,7 +219,9 @@ class NamingRule:
         only by the weight route."""
         behind = {"reference": best.delpd} | {c.label: best.delpd - c.delpd for c in cands}
         others = [c for c in (cands if self.against_all else passing) if c.label != best.label]
-        how_each = self.rulings(fits[best.label].elpd, {c.label: fits[c.label].elpd for c in others}, weights,
+        # the weights less the models the record rules out, as f's mixture reads them (weights_kept)
+        how_each = self.rulings(fits[best.label].elpd, {c.label: fits[c.label].elpd for c in others},
+                                weights_kept(weights, (c.label for c in cands if c.decisively_worse)) or weights,
                                 behind, drop)
         rivals, light = [], []
         for c in others:
