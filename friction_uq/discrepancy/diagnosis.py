@@ -83,7 +83,8 @@ class Diagnosis:
     #: with the later causes in the model (:mod:`.rival_swaps`; the verdicts' ``resolved`` holds the rivals ruled out,
     #: ``superfluous`` whether the candidate was needed)
     swaps: tuple[Swap, ...] = ()
-    #: each swap's fitted model, in ``swaps``' order (members of f's mixture when a candidate is superfluous)
+    #: each swap's fitted model, in ``swaps``' order (when a candidate is superfluous, those the final model does not
+    #: rule out are members of f's mixture)
     swap_models: tuple[ModelFit, ...] = ()
     #: which mixture gives f: "candidates" (the first round names none), "rivals" (a round's rivals left open),
     #: "further" (the last round's weight on further mechanisms), "superfluous" (a candidate fitted in turn not

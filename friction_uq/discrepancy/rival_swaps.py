@@ -44,7 +44,8 @@ without it, which the check does not flag. Asking the gate of it alone would nam
 the other by the order they were fitted in. A candidate that fails its test is *superfluous*
 (``Verdict.superfluous``): not named. Where no round leaves a rival open, f is then the stacking mixture of the
 final model and the check's models of its round (the model without it, the rivals swapped in), every one of which
-holds the later causes (:func:`~.candidates_mixture.superfluous_mixture`).
+holds the later causes, less those the final model rules out by the package's rule
+(:func:`~.candidates_mixture.superfluous_mixture`).
 """
 
 from __future__ import annotations
