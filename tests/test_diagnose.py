@@ -686,6 +686,41 @@ def test_candidates_fitted_in_turn_and_left_open_with_nothing_named_take_the_sta
     assert STATIONARY not in w2 and set(w2) == {"gauge_gain[input_bar]", "zero_drift"}
 
 
+def test_a_further_mechanism_of_the_last_round_stands_for_the_final_model_in_the_open_rivals_mixture():
+    """A record of the axisymmetric simulation with a plug friction and a clearance: round 1 fitted the clearance in
+    turn with a zero drift open, and the last round named nothing but put weight on a plug friction that moves f 10 %
+    (the true second cause). The open rivals' mixture gives f, and the final model's share of it is the last round's
+    further mixture (the final model and the plug friction in their proportions), not the final model alone: the
+    record cannot tell whether the plug friction is there either, and f depends on it."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from friction_uq.discrepancy.candidates_mixture import STATIONARY, further_members, rival_mixture
+    from friction_uq.discrepancy.diagnose import _mixture_after_causes
+    from friction_uq.discrepancy.extended import Variant
+
+    clearance = Variant(MECHANISMS["clearance"])
+    final = SimpleNamespace(label="clearance", f_effective=np.full(500, 0.117))
+    drift = SimpleNamespace(fit=SimpleNamespace(label="zero_drift", f_effective=np.full(500, 0.118)))
+    plug = SimpleNamespace(fit=SimpleNamespace(label="clearance+plug_friction", f_effective=np.full(500, 0.105)))
+    open_round = replace(_verdict("candidates", "clearance", ("zero_drift",)),
+                         weights={"reference": 0.0, "clearance": 0.86, "zero_drift": 0.14})
+    last = replace(_verdict("unexplained", labels=("clearance+plug_friction",)),
+                   weights={"reference": 0.6, "clearance+plug_friction": 0.4})
+    rounds, verdicts = [[drift], [plug]], [open_round, last]
+    further = further_members(final, rounds, verdicts, [clearance])
+    assert further is not None and further[1] == {"clearance": 0.6, "clearance+plug_friction": 0.4}
+    x, w, _, kind = _mixture_after_causes(final, rounds, verdicts, [clearance], (), (), 5, np.full(2000, 0.116),
+                                          lambda m: m)
+    assert kind == "rivals"
+    assert w == pytest.approx({STATIONARY: 0.5, "clearance": 0.5 * 0.86 * 0.6, "clearance+plug_friction":
+                               0.5 * 0.86 * 0.4, "zero_drift": 0.5 * 0.14})
+    assert np.mean(x == 0.105) == pytest.approx(0.5 * 0.86 * 0.4, abs=1e-3)
+    # without further members the final model keeps its whole share, as before
+    _, w0, _ = rival_mixture(final, rounds, verdicts, [clearance], 5, np.full(2000, 0.116))
+    assert w0 == pytest.approx({STATIONARY: 0.5, "clearance": 0.43, "zero_drift": 0.07})
+
+
 @dataclass
 class _Fit:
     """The parts of a :class:`~friction_uq.discrepancy.extended.ModelFit` that the rounds read."""

@@ -9,7 +9,9 @@ record's stacking weight lies on further mechanisms, none of which passes the na
 better than the model with the causes (their evidence sits in a few blocks) or that would move f beyond the
 whole-record models' form term: f is then the mixture of the final model and those mechanisms
 (:func:`further_mixture`), not the final model's alone, whose interval would hold the truth only if nothing more
-were there. A model the record rules out against its round's reference is never a member of a mixture
+were there. Where a round's rivals are left open as well, those further mechanisms stand for the final model in its
+share of the rivals' mixture (:func:`further_members`): the record tells neither which candidate is right nor
+whether the further mechanism is there. A model the record rules out against its round's reference is never a member of a mixture
 (``Verdict.members``), whatever stacking weight its few blocks earn it.
 
 When no cause is named at all (the first round's candidates, unexplained or unconfirmed, or candidates fitted
@@ -44,6 +46,8 @@ STATIONARY_SHARE = 0.5
 
 #: A mixture member's model with its f as reported (``Diagnoser.resolved``: the cut posterior's under ``nu_cut``).
 Resolve = Callable[[ModelFit], ModelFit]
+#: A mixture's members before it is drawn: each label's draws of f, and its weight.
+Members = tuple[dict[str, np.ndarray], dict[str, float]]
 
 
 def _as_fitted(mf: ModelFit) -> ModelFit:
@@ -84,24 +88,28 @@ def named_causes(causes, verdicts) -> list:
 
 
 def rival_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant], seed: int,
-                  stationary_f: np.ndarray | None = None, resolve: Resolve = _as_fitted
-                  ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+                  stationary_f: np.ndarray | None = None, resolve: Resolve = _as_fitted,
+                  further: Members | None = None) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
     """When a round named its cause among candidates and a rival mechanism was never named in a later round (it
     is an alternative, not a second cause), f's draws from the mixture of the final model and those rivals'
     fits, weighted by the first such round's stacking weights; (None, {}, None) when every rival was resolved.
     ``stationary_f``: the stationary analysis' draws, given half the weight when the record names no cause
-    (module docstring). ``resolve``: a member's model with its f as reported (``Diagnoser.resolved``)."""
+    (module docstring). ``resolve``: a member's model with its f as reported (``Diagnoser.resolved``).
+    ``further``: the last round's further members (:func:`further_members`), which stand for the final model in
+    its share: the record cannot tell whether they are in the model with the causes either, and they move its f."""
     for k in open_rounds(causes, verdicts)[:1]:
         verdict = verdicts[k]
         left = open_rivals(verdict, causes)
         fits = {r.fit.label: r.fit for r in rounds[k]}
-        draws = {final.label: final.f_effective} | {label: resolve(fits[label]).f_effective for label in left}
-        w = {final.label: verdict.weights[verdict.named]} | {label: verdict.weights[label] for label in left}
+        own = further or ({final.label: final.f_effective}, {final.label: 1.0})
+        share = verdict.weights[verdict.named] / sum(own[1].values())
+        draws = own[0] | {label: resolve(fits[label]).f_effective for label in left}
+        w = {label: share * x for label, x in own[1].items()} | {label: verdict.weights[label] for label in left}
         if sum(w.values()) <= 0.0:
             w = {label: 1.0 for label in w}
         if not named_causes(causes, verdicts):
             draws, w = _with_stationary(draws, w, stationary_f)
-        return _draw_mixture(draws, w, seed)
+        return draw_mixture(draws, w, seed)
     return None, {}, None
 
 
@@ -121,27 +129,25 @@ def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int,
     if sum(kept.values()) <= 0.0:
         kept = {final.label: 1.0} | {f.label: 1.0 for f in checked if f.label not in worse}
     draws = {final.label: final.f_effective} | {f.label: resolve(f).f_effective for f in checked if f.label in kept}
-    return _draw_mixture(draws, kept, seed)
+    return draw_mixture(draws, kept, seed)
 
 
-def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
-                    seed: int, resolve: Resolve = _as_fitted
-                    ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+def further_members(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
+                    resolve: Resolve = _as_fitted) -> Members | None:
     """After at least one cause, when the last round named nothing (none, unexplained or unconfirmed) and the
     models that carry its stacking weight (``Verdict.members``) include further mechanisms that either have evidence
     over the model with the causes decisive by the package's rule (they fail the naming rule on its spread or on
     their rivals) or, without it, move f's median by more than the whole-record models' form term
     (:func:`~.verdict.moves_f`: the record cannot tell whether they are there, and f depends on it; on an
-    axisymmetric pair record a plug friction behind a named slip law, 75 +- 43 nats, f 15 % lower and right): f's
-    draws from the mixture of those mechanisms' fits and, where it carries weight (its own or lent, below), the
-    final model (its exact posterior; the round's reference), weighted by the round's stacking weights; (None, {},
-    None) when the final model carries the weight alone, when the models that share it with no decisive evidence
-    give the final model's f (among models that predict alike stacking shares the weight at random), or when the
-    last round named a cause.
+    axisymmetric pair record a plug friction behind a named slip law, 75 +- 43 nats, f 15 % lower and right): those
+    mechanisms' fits and, where it carries weight (its own or lent, below), the final model (its exact posterior;
+    the round's reference), as draws of f and the round's stacking weights; None when the final model carries the
+    weight alone, when the models that share it with no decisive evidence give the final model's f (among models
+    that predict alike stacking shares the weight at random), or when the last round named a cause.
     The weight of a member with neither (it predicts alike with the final model and gives its f) goes to the final
     model, so that a member that moves f keeps its own share and no more."""
     if not causes or len(verdicts) <= len(causes) or verdicts[-1].kind not in ("none", "unexplained", "unconfirmed"):
-        return None, {}, None
+        return None
     verdict = verdicts[-1]
     decisive = {c.label for c in verdict.candidates if c.decisive}
     fits = {r.fit.label: r.fit for r in rounds[-1]}
@@ -156,11 +162,20 @@ def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], caus
         else:  # it predicts alike with the final model and gives its f: the final model's exact posterior stands for it
             alike += verdict.weights[label]
     if not draws:
-        return None, {}, None
+        return None
     w = {label: verdict.weights[label] for label in draws}
     if alike > 0.0:
         draws, w = {final.label: final.f_effective} | draws, {final.label: alike} | w
-    return _draw_mixture(draws, w, seed)
+    return draws, w
+
+
+def further_mixture(final: ModelFit, rounds: list, verdicts: list[Verdict], causes: list[Variant],
+                    seed: int, resolve: Resolve = _as_fitted
+                    ) -> tuple[np.ndarray | None, dict[str, float], np.ndarray | None]:
+    """f's draws from the mixture of the last round's further members (:func:`further_members`), their weights and
+    each draw's model; (None, {}, None) without them."""
+    members = further_members(final, rounds, verdicts, causes, resolve)
+    return (None, {}, None) if members is None else draw_mixture(*members, seed)
 
 
 def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stationary_f: np.ndarray | None = None,
@@ -176,7 +191,7 @@ def mixture(base: ModelFit, ranked: Sequence, verdict: Verdict, seed: int, stati
     keep = verdict.members
     w = {k: verdict.weights[k] for k in keep} if keep else {"reference": 1.0}  # all ruled out: the reference stands
     draws, w = _with_stationary({k: resolve(fits[k]).f_effective for k in w}, w, stationary_f)
-    return _draw_mixture(draws, w, seed)
+    return draw_mixture(draws, w, seed)
 
 
 def _with_stationary(draws: dict[str, np.ndarray], weights: dict[str, float], stationary_f: np.ndarray | None
@@ -190,7 +205,7 @@ def _with_stationary(draws: dict[str, np.ndarray], weights: dict[str, float], st
             {STATIONARY: STATIONARY_SHARE} | {k: (1.0 - STATIONARY_SHARE) * v / total for k, v in weights.items()})
 
 
-def _draw_mixture(draws: dict[str, np.ndarray], weights: dict[str, float],
+def draw_mixture(draws: dict[str, np.ndarray], weights: dict[str, float],
                   seed: int) -> tuple[np.ndarray, dict[str, float], np.ndarray]:
     """:data:`MIXTURE_DRAWS` draws of the mixture (the "mixture" stream of ``seed``), the weights normalised, and
     each draw's model."""

@@ -27,7 +27,8 @@ each round's verdict with the naming rule of :mod:`.verdict`.
   When that round's stacking weight lies on further mechanisms none of which it names, f is the mixture of them
   and the model with the causes (``further_mixture``): the final model alone would be quoted as if nothing more
   were there (on the bundled B-05 its interval sat 5 % above
-  the true f, while the weight lay on the plug friction and the velocity weakening it hides).
+  the true f, while the weight lay on the plug friction and the velocity weakening it hides). Where a round's
+  rivals are left open, f is their mixture with the final model, whose share those further mechanisms then share.
 """
 
 from __future__ import annotations
@@ -44,7 +45,8 @@ from .elpd import elpd_difference
 from .exact_model import exact_posterior
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .misfit import MisfitDecision, decide, misfit_detected
-from .candidates_mixture import Resolve, further_mixture, mixture, open_rounds, rival_mixture, superfluous_mixture
+from .candidates_mixture import (Resolve, draw_mixture, further_members, mixture, open_rounds, rival_mixture,
+                                 superfluous_mixture)
 from .diagnosis import Diagnosis, Ranked
 from .rival_swaps import Swap, check_swaps, swap_jobs
 from .verdict import NamingRule, Verdict
@@ -184,15 +186,15 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
 
 def _mixture_after_causes(final: ModelFit, rounds: list, verdicts: list, causes: list, swaps: tuple, checked: tuple,
                           seed: int, stationary_f: np.ndarray | None, resolve: Resolve) -> tuple:
-    """f's mixture once causes were fitted, and which: a round's open rivals first, else the last round's further
-    mechanisms, else a superfluous candidate's round (:mod:`.candidates_mixture`); (None, {}, None, None): f is the
-    final model's."""
-    mix, w, src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f, resolve)
+    """f's mixture once causes were fitted, and which: a round's open rivals first (the last round's further
+    mechanisms standing for the final model in its share), else those further mechanisms, else a superfluous
+    candidate's round (:mod:`.candidates_mixture`); (None, {}, None, None): f is the final model's."""
+    further = further_members(final, rounds, verdicts, causes, resolve)
+    mix, w, src = rival_mixture(final, rounds, verdicts, causes, seed, stationary_f, resolve, further=further)
     if mix is not None:
         return mix, w, src, "rivals"
-    mix, w, src = further_mixture(final, rounds, verdicts, causes, seed, resolve)
-    if mix is not None:
-        return mix, w, src, "further"
+    if further is not None:
+        return *draw_mixture(*further, seed), "further"
     k = next((j for j, v in enumerate(verdicts[:len(causes)]) if v.superfluous), None)
     mix, w, src = superfluous_mixture(final, [m for s, m in zip(swaps, checked) if s.round == k], seed, resolve)
     return mix, w, src, ("superfluous" if mix is not None else None)
