@@ -11,8 +11,8 @@ whole-record models' form term: f is then the mixture of the final model and tho
 (:func:`further_mixture`), not the final model's alone, whose interval would hold the truth only if nothing more
 were there. Where a round's rivals are left open as well, those further mechanisms stand for the final model in its
 share of the rivals' mixture (:func:`further_members`): the record tells neither which candidate is right nor
-whether the further mechanism is there. A model the record rules out against its round's reference is never a member of a mixture
-(``Verdict.members``), whatever stacking weight its few blocks earn it.
+whether the further mechanism is there. A model the record rules out against its round's reference is never a
+member of a mixture (``Verdict.members``), whatever stacking weight its few blocks earn it.
 
 When no cause is named at all (the first round's candidates, unexplained or unconfirmed, or candidates fitted
 in turn whose rivals stay open and no cause besides), the whole-record models
@@ -31,11 +31,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..stats import RULE
 from ..stats.streams import stream
-from .elpd import elpd_difference
 from .extended import ModelFit, Variant
-from .verdict import Verdict, mixture_draws, moves_f, round_weights, weights_kept
+from .verdict import Verdict, mixture_draws, moves_f, round_weights, ruled_out_against, weights_kept
 
 #: Draws of the stacking mixture that gives f when no single cause is named.
 MIXTURE_DRAWS = 1000
@@ -123,8 +121,7 @@ def superfluous_mixture(final: ModelFit, checked: Sequence[ModelFit], seed: int,
     no share of f); (None, {}, None) without them."""
     if not checked:
         return None, {}, None
-    worse = [f.label for f in checked if RULE.decisive(*elpd_difference(final.elpd, f.elpd))]
-    kept = weights_kept(round_weights(final, list(checked), seed), worse)
+    kept = weights_kept(round_weights(final, list(checked), seed), worse := ruled_out_against(final, checked))
     kept = {final.label if k == "reference" else k: w for k, w in kept.items()}
     if sum(kept.values()) <= 0.0:
         kept = {final.label: 1.0} | {f.label: 1.0 for f in checked if f.label not in worse}
@@ -206,7 +203,7 @@ def _with_stationary(draws: dict[str, np.ndarray], weights: dict[str, float], st
 
 
 def draw_mixture(draws: dict[str, np.ndarray], weights: dict[str, float],
-                  seed: int) -> tuple[np.ndarray, dict[str, float], np.ndarray]:
+                 seed: int) -> tuple[np.ndarray, dict[str, float], np.ndarray]:
     """:data:`MIXTURE_DRAWS` draws of the mixture (the "mixture" stream of ``seed``), the weights normalised, and
     each draw's model."""
     x, which = mixture_draws(draws, weights, n=MIXTURE_DRAWS, rng=stream(seed, "mixture"))

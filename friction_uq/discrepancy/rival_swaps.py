@@ -53,12 +53,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from ..stats import RULE
 from ..stats.trimmed import points_to_drop
 from .candidates_mixture import open_rivals
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant
-from .verdict import NamingRule, Verdict, round_weights, weights_kept
+from .verdict import NamingRule, Verdict, round_weights, ruled_out_against, weights_kept
 
 #: The ``rival`` of the swap that leaves the candidate out (the final model without it).
 WITHOUT = "(without it)"
@@ -137,9 +136,8 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
     behind = {"reference": 0.0} | {label: d for label, (d, _) in against.items()}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
     # as in a round: a swap the final model rules out pushes no other out of the mass the weight guards
-    worse = [label for label, (d, se) in against.items() if RULE.decisive(d, se)]
-    how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits}, weights_kept(weights, worse) or weights,
-                            behind, drop)
+    how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits},
+                            weights_kept(weights, ruled_out_against(final, fits)) or weights, behind, drop)
     swaps = []
     for (k, label, _), f in zip(jobs, fits):
         d, se = against[f.label]

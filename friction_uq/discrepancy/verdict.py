@@ -150,6 +150,15 @@ def weights_kept(weights: Mapping[str, float], worse: Iterable[str]) -> dict[str
     return {k: w / total for k, w in kept.items()} if total > 0.0 else {}
 
 
+def ruled_out_against(reference, models: Sequence) -> list[str]:
+    """The labels of ``models`` the record rules out against ``reference`` (each a fit with ``elpd`` and ``label``):
+    the reference's dELPD over each decisive by the package's rule (:attr:`Candidate.decisively_worse` of a round's
+    candidates); the swap check's models against the final model."""
+    from .elpd import elpd_difference
+
+    return [m.label for m in models if RULE.decisive(*elpd_difference(reference.elpd, m.elpd))]
+
+
 def _points(elpd) -> np.ndarray:
     """A model's pointwise values for stacking: its blocks, then its calibration data."""
     return np.concatenate([np.asarray(elpd.pointwise, float), np.asarray(elpd.calibration, float)])
