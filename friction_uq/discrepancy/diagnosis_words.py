@@ -89,7 +89,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         else:
             lead = ("Candidates, not a cause: this record does not tell apart "
                     f"{', '.join(dg.not_separable) or rivals}; fitted in turn: {fitted}.{spare}")
-        quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever is right)"
+        quote = f"from the {mixture_label(dg)} (the f to quote, wide enough for whichever of them is right)"
         evidence = "first cause" if named else "strongest candidate"
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     elif more := further(dg):  # the last round's weight lies on further mechanisms it did not name: their mixture
@@ -98,7 +98,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
                            for k, w in dg.mixture_weights.items())
         with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
         quote = (f"from {with_them}the further causes the record leans to without naming one, weighted by how well "
-                 f"each predicts it ({shares}; the f to quote, wide enough for whichever is right)")
+                 f"each predicts it ({shares}; the f to quote, wide enough for whichever of them is right)")
         evidence = "first cause"
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
@@ -145,10 +145,10 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         half = 100 * dg.mixture_weights[STATIONARY]
         return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the stationary analysis "
                 f"({half:.0f} %) and the candidates weighted by how well each predicts the record ({shares}): the f "
-                f"to quote, wide enough for whichever is right; {f_without['q50']:.3f} from the stationary analysis "
-                "alone.")
+                f"to quote, wide enough for whichever of them is right; {f_without['q50']:.3f} from the stationary "
+                "analysis alone.")
     return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the candidates weighted by how well "
-            f"each predicts the record ({shares}; the f to quote, wide enough for whichever is right), "
+            f"each predicts the record ({shares}; the f to quote, wide enough for whichever of them is right), "
             f"{f_without['q50']:.3f} from the stationary analysis.")
 
 

@@ -80,7 +80,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
         return (f"`diagnose` names {names}, and the record leans to a further cause without naming one "
                 f"({', '.join(more.values())}); "
                 f"f from the stacking mixture is {fm['q50']:.4g} [{fm['q05']:.4g}, {fm['q95']:.4g}] (the JSON's f), "
-                "wide enough for whichever is right: quote that, with this warning.")
+                "wide enough for whichever of them is right: quote that, with this warning.")
     if diagnosis.mixture_f is not None:  # unexplained, or candidates (fitted in turn or not) the record leaves open
         fm = headline(diagnosis)[1]
         q05, q50, q95 = fm["q05"], fm["q50"], fm["q95"]
@@ -98,7 +98,7 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
             what = f"the record does not tell its candidate causes apart{listed}"
         half = " and the stationary analysis in equal parts" if STATIONARY in diagnosis.mixture_weights else ""
         return (f"`diagnose`: {what}; f from their stacking mixture{half} is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the "
-                "JSON's f), wide enough for whichever is right: quote that, with this warning.")
+                "JSON's f), wide enough for whichever of them is right: quote that, with this warning.")
     if not diagnosis.causes:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
     fx = headline(diagnosis)[1]  # the JSON's f: the named model's, with the bars' calibration
