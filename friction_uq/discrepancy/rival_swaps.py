@@ -28,7 +28,7 @@ check's tolerance forgives.
 
 Asked only of a round followed by a later cause: for the last cause's round the swap is the round's own
 comparison, already judged. The weight route is the naming rule's own, its 90 % guard included (the weight of the
-swaps the final model rules out set aside first, :func:`.verdict.weights_kept`). A rival of the
+swaps the final model rules out set aside first, :meth:`.verdict.NamingRule.rulings`). A rival of the
 same group as a later cause (a second friction law) cannot join the model beside it: it is swapped in for the
 candidate *and* that cause, and must stand in for both (on the bundled B-02, the slip law, a rival of the first
 round's dispersion, against the velocity law named later). Before, such a rival could not be asked and kept its
@@ -53,11 +53,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
+from ..stats import RULE
 from ..stats.trimmed import points_to_drop
 from .candidates_mixture import open_rivals
 from .elpd import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant
-from .verdict import NamingRule, Verdict, round_weights, ruled_out_against, weights_kept
+from .verdict import NamingRule, Verdict, round_weights
 
 #: The ``rival`` of the swap that leaves the candidate out (the final model without it).
 WITHOUT = "(without it)"
@@ -136,8 +137,8 @@ def check_swaps(dg: Diagnoser, final: ModelFit, causes: list[Variant], verdicts:
     behind = {"reference": 0.0} | {label: d for label, (d, _) in against.items()}
     drop = points_to_drop(len(final.elpd.pointwise), rule.drop_fraction)
     # as in a round: a swap the final model rules out pushes no other out of the mass the weight guards
-    how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits},
-                            weights_kept(weights, ruled_out_against(final, fits)) or weights, behind, drop)
+    how_each = rule.rulings(final.elpd, {f.label: f.elpd for f in fits}, weights, behind, drop,
+                            worse=[label for label, (d, se) in against.items() if RULE.decisive(d, se)])
     swaps = []
     for (k, label, _), f in zip(jobs, fits):
         d, se = against[f.label]

@@ -228,10 +228,8 @@ class NamingRule:
         only by the weight route."""
         behind = {"reference": best.delpd} | {c.label: best.delpd - c.delpd for c in cands}
         others = [c for c in (cands if self.against_all else passing) if c.label != best.label]
-        # the weights less the models the record rules out, as f's mixture reads them (weights_kept)
-        how_each = self.rulings(fits[best.label].elpd, {c.label: fits[c.label].elpd for c in others},
-                                weights_kept(weights, (c.label for c in cands if c.decisively_worse)) or weights,
-                                behind, drop)
+        how_each = self.rulings(fits[best.label].elpd, {c.label: fits[c.label].elpd for c in others}, weights,
+                                behind, drop, worse=[c.label for c in cands if c.decisively_worse])
         rivals, light = [], []
         for c in others:
             how = how_each[c.label]
@@ -242,10 +240,13 @@ class NamingRule:
         return rivals, tuple(light)
 
     def rulings(self, best, others: Mapping, weights: Mapping[str, float], behind: Mapping[str, float],
-                drop: int) -> dict[str, str | None]:
+                drop: int, worse: Iterable[str] = ()) -> dict[str, str | None]:
         """How model ``best`` rules out each of ``others`` (label -> :class:`~.elpd.Elpd`), by :meth:`ruling`: each
         with the weight of the models that predict alike with it (``behind``: each label's ELPD behind the best),
-        the models that carry 90 % of ``weights`` guarded (as in the campaign: the weight never rules them out)."""
+        the models that carry 90 % of ``weights`` guarded (as in the campaign: the weight never rules them out).
+        ``worse``: the labels of the models the record rules out against the reference, whose weight is set aside
+        first (:func:`weights_kept`)."""
+        weights = weights_kept(weights, worse) or weights
         carried = set(WEIGHT_RULE.supported(weights))
         return {label: self.ruling(best, other, weight=WEIGHT_RULE.alike_weight(weights, behind, label), drop=drop,
                                    carried=label in carried) for label, other in others.items()}
