@@ -1,8 +1,9 @@
 """Posterior sampling of (f, nu[, hoop_gain]) with emcee.
 
 Modules: :mod:`.model` (parametrisation, log posterior, start ball), :mod:`.moves` (the
-differential-evolution move inside independent ensembles), :mod:`.ensemble` (the loop, stopping
-rule, draws), :mod:`.checkpoint` (saving and resuming), :mod:`.results` (what is returned).
+differential-evolution move inside independent ensembles), :mod:`.ensemble` (settings, start,
+draws), :mod:`.stopping_rule` (the loop of steps and its stopping rule), :mod:`.checkpoint` (saving and resuming),
+:mod:`.results` (what is returned).
 
 Design
 ------
@@ -44,7 +45,8 @@ Design
   posteriori in z, every walker inside the prior support.
 """
 
-from .ensemble import integrated_time, likelihood_priors, sample_posterior
+from .ensemble import likelihood_priors, sample_posterior
+from .stopping_rule import integrated_time
 from .model import LogPosterior, _initial_guess, start_ball
 from .moves import BlockDEMove
 from .results import ConvergenceWarning, PosteriorSamples, Progress, SamplerSettings, stderr_progress

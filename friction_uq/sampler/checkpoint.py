@@ -14,7 +14,8 @@ import hashlib
 import os
 import zipfile
 from collections.abc import Callable
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -103,3 +104,20 @@ def discard(path: str | os.PathLike[str]) -> None:
         os.unlink(path)
     except FileNotFoundError:
         pass
+
+
+@dataclass
+class Store:
+    """Where the checkpoint goes (None: nowhere), its call's fingerprint, and when it was last written."""
+
+    path: str | Path | None
+    fingerprint: str
+    last: float = field(default_factory=time.perf_counter)
+
+    def write(self, backend) -> None:
+        """Write the chain so far of ``backend`` (an emcee backend; a no-op without a path)."""
+        if self.path is not None:
+            save(self.path, self.fingerprint, Checkpoint(
+                backend.get_chain(), backend.get_log_prob(), np.asarray(backend.accepted, float),
+                backend.random_state))
+            self.last = time.perf_counter()

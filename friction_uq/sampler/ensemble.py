@@ -1,14 +1,12 @@
-"""The sampling loop: emcee with several independent ensembles, stopping rule, checkpoints, draws."""
+"""The sampling call: emcee with several independent ensembles, from the checked settings and the start to the kept
+draws (the loop of steps and its stopping rule: :mod:`.stopping_rule`)."""
 
 from __future__ import annotations
 
-import contextlib
 import math
-import signal
-import threading
 import time
-import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import emcee
@@ -22,58 +20,8 @@ from ..window import StationaryData
 from . import checkpoint
 from .model import LogPosterior, start_ball
 from .moves import BlockDEMove
-from .results import ConvergenceWarning, PosteriorSamples, Progress, SamplerSettings
-
-
-def integrated_time(chain: np.ndarray, *, c: float = 5.0) -> np.ndarray:
-    """Walker-averaged integrated autocorrelation time (steps) per parameter.
-
-    Same estimator as ``emcee.autocorr.integrated_time`` (Goodman-Weare/Sokal: autocorrelation
-    averaged over walkers, Sokal's automatic window, smallest M with M >= c tau(M)), with one FFT
-    over all walkers and parameters instead of one per walker.
-
-    Parameters
-    ----------
-    chain : array, shape (nsteps, nwalkers, ndim)
-
-    Returns
-    -------
-    array, shape (ndim,)
-    """
-    x = np.asarray(chain, float)
-    n = x.shape[0]
-    nfft = 1 << (2 * n - 1).bit_length()
-    x = x - x.mean(axis=0)
-    fx = np.fft.rfft(x, n=nfft, axis=0)
-    acf = np.fft.irfft(fx * np.conj(fx), n=nfft, axis=0)[:n]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        acf = acf / acf[0]
-    acf = np.nanmean(acf, axis=1)  # (n, ndim)
-    taus = 2.0 * np.cumsum(acf, axis=0) - 1.0
-    m = np.arange(n)[:, None]
-    ok = m >= c * taus
-    window = np.where(ok.any(axis=0), np.argmax(ok, axis=0), n - 1)
-    return taus[window, np.arange(x.shape[2])]
-
-
-@contextlib.contextmanager
-def _interrupt_between_steps() -> Iterator[None]:
-    """Hold Ctrl-C (SIGINT) while emcee steps and raise KeyboardInterrupt when the block of steps ends: emcee's
-    wrapper of the log-probability prints the walkers' positions and a traceback for any exception raised in
-    it, KeyboardInterrupt included. Only in the main thread (elsewhere signals cannot be handled), and not where
-    SIGINT is ignored (a background job of a shell: Ctrl-C is not meant for it, and catching it during the steps
-    only would stop the job at some moments and not at others)."""
-    if threading.current_thread() is not threading.main_thread() or signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
-        yield
-        return
-    caught: list[int] = []
-    old = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, old if old is not None else signal.default_int_handler)
-    if caught:
-        raise KeyboardInterrupt
+from .results import PosteriorSamples, Progress, SamplerSettings
+from .stopping_rule import integrated_time, run_until_steady
 
 
 def _memory_backend(ck: checkpoint.Checkpoint, nwalkers: int, ndim: int) -> emcee.backends.Backend:
@@ -163,15 +111,7 @@ def sample_posterior(
     t_start = time.perf_counter()
     settings = SamplerSettings(nwalkers=nwalkers, n_ensembles=n_ensembles, max_steps=max_steps,
                                check_every=check_every, checkpoint_seconds=checkpoint_seconds)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2**64:
-        raise SamplingError(f"seed must be an integer in [0, 2**64), got {seed!r}")
-    if nwalkers < 4 or nwalkers % 2:
-        raise SamplingError(f"nwalkers must be an even number >= 4, got {nwalkers}")
-    if n_ensembles < 1 or max_steps < check_every or check_every < 10:
-        raise SamplingError(
-            f"need n_ensembles >= 1, check_every >= 10 and max_steps >= check_every; got {n_ensembles}, "
-            f"{check_every}, {max_steps}"
-        )
+    _check_settings(seed, settings)
     if likelihood is None:
         likelihood = Likelihood(data, hoop=hoop, axial_poisson=axial_poisson)
     elif likelihood.data is not data or (hoop is not None and bool(hoop) != likelihood.has_hoop):
@@ -183,106 +123,29 @@ def sample_posterior(
     ndim = len(names)
     if nwalkers < 2 * ndim:
         raise SamplingError(f"nwalkers must be >= {2 * ndim} for {ndim} parameters, got {nwalkers}")
-    n_all = nwalkers * n_ensembles
-    seeds = np.random.SeedSequence(seed).spawn(2)
-    rng_start = np.random.default_rng(seeds[1])
-
     fp = checkpoint.fingerprint(data, prior, names, seed, settings) if backend_path is not None else ""
-    ck = (checkpoint.load(backend_path, fp, nwalkers=n_all, ndim=ndim, notify=notify)
-          if backend_path is not None else None)
-    move = BlockDEMove(n_ensembles)
-    if ck is not None:
-        backend = _memory_backend(ck, n_all, ndim)
-        state = backend.get_last_sample()
-        z_map = start_ball(log_post, prior, nwalkers=nwalkers, n_ensembles=1, rng=rng_start)[0]  # for the record
-    else:
-        backend = emcee.backends.Backend()
-        z_map, ball = start_ball(log_post, prior, nwalkers=nwalkers, n_ensembles=n_ensembles, rng=rng_start)
-        rs = legacy_state(np.random.default_rng(seeds[0]))
-        state = emcee.State(ball.reshape(n_all, ndim), random_state=rs.get_state())
-    sampler = emcee.EnsembleSampler(n_all, ndim, log_post, vectorize=True, backend=backend, moves=move)
-
-    def save() -> None:
-        checkpoint.save(backend_path, fp, checkpoint.Checkpoint(
-            backend.get_chain(), backend.get_log_prob(), np.asarray(backend.accepted, float),
-            backend.random_state))
-
-    converged = False
-    prev_tau: np.ndarray | None = None
-    last_save = time.perf_counter()
-    # a resumed run whose stored chain ends on a check point is checked before stepping, so that
-    # resuming a finished run gives back the same draws instead of stepping one block further
-    check_first = backend.iteration > 0 and backend.iteration % check_every == 0
-    try:
-        while True:
-            done = backend.iteration
-            target = min(max_steps, (done // check_every + 1) * check_every)
-            if not check_first and target > done:
-                with _interrupt_between_steps():
-                    state = sampler.run_mcmc(state, target - done, progress=False, skip_initial_state_check=True)
-                if backend_path is not None and time.perf_counter() - last_save >= checkpoint_seconds:
-                    save()
-                    last_save = time.perf_counter()
-            check_first = False
-            n = backend.iteration
-            chains = backend.get_chain()  # (n, all walkers, ndim)
-            tau = integrated_time(chains)
-            if prev_tau is None:  # first check (or first after resuming): previous check from the stored chain
-                prev_tau = integrated_time(chains[: n - check_every]) if n >= 2 * check_every else np.full(ndim, np.inf)
-            change = float(np.max(np.abs(prev_tau - tau) / tau))
-            prev_tau = tau
-            tau_max = float(np.max(tau))
-            acc = float(np.mean(backend.accepted) / max(n, 1))
-            if progress is not None:
-                progress(Progress(n, max_steps, tau_max, change, n / tau_max, acc, time.perf_counter() - t_start,
-                                  settings.tau_factor, settings.tau_rtol))
-            if n > settings.tau_factor * tau_max and change < settings.tau_rtol:
-                converged = True
-                break
-            if n >= max_steps:
-                warnings.warn(
-                    f"sampler stopped at max_steps={max_steps} before convergence: steps/tau = {n / tau_max:.1f} "
-                    f"(needs > {settings.tau_factor:g}), tau change {100 * change:.1f} % (needs < "
-                    f"{100 * settings.tau_rtol:g} %); raise max_steps or treat the posterior as approximate",
-                    ConvergenceWarning, stacklevel=2,
-                )
-                break
-    except KeyboardInterrupt:  # Ctrl-C: the steps made so far are kept, the next run resumes from them
-        if backend_path is not None and backend.iteration > 0:
-            save()
-        raise
-    if backend_path is not None:
-        save()  # a run killed while its outputs are written resumes here without stepping
-
-    chain = backend.get_chain()  # (n, all walkers, ndim)
-    blocks = [slice(k * nwalkers, (k + 1) * nwalkers) for k in range(n_ensembles)]
-    tau_all = np.array([integrated_time(chain[:, b]) for b in blocks])
-    burn = int(math.ceil(settings.burn_factor * tau_max))
-    if burn >= n - 1:
-        burn = n // 2
-    # thin to tau/2, and further so that at most max_draws draws are kept (the pointwise
-    # log-likelihood of every kept draw is stored; thinned beyond tau the draws are nearly
-    # independent, so ESS ~ max_draws)
-    thin = max(1, int(settings.thin_factor * float(np.min(tau))),
-               math.ceil((n - burn) * n_all / settings.max_draws))
-    kept = chain[burn::thin]  # (nkeep, all walkers, ndim)
-    z = np.stack([np.transpose(kept[:, b], (1, 0, 2)).reshape(-1, ndim) for b in blocks])  # walker-major chains
-    theta = log_post.to_theta(z)
-    flat = theta.reshape(-1, ndim)
-    ll = np.concatenate([likelihood(flat[i:i + 8192]) for i in range(0, len(flat), 8192)]).reshape(z.shape[:2])
-    lprior = prior.logpdf(flat).reshape(z.shape[:2])
+    store = checkpoint.Store(backend_path, fp)
+    backend, state, z_map = _start(log_post, prior, settings, ndim, seed, store, notify)
+    sampler = emcee.EnsembleSampler(nwalkers * n_ensembles, ndim, log_post, vectorize=True, backend=backend,
+                                    moves=BlockDEMove(n_ensembles))
+    converged, tau = run_until_steady(sampler, state, settings, store, progress, t_start)
+    draws = _kept_draws(backend.get_chain(), settings, tau, log_post)
+    flat = draws.theta.reshape(-1, ndim)
+    ll = np.concatenate([likelihood(flat[i:i + 8192]) for i in range(0, len(flat), 8192)]).reshape(draws.shape)
+    lprior = prior.logpdf(flat).reshape(draws.shape)
+    n = backend.iteration
     accepted = np.asarray(backend.accepted, float)
-    acceptance = np.array([accepted[b].mean() / n for b in blocks])
+    acceptance = np.array([accepted[b].mean() / n for b in _blocks(settings)])
     return PosteriorSamples(
         names=names,
-        draws=likelihood.parameters.as_dict(theta),
+        draws=likelihood.parameters.as_dict(draws.theta),
         log_likelihood=ll,
         log_prior=lprior,
         acceptance=acceptance,
-        tau=tau_all,
+        tau=draws.tau,
         n_steps=n,
-        burn=burn,
-        thin=thin,
+        burn=draws.burn,
+        thin=draws.thin,
         converged=converged,
         seconds=time.perf_counter() - t_start,
         seed=int(seed),
@@ -293,3 +156,71 @@ def sample_posterior(
         prior_description=prior.describe(),
         settings=settings,
     )
+
+
+def _check_settings(seed: int, settings: SamplerSettings) -> None:
+    """:class:`SamplingError` for a seed or a setting out of range, before any work."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2**64:
+        raise SamplingError(f"seed must be an integer in [0, 2**64), got {seed!r}")
+    if settings.nwalkers < 4 or settings.nwalkers % 2:
+        raise SamplingError(f"nwalkers must be an even number >= 4, got {settings.nwalkers}")
+    if settings.n_ensembles < 1 or settings.max_steps < settings.check_every or settings.check_every < 10:
+        raise SamplingError(
+            f"need n_ensembles >= 1, check_every >= 10 and max_steps >= check_every; got {settings.n_ensembles}, "
+            f"{settings.check_every}, {settings.max_steps}"
+        )
+
+
+def _blocks(settings: SamplerSettings) -> list[slice]:
+    """The walkers of each independent ensemble (one chain each) among all the sampler's walkers."""
+    return [slice(k * settings.nwalkers, (k + 1) * settings.nwalkers) for k in range(settings.n_ensembles)]
+
+
+def _start(log_post: LogPosterior, prior, settings: SamplerSettings, ndim: int, seed: int, store: checkpoint.Store,
+           notify: Callable[[str], None] | None) -> tuple[emcee.backends.Backend, emcee.State, np.ndarray]:
+    """The backend and the state to step from: a stored checkpoint of the same call resumed, else a fresh ball
+    around the mode (the "start" stream of ``seed``; the ensembles' own stream is its sibling); and the mode."""
+    n_all = settings.nwalkers * settings.n_ensembles
+    seeds = np.random.SeedSequence(seed).spawn(2)
+    rng_start = np.random.default_rng(seeds[1])
+    ck = (checkpoint.load(store.path, store.fingerprint, nwalkers=n_all, ndim=ndim, notify=notify)
+          if store.path is not None else None)
+    if ck is not None:
+        backend = _memory_backend(ck, n_all, ndim)
+        z_map = start_ball(log_post, prior, nwalkers=settings.nwalkers, n_ensembles=1, rng=rng_start)[0]  # reported
+        return backend, backend.get_last_sample(), z_map
+    z_map, ball = start_ball(log_post, prior, nwalkers=settings.nwalkers, n_ensembles=settings.n_ensembles,
+                             rng=rng_start)
+    rs = legacy_state(np.random.default_rng(seeds[0]))
+    return emcee.backends.Backend(), emcee.State(ball.reshape(n_all, ndim), random_state=rs.get_state()), z_map
+
+
+@dataclass(frozen=True)
+class _Draws:
+    """The kept draws, per chain (one chain per ensemble, walker-major), and how they were kept."""
+
+    theta: np.ndarray  # (chains, draws, ndim), the parameters' own coordinates
+    tau: np.ndarray  # (chains, ndim), each ensemble's integrated time
+    burn: int
+    thin: int
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.theta.shape[:2]
+
+
+def _kept_draws(chain: np.ndarray, settings: SamplerSettings, tau: np.ndarray, log_post: LogPosterior) -> _Draws:
+    """``tau``: each parameter's integrated time over all walkers. Burn-in of ``burn_factor`` tau dropped (half the chain if that is all of it), thinned to tau/2 and further
+    so that at most ``max_draws`` draws are kept (the pointwise log-likelihood of every kept draw is stored;
+    thinned beyond tau the draws are nearly independent, so ESS ~ max_draws)."""
+    n, n_all, ndim = chain.shape
+    blocks = _blocks(settings)
+    tau_all = np.array([integrated_time(chain[:, b]) for b in blocks])
+    burn = int(math.ceil(settings.burn_factor * float(np.max(tau))))
+    if burn >= n - 1:
+        burn = n // 2
+    thin = max(1, int(settings.thin_factor * float(np.min(tau))),
+               math.ceil((n - burn) * n_all / settings.max_draws))
+    kept = chain[burn::thin]  # (nkeep, all walkers, ndim)
+    z = np.stack([np.transpose(kept[:, b], (1, 0, 2)).reshape(-1, ndim) for b in blocks])  # walker-major chains
+    return _Draws(log_post.to_theta(z), tau_all, burn, thin)
