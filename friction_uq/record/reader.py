@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from ..apparatus import Apparatus
 from ..errors import RecordError
 from ._apparatus_reader import read_apparatus
 from ..plausible import (
@@ -98,8 +99,26 @@ def read_record(path: str | os.PathLike[str]) -> Record:
 
 
 def _read_open(fh: Any, p: Path, r: Reader) -> Record:
-    import h5py
+    """The record of an open file, checked part by part in the order of the contract: the root's attributes, the
+    apparatus, the signals, the provenance; the first problem raises ``r.fail`` (file, field, problem)."""
+    header = _read_header(fh, r)
+    apparatus = _read_apparatus(fh, r)
+    sample_rate, t0, channels = _read_signals(fh, r, apparatus)
+    return Record(
+        path=str(p),
+        sample_rate=sample_rate,
+        t0=t0,
+        channels=MappingProxyType(channels),
+        apparatus=apparatus,
+        provenance=MappingProxyType(_read_provenance(fh, r)),
+        sha256=sha256_of(p),
+        **header,
+    )
 
+
+def _read_header(fh: Any, r: Reader) -> dict[str, Any]:
+    """The root's attributes: the format and its version, the ids, the date, the description and the striker's
+    speed (the :class:`Record` fields they fill)."""
     fmt = r.attr(fh, "/", "format", "str")
     if fmt != FORMAT:
         raise r.fail("/@format", f"is {fmt!r}, expected {FORMAT!r}")
@@ -136,14 +155,25 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
         raise r.fail("/@striker_velocity", f"must be > 0 m/s, got {striker_velocity!r}")
     if striker_velocity is not None and out_of_range("striker_velocity", striker_velocity):
         raise r.fail("/@striker_velocity", out_of_range("striker_velocity", striker_velocity))
+    return dict(test_id=test_id, campaign=campaign, date=date, description=description,
+                striker_velocity=striker_velocity)
 
-    # ---- apparatus ----
-    app = r.member(fh, "apparatus", "/apparatus")
-    if app is None:
-        raise r.fail("/apparatus", "required group is missing")
-    if not isinstance(app, h5py.Group):
-        raise r.fail("/apparatus", "must be a group")
-    apparatus = read_apparatus(app, r)
+
+def _group(parent: Any, name: str, r: Reader) -> Any:
+    """A required group under ``parent`` (the root)."""
+    import h5py
+
+    g = r.member(parent, name, f"/{name}")
+    if g is None:
+        raise r.fail(f"/{name}", "required group is missing")
+    if not isinstance(g, h5py.Group):
+        raise r.fail(f"/{name}", "must be a group")
+    return g
+
+
+def _read_apparatus(fh: Any, r: Reader) -> Apparatus:
+    """/apparatus: its parts, checked together (:func:`apparatus_problem`), and the sample's material printable."""
+    apparatus = read_apparatus(_group(fh, "apparatus", r), r)
     implausible = apparatus_problem(apparatus)
     if implausible:
         part, attr, problem = implausible
@@ -151,13 +181,13 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
     bad = unprintable(apparatus.sample.material)
     if bad:
         raise r.fail("/apparatus/sample@material", f"{bad} ('{escaped(apparatus.sample.material)}')")
+    return apparatus
 
-    # ---- signals ----
-    sig = r.member(fh, "signals", "/signals")
-    if sig is None:
-        raise r.fail("/signals", "required group is missing")
-    if not isinstance(sig, h5py.Group):
-        raise r.fail("/signals", "must be a group")
+
+def _read_signals(fh: Any, r: Reader, apparatus: Apparatus) -> tuple[float, float, dict[str, Channel]]:
+    """/signals: the sample rate, t0 and every channel (the required ones present, all of one length), the record
+    long enough for the reflected wave to pass the input-bar gauge."""
+    sig = _group(fh, "signals", r)
     sample_rate = r.attr(sig, "/signals", "sample_rate", "float")
     if sample_rate <= 0:
         raise r.fail("/signals@sample_rate", f"must be > 0 Hz, got {sample_rate!r}")
@@ -166,7 +196,6 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
     for key, value in (("sample_rate", sample_rate), ("t0", t0)):
         if out_of_range(f"signals.{key}", value):
             raise r.fail(f"/signals@{key}", out_of_range(f"signals.{key}", value))
-
     channels: dict[str, Channel] = {}
     length: int | None = None
     first: str | None = None
@@ -177,15 +206,7 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
             if name in REQUIRED_CHANNELS:
                 raise r.fail(where, "required channel is missing")
             continue
-        if not isinstance(ds, h5py.Dataset):
-            raise r.fail(where, "must be a dataset")
-        if ds.ndim != 1:
-            raise r.fail(where, f"must be 1-D, got shape {ds.shape}")
-        if ds.dtype.kind != "f" or ds.dtype.itemsize not in (4, 8):
-            raise r.fail(where, f"must be float32 or float64, got {ds.dtype}")
-        if ds.shape[0] > MAX_SAMPLES:
-            raise r.fail(where, f"declares {ds.shape[0]} samples, more than the {MAX_SAMPLES} a channel may have "
-                         "(docs/limits.md)")
+        _check_dataset(ds, where, r)
         if length is None:
             length, first = ds.shape[0], name
             if length < MIN_SAMPLES:
@@ -194,34 +215,10 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
             raise r.fail(
                 where, f"has {ds.shape[0]} samples but /signals/{first} has {length}; channels must have equal length"
             )
-        units = r.attr(ds, where, "units", "str")
-        if units not in UNITS:
-            raise r.fail(f"{where}@units", f"is {units!r}, allowed: {', '.join(UNITS)}")
-        spv = None
-        if units == "V":
-            spv = r.attr(ds, where, "strain_per_volt", "float", required=False)
-            if spv is None:
-                raise r.fail(where, "units are 'V' but attribute 'strain_per_volt' is missing")
-            if spv == 0:
-                raise r.fail(f"{where}@strain_per_volt", "must not be zero")
-            if out_of_range("signals.strain_per_volt", abs(spv)):
-                raise r.fail(f"{where}@strain_per_volt", out_of_range("signals.strain_per_volt", abs(spv)))
-            scale = spv
-        else:
-            scale = UNITS[units]
-        raw = np.asarray(ds[()], dtype=np.float64)
-        check_samples(raw, where, r)
-        strain = -scale * raw  # the one sign flip of the package: compression positive from here on
-        strain.setflags(write=False)
-        check_strain(strain, where, r)
-        check_distinct(strain, channels, where, r)
-        channels[name] = Channel(name, strain, units, spv)
+        channels[name] = _read_channel(ds, name, where, r, channels)
     assert length is not None  # REQUIRED_CHANNELS is not empty
-
-    # a record must be long enough for the reflected wave to pass the input-bar gauge
     duration = length / sample_rate
-    ib = apparatus.input_bar
-    needed = 2.0 * ib.gauge_delay + apparatus.pulse_duration
+    needed = 2.0 * apparatus.input_bar.gauge_delay + apparatus.pulse_duration
     if duration < needed:
         raise r.fail(
             "/signals",
@@ -229,32 +226,64 @@ def _read_open(fh: Any, p: Path, r: Reader) -> Record:
             f"needs at least 2 x gauge_distance / wave_speed + 2 x striker length / striker wave speed "
             f"= {needed * 1e6:.0f} us",
         )
+    return sample_rate, t0, channels
 
-    provenance: dict[str, Any] = {}
+
+def _check_dataset(ds: Any, where: str, r: Reader) -> None:
+    """A channel's dataset: 1-D floats, no more samples than a channel may have (checked before it is read)."""
+    import h5py
+
+    if not isinstance(ds, h5py.Dataset):
+        raise r.fail(where, "must be a dataset")
+    if ds.ndim != 1:
+        raise r.fail(where, f"must be 1-D, got shape {ds.shape}")
+    if ds.dtype.kind != "f" or ds.dtype.itemsize not in (4, 8):
+        raise r.fail(where, f"must be float32 or float64, got {ds.dtype}")
+    if ds.shape[0] > MAX_SAMPLES:
+        raise r.fail(where, f"declares {ds.shape[0]} samples, more than the {MAX_SAMPLES} a channel may have "
+                     "(docs/limits.md)")
+
+
+def _read_channel(ds: Any, name: str, where: str, r: Reader, read: dict[str, Channel]) -> Channel:
+    """One channel as strain, compression positive (the package's one sign flip), its units and, for volts, the
+    strain per volt; checked sample by sample, as strain, and against the channels ``read`` before it."""
+    units = r.attr(ds, where, "units", "str")
+    if units not in UNITS:
+        raise r.fail(f"{where}@units", f"is {units!r}, allowed: {', '.join(UNITS)}")
+    spv = None
+    if units == "V":
+        spv = r.attr(ds, where, "strain_per_volt", "float", required=False)
+        if spv is None:
+            raise r.fail(where, "units are 'V' but attribute 'strain_per_volt' is missing")
+        if spv == 0:
+            raise r.fail(f"{where}@strain_per_volt", "must not be zero")
+        if out_of_range("signals.strain_per_volt", abs(spv)):
+            raise r.fail(f"{where}@strain_per_volt", out_of_range("signals.strain_per_volt", abs(spv)))
+        scale = spv
+    else:
+        scale = UNITS[units]
+    raw = np.asarray(ds[()], dtype=np.float64)
+    check_samples(raw, where, r)
+    strain = -scale * raw  # the one sign flip of the package: compression positive from here on
+    strain.setflags(write=False)
+    check_strain(strain, where, r)
+    check_distinct(strain, read, where, r)
+    return Channel(name, strain, units, spv)
+
+
+def _read_provenance(fh: Any, r: Reader) -> dict[str, Any]:
+    """/provenance's attributes (optional, free-form), each bounded like every attribute."""
     prov = r.member(fh, "provenance", "/provenance")
-    if prov is not None:
-        for k in prov.attrs:  # free-form, but bounded like every attribute
-            if prov.attrs.get_id(k).get_storage_size() > MAX_ATTRIBUTE_BYTES:
-                raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
-        provenance = {k: plain(v) for k, v in prov.attrs.items()}
-        for k, v in provenance.items():  # a variable-length string is stored apart: its storage size does not count it
-            if isinstance(v, str) and text_bytes(v) > MAX_ATTRIBUTE_BYTES:
-                raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
-
-    return Record(
-        path=str(p),
-        test_id=test_id,
-        campaign=campaign,
-        sample_rate=sample_rate,
-        t0=t0,
-        channels=MappingProxyType(channels),
-        apparatus=apparatus,
-        date=date,
-        description=description,
-        striker_velocity=striker_velocity,
-        provenance=MappingProxyType(provenance),
-        sha256=sha256_of(p),
-    )
+    if prov is None:
+        return {}
+    for k in prov.attrs:
+        if prov.attrs.get_id(k).get_storage_size() > MAX_ATTRIBUTE_BYTES:
+            raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
+    provenance = {k: plain(v) for k, v in prov.attrs.items()}
+    for k, v in provenance.items():  # a variable-length string is stored apart: its storage size does not count it
+        if isinstance(v, str) and text_bytes(v) > MAX_ATTRIBUTE_BYTES:
+            raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
+    return provenance
 
 
 def read_truth(path: str | os.PathLike[str]) -> dict[str, Any]:
