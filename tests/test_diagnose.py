@@ -11,6 +11,8 @@ from types import MappingProxyType, SimpleNamespace
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from friction_uq.analysis import prepare
 from friction_uq.discrepancy import diagnosed_f, diagnosis_words, outcome, round_clauses
@@ -101,6 +103,40 @@ def test_evidence_in_a_few_blocks_names_nothing_and_spread_evidence_names_the_ca
     # a rival that predicts the record better, if only in a few blocks, is not ruled out: the two are candidates
     v = rule.judge(base, _round(base, [_fit("clearance", None, spread), _fit("plug_friction", None, few)]), misfit=True)
     assert v.kind == "candidates" and v.named == "clearance" and v.rivals == ("plug_friction",)
+
+
+def test_spread_evidence_is_decisive_however_much_a_few_blocks_add_on_top():
+    from friction_uq.discrepancy.verdict import NamingRule
+
+    base = _fit("reference", None, _noise())
+    spread = _noise(seed=2) + 0.5  # about 100 nats, every block a little better: named
+    heavy = spread.copy()
+    heavy[:3] += 2000.0  # and 6000 more at three fronts: the whole record's 2 SE (about 6900) exceeds its sum
+    rule = NamingRule(drop_fraction=0.05)
+    for blocks in (spread, heavy):
+        v = rule.judge(base, _round(base, [_fit("clearance", None, blocks)]), misfit=True)
+        c = v.candidates[0]
+        assert c.spread and c.decisive and c.passes
+        assert v.kind == "named" and v.named == "clearance"
+    c = rule.judge(base, _round(base, [_fit("clearance", None, heavy)]), misfit=True).candidates[0]
+    assert c.delpd < 2.0 * c.se  # the whole record alone would not have passed: the rule asks it without them
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(-2.0, 3.0), min_size=40, max_size=120), st.floats(1.0, 1e4))
+def test_more_evidence_in_the_blocks_left_out_never_turns_a_pass_into_a_fail(d, extra):
+    from friction_uq.discrepancy.verdict import NamingRule
+    from friction_uq.stats.trimmed import points_to_drop
+
+    rule = NamingRule(drop_fraction=0.05)
+    d = np.asarray(d)
+    base = _fit("reference", None, np.zeros(len(d)))
+    drop = points_to_drop(len(d), rule.drop_fraction)
+    more = d.copy()
+    more[np.argsort(d)[len(d) - drop:]] += extra  # the blocks the spread test leaves out, better still
+    before, after = (rule.candidate(r.fit, base, r.delpd, r.se, 0.5)
+                     for blocks in (d, more) for r in _round(base, [_fit("clearance", None, blocks)]))
+    assert after.passes or not before.passes
 
 
 def test_two_mechanisms_the_record_does_not_separate_are_candidates_and_a_gain_on_another_gauge_is_named():

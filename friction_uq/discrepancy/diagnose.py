@@ -2,10 +2,10 @@
 each round's verdict with the naming rule of :mod:`.verdict`.
 
 * a mechanism is named only when its dELPD over the reference model is decisive by the package's rule
-  (above 4 and 2 standard errors), when it stays decisive with the blocks that favour it most left out
-  (the evidence is spread over the record, not a few blocks at a front where two simulators of the same
-  test differ), and when it rules out every other mechanism: by the same rule, or by the stacking weight
-  (:mod:`.verdict`, 3.);
+  (above 4 and 2 standard errors) with the blocks that favour it most left out (the evidence is spread over
+  the record, not a few blocks at a front where two simulators of the same test differ; the whole record's
+  sum is then larger still, whatever its standard error), and when it rules out every other mechanism: by
+  the same rule, or by the stacking weight (:mod:`.verdict`, 3.);
 * several mechanisms that pass but do not rule each other out are *candidates*: the record does not tell
   them apart (``not_separable``, with what would separate them), and f is then the stacking mixture of
   the models that carry the weight; the same mechanism on another gauge (a gain) is named, its gauge

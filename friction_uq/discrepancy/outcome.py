@@ -44,7 +44,8 @@ def kappa_draws(mf: ModelFit) -> np.ndarray:
 def _entry(r: Ranked, verdict=None) -> dict[str, object]:
     v = r.fit.variants[-1]
     params = {p.name: summarize_draws(r.fit.fit.draws[p.name]) for p in v.mechanism.parameters}
-    judged = {} if verdict is None else next(({"weight": c.weight, "delpd_trimmed": c.delpd_trimmed,
+    judged = {} if verdict is None else next(({"decisive": c.decisive, "weight": c.weight,
+                                               "delpd_trimmed": c.delpd_trimmed,
                                                "se_trimmed": c.se_trimmed, "spread": c.spread,
                                                "ruled_out_by_weight": c.label in verdict.by_weight}
                                               for c in verdict.candidates if c.label == r.fit.label), {})
@@ -121,8 +122,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "residual_rms": {ch: {ph: {"before": b, "after": a} for ph, (b, a) in phases.items()}
                          for ch, phases in dg.rms.items()},
         "rule": "a cause is named only of a misfit the whole-record check found, when its dELPD over the model without "
-                "it exceeds 4 and 2 SE, still does with the 5 % of blocks that favour it most left out (spread over "
-                "the record), and rules out every other extended model (by the same margin, or by the stacking weight: "
+                "it exceeds 4 and 2 SE with the 5 % of blocks that favour it most left out (spread over the record; "
+                "the whole record's sum is larger still), and rules out every other extended model (by the same margin, or by the stacking weight: "
                 "more than 4 behind with the 5 % of blocks that favour the best left out, under 0.1 of the weight with "
                 "the models as far behind that predict alike); several it does not rule out are candidates, a misfit "
                 "none explains is unexplained, and f is then the stacking mixture of the models that carry the weight "

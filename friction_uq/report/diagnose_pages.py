@@ -41,8 +41,9 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
             rows.append(r)
             labels.append(f"{k + 1}: {r.fit.variants[-1].label}" + (f" (w {c.weight:.2f})" if c is not None else ""))
             named.append(cause is not None and r.fit.variants[-1] is cause)
-            colours.append("tab:red" if (c.passes if c is not None else r.decisive) else
-                           "tab:orange" if r.decisive else "0.6")
+            decisive = c.decisive if c is not None else r.decisive
+            colours.append("tab:red" if (c.passes if c is not None else decisive) else
+                           "tab:orange" if decisive else "0.6")
         seps.append(len(rows))
     y = np.arange(len(rows))[::-1]
     d = np.array([r.delpd for r in rows])
@@ -105,8 +106,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
         lines.insert(7, f"f, stacking mixture ({', '.join(f'{k} {w:.2f}' for k, w in dg.mixture_weights.items())}): "
                         f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (given the headers; the sentence's f to quote adds the bars' calibration)")
     lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
-                  "round's reference is > 4 and > 2 SE, still is with the 5 % of blocks most in its favour left "
-                  "out, and rules out every other mechanism (by the same margin, or the other is > 4 behind without "
+                  "round's reference is > 4 and > 2 SE with the 5 % of blocks most in its favour left out (the "
+                  "whole record's sum is larger still), and rules out every other mechanism (by the same margin, or the other is > 4 behind without "
                   "those blocks and carries < 0.1 of the weight); others not ruled out make candidates, a misfit "
                   "none explains is unexplained (f then from the stacking mixture, "
                   "half of it the stationary analysis' f when nothing is named); "
