@@ -65,7 +65,8 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
                   "than they explain)", fontsize=8)
     ax.legend([Patch(color="tab:red"), Patch(color="tab:orange"), Patch(color="0.6"),
                Line2D([], [], color="tab:blue", ls="--")],
-              ["decisive and spread over the record (bold: the cause named in that round)",
+              ["decisive with the 5 % of blocks most in its favour left out: spread over the record, whatever\n"
+               "its whole-record bar (bold: the cause named in that round)",
                "decisive, but carried by a few blocks (5 % left out: not decisive)", "not decisive", "dELPD = 4"],
               loc="lower right", fontsize=7)
     ax.text(0.0, -0.16, "w: stacking weight, the share of the record's predictions the model carries against the "
