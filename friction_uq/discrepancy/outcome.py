@@ -50,7 +50,7 @@ def _entry(r: Ranked, verdict=None) -> dict[str, object]:
                                                "ruled_out_by_weight": c.label in verdict.by_weight}
                                               for c in verdict.candidates if c.label == r.fit.label), {})
     return {"name": v.mechanism.name, "channel": v.channel, "model": r.fit.label, "delpd": r.delpd, "se": r.se,
-            "decisive": r.decisive, **judged, "parameters": params,
+            "decisive": r.decisive, **judged, "parameters": params,  # judged: the naming rule's decisive
             "calibration_elpd": dict(zip(r.fit.elpd.calibration_names, map(float, r.fit.elpd.calibration))),
             "f_effective": summarize_draws(r.fit.f_effective), "f_from": r.fit.f_from,
             "draws": int(len(r.fit.f_effective)), "ess": _ess(r.fit.fit.log_weights)}
@@ -123,7 +123,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                          for ch, phases in dg.rms.items()},
         "rule": "a cause is named only of a misfit the whole-record check found, when its dELPD over the model without "
                 "it exceeds 4 and 2 SE with the 5 % of blocks that favour it most left out (spread over the record; "
-                "the whole record's sum is larger still), and rules out every other extended model (by the same margin, or by the stacking weight: "
+                "the whole record's sum is larger still), and rules out every other extended model (by the same "
+                "margin, or by the stacking weight: "
                 "more than 4 behind with the 5 % of blocks that favour the best left out, under 0.1 of the weight with "
                 "the models as far behind that predict alike); several it does not rule out are candidates, a misfit "
                 "none explains is unexplained, and f is then the stacking mixture of the models that carry the weight "

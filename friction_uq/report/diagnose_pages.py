@@ -108,7 +108,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
                         f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (given the headers; the sentence's f to quote adds the bars' calibration)")
     lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
                   "round's reference is > 4 and > 2 SE with the 5 % of blocks most in its favour left out (the "
-                  "whole record's sum is larger still), and rules out every other mechanism (by the same margin, or the other is > 4 behind without "
+                  "whole record's sum is larger still), and rules out every other mechanism (by the same margin, "
+                  "or the other is > 4 behind without "
                   "those blocks and carries < 0.1 of the weight); others not ruled out make candidates, a misfit "
                   "none explains is unexplained (f then from the stacking mixture, "
                   "half of it the stationary analysis' f when nothing is named); "

@@ -210,9 +210,10 @@ class _Draws:
 
 
 def _kept_draws(chain: np.ndarray, settings: SamplerSettings, tau: np.ndarray, log_post: LogPosterior) -> _Draws:
-    """``tau``: each parameter's integrated time over all walkers. Burn-in of ``burn_factor`` tau dropped (half the chain if that is all of it), thinned to tau/2 and further
-    so that at most ``max_draws`` draws are kept (the pointwise log-likelihood of every kept draw is stored;
-    thinned beyond tau the draws are nearly independent, so ESS ~ max_draws)."""
+    """``tau``: each parameter's integrated time over all walkers. Burn-in of ``burn_factor`` tau dropped (half
+    the chain if that is all of it), thinned to tau/2 and further so that at most ``max_draws`` draws are kept
+    (the pointwise log-likelihood of every kept draw is stored; thinned beyond tau the draws are nearly
+    independent, so ESS ~ max_draws)."""
     n, n_all, ndim = chain.shape
     blocks = _blocks(settings)
     tau_all = np.array([integrated_time(chain[:, b]) for b in blocks])
