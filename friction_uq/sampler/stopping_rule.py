@@ -103,7 +103,8 @@ def run_until_steady(sampler: emcee.EnsembleSampler, state: emcee.State, setting
                 acc = float(np.mean(backend.accepted) / max(n, 1))
                 progress(Progress(n, settings.max_steps, tau_max, change, n / tau_max, acc,
                                   time.perf_counter() - t_start, settings.tau_factor, settings.tau_rtol))
-            if n > settings.tau_factor * tau_max and change < settings.tau_rtol:
+            converged = n > settings.tau_factor * tau_max and change < settings.tau_rtol
+            if converged:
                 break
             if n >= settings.max_steps:
                 warnings.warn(
@@ -112,11 +113,10 @@ def run_until_steady(sampler: emcee.EnsembleSampler, state: emcee.State, setting
                     f"{100 * settings.tau_rtol:g} %); raise max_steps or treat the posterior as approximate",
                     ConvergenceWarning, stacklevel=3,
                 )
-                store.write(backend)  # a run killed while its outputs are written resumes here without stepping
-                return False, tau
+                break
     except KeyboardInterrupt:  # Ctrl-C: the steps made so far are kept, the next run resumes from them
         if backend.iteration > 0:
             store.write(backend)
         raise
     store.write(backend)  # a run killed while its outputs are written resumes here without stepping
-    return True, tau
+    return converged, tau
