@@ -7,8 +7,9 @@ each round's verdict with the naming rule of :mod:`.verdict`.
   sum is then larger still, whatever its standard error), and when it rules out every other mechanism: by
   the same rule, or by the stacking weight (:mod:`.verdict`, 3.);
 * several mechanisms that pass but do not rule each other out are *candidates*: the record does not tell
-  them apart (``not_separable``, with what would separate them), and f is then the stacking mixture of
-  the models that carry the weight; the same mechanism on another gauge (a gain) is named, its gauge
+  them apart (``not_separable``, with what would separate them, and, where they are all faults of the chain
+  that delay one gauge's fronts, the delay they agree on: :mod:`.front_delay`), and f is then the stacking
+  mixture of the models that carry the weight; the same mechanism on another gauge (a gain) is named, its gauge
   listed as uncertain;
 * a misfit of the reference model (the whole-record check's decision, :mod:`.misfit`) that no mechanism
   explains by that rule is *unexplained*: the candidates are listed with their stacking weights and f is
@@ -44,6 +45,7 @@ from ..analysis import Prepared
 from .elpd import elpd_difference
 from .exact_model import exact_posterior
 from .extended import Diagnoser, ModelFit, Variant, candidates
+from .front_delay import round_shared_delay
 from .misfit import MisfitDecision, decide, misfit_detected
 from .candidates_mixture import (Resolve, draw_mixture, further_members, mixture, open_rounds, rival_mixture,
                                  superfluous_mixture)
@@ -156,6 +158,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     if st.not_sep and verdicts and 0 not in open_rounds(causes, verdicts):
         # the rivals of round 1 were second causes, named in later rounds, or ruled out with them in the model
         st.not_sep, st.separate_by = (), None
+    shared = round_shared_delay(verdicts[0], rounds[0], st.not_sep, prep.record.apparatus) if st.not_sep else None
     say("posterior predictive of the final model")
     if causes and len(next(iter(final.predicted.values()))) == 1:  # the mode only: a cause of the last round
         final = replace(final, predicted=dg.predictive(final))
@@ -181,7 +184,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
                      posterior_method=method, posterior_converged=converged, context=dg.context, seed=seed,
                      verdicts=tuple(verdicts), mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src, swaps=swaps,
-                     swap_models=checked, mixture_of=mixture_of)
+                     swap_models=checked, mixture_of=mixture_of, shared_delay=shared)
 
 
 def _mixture_after_causes(final: ModelFit, rounds: list, verdicts: list, causes: list, swaps: tuple, checked: tuple,

@@ -11,6 +11,7 @@ import numpy as np
 from ..stats import RULE
 from .candidates_mixture import named_causes, open_rivals, open_rounds
 from .extended import ModelFit, Variant
+from .front_delay import SharedDelay
 from .mechanisms import Context
 from .misfit import MisfitDecision
 from .rival_swaps import Swap
@@ -90,6 +91,9 @@ class Diagnosis:
     #: "further" (the last round's weight on further mechanisms), "superfluous" (a candidate fitted in turn not
     #: needed: the final model and the swap check's models of its round), or None (f is the final model's)
     mixture_of: str | None = None
+    #: the delay on one gauge that the first round's candidates agree on, when the record does not tell apart
+    #: delay-like faults of the measurement chain (:mod:`.front_delay`); None otherwise
+    shared_delay: SharedDelay | None = None
 
     @property
     def verdict(self) -> Verdict | None:

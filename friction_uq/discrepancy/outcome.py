@@ -96,6 +96,8 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                    "weight": sw.weight, "ruled_out": sw.ruling, "check_flags": sw.flagged} for sw in dg.swaps],
         "not_separable": list(dg.not_separable),
         "separate_by": dg.separate_by,
+        # the delay on one gauge the candidates not told apart agree on, when they all delay its fronts (front_delay)
+        "shared_delay": dg.shared_delay.to_json() if dg.shared_delay is not None else None,
         "ranking": [_entry(r, v) for r in dg.ranking],
         "rounds": [[_entry(r, dg.verdicts[k + 1] if k + 1 < len(dg.verdicts) else None) for r in rnd]
                    for k, rnd in enumerate(dg.rounds[1:])],

@@ -54,7 +54,8 @@ def reproducible(dt):
 
 
 
-#: The run's JSON: its schema name and version (8: ``discrepancy.causes`` leaves out a later round's chain entry kept
+#: The run's JSON: its schema name and version (9: ``discrepancy.shared_delay``, the delay on one gauge the candidates
+#: the record does not tell apart agree on; 8: ``discrepancy.causes`` leaves out a later round's chain entry kept
 #: in the model within the whole-record check's tolerance, listed in ``discrepancy.within_tolerance``; 7: a ranking
 #: entry's ``f_from`` says whether its f is the cut posterior's or the whole-record fit's; 6: a diagnosed model's f and ``nu_extended`` are the cut posterior's,
 #: nu from the stationary windows (``discrepancy.nu_source``), the whole record's own reading ``nu_whole_record``;
@@ -63,7 +64,7 @@ def reproducible(dt):
 #: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
-RUN_SCHEMA_VERSION = 8
+RUN_SCHEMA_VERSION = 9
 
 
 def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],
