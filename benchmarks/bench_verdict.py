@@ -13,7 +13,9 @@ Prints per group: records, verdicts (named / candidates / unexplained / none), t
 90 % interval holding the truth (named: the named model's f; candidates or unexplained: the stacking
 mixture's; none: the baseline's), the same with the output bars' calibration folded in ("+calib.") and with the
 whole-record models' form beside it ("+form": the f to quote's fold, :mod:`friction_uq.quoted`), and the confusion
-of first named causes. f here is the normal approximation's (``diagnose`` then takes the named model's exact
+of first named causes; then the single effects split by whether the whole-record check saw a misfit (the effects
+it does not see are not named by design), with the candidates that agree on one gauge's delay
+(:mod:`friction_uq.discrepancy.front_delay`). f here is the normal approximation's (``diagnose`` then takes the named model's exact
 posterior); the stationary analysis' half of a mixture (``diagnose``'s, when nothing is named) is not stored.
 """
 
@@ -30,12 +32,16 @@ from types import SimpleNamespace
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_misfit import SETUPS  # noqa: E402
+
 from friction_uq.discrepancy.candidates_mixture import mixture
 from friction_uq.discrepancy.diagnose import Ranked
 from friction_uq.discrepancy.diagnosed_f import folded_sd_of
 from friction_uq.discrepancy.elpd import Elpd, elpd_difference
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
+from friction_uq.discrepancy.front_delay import shared_delay
 from friction_uq.discrepancy.verdict import NamingRule
 from friction_uq.quoted import WHOLE_RECORD_MODEL_FORM, quoted_summary
 
@@ -83,7 +89,20 @@ def outcome(rec: dict, rule: NamingRule) -> dict:
 
     return {"kind": v.kind, "named": named, "covered": bool(q05 <= truth <= q95),
             "quoted_calibration": quoted_covers(0.0), "quoted": quoted_covers(WHOLE_RECORD_MODEL_FORM),
-            "candidates": [v.named, *v.rivals] if v.kind == "candidates" else []}
+            "candidates": [v.named, *v.rivals] if v.kind == "candidates" else [],
+            "shared_delay": _shared_delay(rec, v) if v.kind == "candidates" else None}
+
+
+def _shared_delay(rec: dict, v) -> object:
+    """The delay the candidates agree on (:mod:`friction_uq.discrepancy.front_delay`), from the stored modes (the
+    record's set-up from its index: A for even, B for odd, as ``verdict_records.make`` draws them)."""
+    models = {m["label"]: m for m in rec["models"]}
+    setup = "A" if int(rec["name"].rsplit("-", 1)[1]) % 2 == 0 else "B"
+    mechanisms = {models[label]["mechanism"] for label in (v.named, *v.rivals)}
+    if len(mechanisms) < 2:
+        return None
+    fits = [(models[label]["mechanism"], models[label]["mode"]) for label in (v.named, *v.rivals)]
+    return shared_delay(fits, SETUPS[setup].apparatus)
 
 
 def hidden(group: str) -> str | None:
@@ -103,6 +122,12 @@ def table(records: list[dict], rule: NamingRule) -> str:
         c["covered"] += o["covered"]
         c["quoted_calibration"] += o["quoted_calibration"]
         c["quoted"] += o["quoted"]
+        if hidden(rec["group"]) is not None:  # the effect records by what the whole-record check saw
+            seen = "seen" if rec["misfit"] else "unseen"
+            c[seen] += 1
+            c[f"{seen}_exact"] += o["named"] is not None and o["named"] == hidden(rec["group"])
+            c[f"{seen}_{o['kind']}"] += 1
+            c["seen_delay"] += rec["misfit"] and o["shared_delay"] is not None
         confusion[rec["group"]][o["named"] or f"({o['kind']})"] += 1
     head = (f"{'group':<32} {'n':>3} {'named':>5} {'cand.':>5} {'unexpl.':>7} {'unconf.':>7} {'none':>4} {'exact':>5} "
             f"{'in cand.':>8} {'f cov.':>6} {'+calib.':>7} {'+form':>5}  first named cause (or verdict)")
@@ -125,7 +150,17 @@ def table(records: list[dict], rule: NamingRule) -> str:
                  f"{share(effect, 'exact')}; f covered on effect records: {share(effect, 'covered')} (with the bars' "
                  f"calibration {share(effect, 'quoted_calibration')}, and the whole-record form {share(effect, 'quoted')})"
                  f", on clean: {share(clean, 'covered')} ({share(clean, 'quoted_calibration')}, {share(clean, 'quoted')})")
+    lines.append(f"of the single effects the whole-record check sees (a misfit), {share(effect, 'seen')}: exact cause "
+                 f"{share_of(rows, effect, 'seen_exact', 'seen')}, candidates {share_of(rows, effect, 'seen_candidates', 'seen')} "
+                 f"({sum(rows[g]['seen_delay'] for g in effect)} of them agreeing on one gauge's delay), unexplained "
+                 f"{share_of(rows, effect, 'seen_unexplained', 'seen')}, a wrong cause named "
+                 f"{sum(rows[g]['seen_named'] - rows[g]['seen_exact'] for g in effect)}; the check sees no misfit on "
+                 f"{share(effect, 'unseen')} (exact {sum(rows[g]['unseen_exact'] for g in effect)})")
     return "\n".join(lines)
+
+
+def share_of(rows, groups, key: str, of: str) -> str:
+    return f"{sum(rows[g][key] for g in groups)}/{sum(rows[g][of] for g in groups)}"
 
 
 def main() -> None:
