@@ -98,11 +98,8 @@ def _shared_delay(rec: dict, v) -> object:
     record's set-up from its index: A for even, B for odd, as ``verdict_records.make`` draws them)."""
     models = {m["label"]: m for m in rec["models"]}
     setup = "A" if int(rec["name"].rsplit("-", 1)[1]) % 2 == 0 else "B"
-    mechanisms = {models[label]["mechanism"] for label in (v.named, *v.rivals)}
-    if len(mechanisms) < 2:
-        return None
     fits = [(models[label]["mechanism"], models[label]["mode"]) for label in (v.named, *v.rivals)]
-    return shared_delay(fits, SETUPS[setup].apparatus)
+    return shared_delay(fits, SETUPS[setup].apparatus)  # None unless two or more delay-like mechanisms agree
 
 
 def hidden(group: str) -> str | None:
@@ -143,8 +140,7 @@ def table(records: list[dict], rule: NamingRule) -> str:
     effect = [g for g in rows if not g.startswith("clean")]
 
     def share(groups, key):
-        n = sum(rows[g]["n"] for g in groups)
-        return f"{sum(rows[g][key] for g in groups)}/{n}"
+        return share_of(rows, groups, key, "n")
 
     lines.append(f"clean records with a cause named: {share(clean, 'named')}; single effects with the exact cause: "
                  f"{share(effect, 'exact')}; f covered on effect records: {share(effect, 'covered')} (with the bars' "
@@ -160,6 +156,7 @@ def table(records: list[dict], rule: NamingRule) -> str:
 
 
 def share_of(rows, groups, key: str, of: str) -> str:
+    """'k/n': the count ``key`` over the count ``of``, summed over ``groups``."""
     return f"{sum(rows[g][key] for g in groups)}/{sum(rows[g][of] for g in groups)}"
 
 
