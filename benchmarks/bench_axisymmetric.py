@@ -29,7 +29,7 @@ import numpy as np
 
 from friction_uq.physics.cell import beta
 from friction_uq.simulate import SimulationConfig, load_config, run_model
-from friction_uq.simulate.axisymmetric.compare import (
+from friction_uq.simulate.axisymmetric.side_by_side import (
     PHASES,
     QUANTITIES,
     UNITS,
@@ -38,7 +38,7 @@ from friction_uq.simulate.axisymmetric.compare import (
     gauge_discrepancy,
     phase_windows,
 )
-from friction_uq.simulate.axisymmetric.model import run_axisymmetric
+from friction_uq.simulate.axisymmetric.model_axisymmetric import run_axisymmetric
 from friction_uq.simulate.axisymmetric.settings import ModelSettings
 
 ROOT = Path(__file__).resolve().parents[1]

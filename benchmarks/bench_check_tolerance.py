@@ -41,7 +41,7 @@ from bench_misfit import clean_config  # noqa: E402
 from bench_trust import _axisymmetric, make_record  # noqa: E402
 
 from friction_uq.analysis import identify, prepare  # noqa: E402
-from friction_uq.discrepancy import pipeline  # noqa: E402
+from friction_uq.discrepancy import run_stage  # noqa: E402
 from friction_uq.discrepancy.misfit import cell_test, cell_threshold, phase_spans  # noqa: E402
 from friction_uq.discrepancy.whole_record import TIMING_TOLERANCE, TOLERANCE  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
@@ -64,7 +64,7 @@ def cell_statistics(path: str, seed: int) -> dict[tuple[str, str], np.ndarray]:
     prep = prepare(read_record(path))
     priors = load_priors(default_prior_path(prep.record.apparatus.sample.material))
     start = whole_record_start(identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3)), priors)
-    wr = pipeline.whole_record_check(prep, priors, start, hoop=prep.data.hoop is not None, seed=seed).comparison
+    wr = run_stage.whole_record_check(prep, priors, start, hoop=prep.data.hoop is not None, seed=seed).comparison
     out = {}
     for ch in wr.phase_bounds:
         for phase, a, b in phase_spans(wr, ch):

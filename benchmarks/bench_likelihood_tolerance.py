@@ -43,7 +43,7 @@ from friction_uq.analysis import identify, prepare  # noqa: E402
 from friction_uq.discrepancy import record_likelihood  # noqa: E402
 from friction_uq.discrepancy.exact_model import exact_posterior  # noqa: E402
 from friction_uq.discrepancy.extended import Diagnoser  # noqa: E402
-from friction_uq.discrepancy.pipeline import f_nu_log_prior  # noqa: E402
+from friction_uq.discrepancy.run_stage import f_nu_log_prior  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.models.parameters import F  # noqa: E402
 from friction_uq.models.simulator import NU  # noqa: E402

@@ -38,7 +38,7 @@ from bench_misfit import SETUPS  # noqa: E402
 from friction_uq.discrepancy.candidates_mixture import mixture
 from friction_uq.discrepancy.diagnose import Ranked
 from friction_uq.discrepancy.diagnosed_f import folded_sd_of
-from friction_uq.discrepancy.elpd import Elpd, elpd_difference
+from friction_uq.discrepancy.block_loo import Elpd, elpd_difference
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
 from friction_uq.discrepancy.front_delay import shared_delay

@@ -18,7 +18,7 @@ from friction_uq.physics.tube import bore_compliance_factor, lame_hoop_strain
 from friction_uq.simulate import SimulationConfig, run_model
 from friction_uq.simulate.axisymmetric.kernels import elastic_forces
 from friction_uq.simulate.axisymmetric.mesh import TUBE, Block, Material, build_mesh
-from friction_uq.simulate.axisymmetric.model import run_axisymmetric
+from friction_uq.simulate.axisymmetric.model_axisymmetric import run_axisymmetric
 from friction_uq.simulate.axisymmetric.settings import ModelSettings
 from friction_uq.simulate.axisymmetric.statics import StaticSolver, pressure_load, stiffness_matrix
 from friction_uq.simulate.config import default_apparatus

@@ -61,7 +61,7 @@ def test_one_friction_law_at_a_time():
 def _fit(name, channel, blocks, f=0.05):
     from types import SimpleNamespace
 
-    from friction_uq.discrepancy.elpd import Elpd
+    from friction_uq.discrepancy.block_loo import Elpd
     from friction_uq.discrepancy.extended import Variant
 
     label = name if channel is None else f"{name}[{channel}]"
@@ -72,7 +72,7 @@ def _fit(name, channel, blocks, f=0.05):
 
 def _round(reference, fits):
     from friction_uq.discrepancy.diagnose import Ranked
-    from friction_uq.discrepancy.elpd import elpd_difference
+    from friction_uq.discrepancy.block_loo import elpd_difference
 
     return tuple(sorted((Ranked(f, *elpd_difference(f.elpd, reference.elpd)) for f in fits), key=lambda r: -r.delpd))
 
@@ -140,7 +140,7 @@ def test_more_evidence_in_the_blocks_left_out_never_turns_a_pass_into_a_fail(d, 
 
 
 def test_a_rival_behind_by_spread_evidence_is_ruled_out_however_much_a_few_blocks_add_on_top():
-    from friction_uq.discrepancy.elpd import Elpd
+    from friction_uq.discrepancy.block_loo import Elpd
     from friction_uq.discrepancy.verdict import NamingRule
 
     rival = _noise(seed=5)
@@ -159,7 +159,7 @@ def test_a_rival_behind_by_spread_evidence_is_ruled_out_however_much_a_few_block
 @settings(max_examples=60, deadline=None)
 @given(st.lists(st.floats(-2.0, 2.0), min_size=40, max_size=120), st.floats(0.0, 1.5), st.floats(1.0, 1e4))
 def test_more_lead_in_the_blocks_left_out_never_reopens_a_rival_ruled_out_without_them(d, shift, extra):
-    from friction_uq.discrepancy.elpd import Elpd, elpd_difference
+    from friction_uq.discrepancy.block_loo import Elpd, elpd_difference
     from friction_uq.stats import RULE
     from friction_uq.discrepancy.verdict import NamingRule
     from friction_uq.stats.trimmed import points_to_drop
@@ -199,7 +199,7 @@ def test_two_mechanisms_the_record_does_not_separate_are_candidates_and_a_gain_o
 def test_a_rival_behind_over_the_whole_record_with_no_weight_is_ruled_out_and_one_behind_at_a_front_or_with_weight_is_not():
     """The weight route of the naming rule (friction_uq.discrepancy.verdict, 3.): a lead within 2 SE rules a rival
     out when it holds with the spread test's blocks left out and the rival carries no stacking weight."""
-    from friction_uq.discrepancy.elpd import elpd_difference
+    from friction_uq.discrepancy.block_loo import elpd_difference
     from friction_uq.discrepancy.verdict import NamingRule
 
     base = _fit("reference", None, _noise())
@@ -823,7 +823,7 @@ class _RoundsDiagnoser:
         return fit
 
     def fit_many(self, jobs, workers, cut):
-        from friction_uq.discrepancy.elpd import Elpd
+        from friction_uq.discrepancy.block_loo import Elpd
 
         out = []
         for variants, _, label in jobs:
@@ -856,7 +856,7 @@ def test_a_later_round_within_the_checks_tolerance_names_a_chain_entry_only_if_i
     moves f by more than the whole-record models' form term (4.1 %), otherwise kept in the model (the later rounds
     and the swap check see it), not named; f is the same either way. A mechanism of the cell is named."""
     from friction_uq.discrepancy import diagnose as dmod
-    from friction_uq.discrepancy.elpd import Elpd
+    from friction_uq.discrepancy.block_loo import Elpd
     from friction_uq.discrepancy.extended import Variant
 
     def variant(label):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from friction_uq.discrepancy.elpd import CALIBRATION_FLOOR, Elpd, calibration_loo, elpd_difference, with_calibration
+from friction_uq.discrepancy.block_loo import CALIBRATION_FLOOR, Elpd, calibration_loo, elpd_difference, with_calibration
 from friction_uq.stats.ar1 import ar1_block_loo
 from friction_uq.stats.elpd import psis_loo
 

@@ -31,7 +31,7 @@ from friction_uq.shpb import (
     fit_balance,
     read_lanl_raw,
 )
-from friction_uq.shpb.diagnose import Candidate
+from friction_uq.shpb.balance_diagnosis import Candidate
 
 RECORD = (Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "real" / "lanl-hoppybar-cu"
           / "20061201_1148HE_CuOFE_273K.raw")
@@ -188,7 +188,7 @@ def test_lanl_gain_is_the_header_200_not_500(lanl) -> None:
 
 
 def test_registry_documents_each_mechanism() -> None:
-    from friction_uq.shpb.mechanisms import GAIN_LOG_SD, MECHANISMS, lognormal_logpdf
+    from friction_uq.shpb.balance_mechanisms import GAIN_LOG_SD, MECHANISMS, lognormal_logpdf
 
     assert list(MECHANISMS) == ["gauge_gain", "wave_speed", "dispersion"]
     for m in MECHANISMS.values():
@@ -200,6 +200,6 @@ def test_registry_documents_each_mechanism() -> None:
     drop = lognormal_logpdf(1.0, log_sd=GAIN_LOG_SD) - lognormal_logpdf(2.5, log_sd=GAIN_LOG_SD)
     assert drop == pytest.approx(2.0 + math.log(2.5))  # z^2 / 2 and the 1 / x of the density
     with pytest.raises(ValueError, match=r"bar mechanism 'dispersion' is already registered"):
-        from friction_uq.shpb.mechanisms import register
+        from friction_uq.shpb.balance_mechanisms import register
 
         register(MECHANISMS["dispersion"])

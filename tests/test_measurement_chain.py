@@ -177,7 +177,7 @@ def chain_records(tmp_path_factory):
 
 def _fits(path, names):
     from friction_uq.analysis import prepare
-    from friction_uq.discrepancy.elpd import elpd_difference
+    from friction_uq.discrepancy.block_loo import elpd_difference
     from friction_uq.discrepancy.extended import Diagnoser, Variant
     from friction_uq.discrepancy.mechanisms import MECHANISMS
     from friction_uq.priors import default_prior_path, load_priors

@@ -16,7 +16,7 @@ from friction_uq.models import SimulatorModel, measured_loading
 from friction_uq.models.parameters import F, HOOP_GAIN, NU, Parameter, ParameterSet
 from friction_uq.record import read_record
 from friction_uq.simulate import SimulationConfig, simulate_to_file
-from friction_uq.simulate.model import run_model
+from friction_uq.simulate.model_1d import run_model
 from simulated import noisy_config
 
 

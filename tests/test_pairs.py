@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 from friction_uq.discrepancy import outcome
-from friction_uq.discrepancy.elpd import elpd_difference
+from friction_uq.discrepancy.block_loo import elpd_difference
 from friction_uq.stats import RULE
 from friction_uq.stats.trimmed import points_to_drop
 from friction_uq.discrepancy.diagnose import MAX_CAUSES

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from friction_uq.discrepancy.candidates_mixture import named_causes, unresolved_rounds
-from friction_uq.discrepancy.elpd import Elpd, elpd_difference
+from friction_uq.discrepancy.block_loo import Elpd, elpd_difference
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
 from friction_uq.discrepancy.rival_swaps import WITHOUT, check_swaps, swap_jobs, swap_start

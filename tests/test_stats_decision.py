@@ -11,8 +11,8 @@ from friction_uq.campaigns.law_comparison import simplest_supported
 from friction_uq.campaigns.flags import setup_flags
 from friction_uq.campaigns.laws import LAWS, Elpd, best_law, rank
 from friction_uq.discrepancy.diagnose import Ranked
-from friction_uq.discrepancy.elpd import Elpd as RecordElpd, elpd_difference
-from friction_uq.shpb.diagnose import Candidate
+from friction_uq.discrepancy.block_loo import Elpd as RecordElpd, elpd_difference
+from friction_uq.shpb.balance_diagnosis import Candidate
 from friction_uq.stats import RULE, DecisionRule, paired_difference
 
 

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..analysis import Prepared
-from .elpd import elpd_difference
+from .block_loo import elpd_difference
 from .exact_model import exact_posterior
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .front_delay import round_shared_delay

@@ -5,7 +5,7 @@ For each mechanism (:mod:`.mechanisms`; ``gauge_gain`` once per bar gauge) the s
 the measured incident wave, extended by the mechanism, is fitted to the whole record (:mod:`.fit`:
 posterior by a Laplace approximation; f, nu and the sample's modulus stay free, a nuisance with a
 10 % lognormal prior, the hoop gauge's calibration factor marginalised under its 5 % prior) and scored by its expected log predictive
-density over blocks of 10 us of every gauge (:mod:`.elpd`: exact leave-one-block-out for AR(1)
+density over blocks of 10 us of every gauge (:mod:`.block_loo`: exact leave-one-block-out for AR(1)
 noise) and over the calibration data the fit takes as priors (the hoop gauge's factor, the sample's
 modulus), each left out in turn. The baseline is the same simulator without extension. What is
 named from these scores is :mod:`.diagnose`'s rule.
@@ -32,7 +32,7 @@ from ..models.parameters import summarize_draws
 from ..models.measurement_chain import Reading
 from ..stats.ar1 import ar1_block_loo
 from ..stats.streams import stream
-from .elpd import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
+from .block_loo import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
 from .nu_cut import CutFit, conditional_fit, window_nu

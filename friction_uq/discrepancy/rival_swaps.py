@@ -56,7 +56,7 @@ from dataclasses import dataclass, replace
 from ..stats import RULE
 from ..stats.trimmed import points_to_drop
 from .candidates_mixture import open_rivals
-from .elpd import elpd_difference
+from .block_loo import elpd_difference
 from .extended import Diagnoser, ModelFit, Variant
 from .verdict import NamingRule, Verdict, round_weights
 

@@ -164,7 +164,7 @@ def ruled_out_against(reference, models: Sequence) -> list[str]:
     """The labels of ``models`` the record rules out against ``reference`` (each a fit with ``elpd`` and ``label``):
     the reference's dELPD over each decisive by the package's rule (:attr:`Candidate.decisively_worse` of a round's
     candidates); the swap check's models against the final model."""
-    from .elpd import elpd_difference
+    from .block_loo import elpd_difference
 
     return [m.label for m in models if RULE.decisive(*elpd_difference(reference.elpd, m.elpd))]
 
@@ -202,7 +202,7 @@ class NamingRule:
 
     def candidate(self, fit, reference, delpd: float, se: float, weight: float) -> Candidate:
         """One model against the reference, with the spread test."""
-        from .elpd import elpd_difference
+        from .block_loo import elpd_difference
 
         drop = points_to_drop(len(reference.elpd.pointwise), self.drop_fraction)
         dt, set_ = elpd_difference(fit.elpd, reference.elpd, drop=drop)
@@ -269,7 +269,7 @@ class NamingRule:
         ``other``'s with the models that predict alike with it) or None (it does not). ``carried``: ``other`` is
         among the models that carry 90 % of the weight (:meth:`WeightRule.supported`), which, as in the campaign,
         the weight never rules out."""
-        from .elpd import elpd_difference
+        from .block_loo import elpd_difference
 
         d, se = elpd_difference(best, other)
         rest, se_rest = elpd_difference(best, other, drop=drop)

@@ -1,6 +1,6 @@
 """The simulator of the whole test as a forward model with named parameters.
 
-:class:`SimulatorModel` wraps :func:`friction_uq.simulate.model.run_model`: given a record's
+:class:`SimulatorModel` wraps :func:`friction_uq.simulate.model_1d.run_model`: given a record's
 apparatus and a loading (the measured incident wave, :func:`.loading.measured_loading`, or a
 trapezoid), it predicts what each gauge reads over the whole record for given parameter values:
 the input-bar gauge (incident as given plus the simulated reflected wave), both output-bar gauges
@@ -26,7 +26,7 @@ import numpy as np
 from ..record import Apparatus
 from ..simulate.config import DEFAULT_PLUG, ChannelSpec, SimulationConfig
 from ..simulate.loading import Loading
-from ..simulate.model import run_model
+from ..simulate.model_1d import run_model
 from .measurement_chain import Reading, delayed
 from .parameters import F, HOOP_GAIN, Parameter, ParameterSet
 

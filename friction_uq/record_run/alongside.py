@@ -29,9 +29,9 @@ def alongside(prep: Prepared, priors, start: dict[str, float], *, hoop: bool, se
     needs no posterior draw) and its pages of the report (``pages``)."""
     wrc = None
     if check:
-        from ..discrepancy import pipeline
+        from ..discrepancy import run_stage
 
-        wrc = pipeline.whole_record_check(prep, priors, start, hoop=hoop, seed=seed)
+        wrc = run_stage.whole_record_check(prep, priors, start, hoop=hoop, seed=seed)
     part = None
     if pages and wrc is not None:
         from ..report.pdf import render_record_part

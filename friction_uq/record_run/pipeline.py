@@ -185,14 +185,14 @@ def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck,
                   say: Callable[[str], None]) -> object | None:
     """The whole-record check written into the DataTree; with ``diagnose``, every mechanism of the catalogue
     fitted to the whole record and the cause named (written there too), else None."""
-    from ..discrepancy import outcome, pipeline
+    from ..discrepancy import outcome, run_stage
 
-    pipeline.add_whole_record(post.datatree, wrc)
+    run_stage.add_whole_record(post.datatree, wrc)
     if not diagnose:
         return None
     say("diagnose: fitting each mechanism of the catalogue to the whole record")
     start = {"f": post.summary["f"].q50, "nu": post.summary["nu"].q50}
-    diag = pipeline.run_diagnose(s.prepared, s.priors, start, hoop=s.use_hoop, seed=seed, say=say, check=wrc,
+    diag = run_stage.run_diagnose(s.prepared, s.priors, start, hoop=s.use_hoop, seed=seed, say=say, check=wrc,
                                  stationary_f=post.samples.flat("f"))
     outcome.add_to_datatree(post.datatree, diag, s.priors["f"])
     return diag

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import atomic_path
-from ..simulate.axisymmetric.compare import (
+from ..simulate.axisymmetric.side_by_side import (
     PHASES,
     QUANTITIES,
     UNITS,

@@ -1,6 +1,6 @@
 """Posterior sampling of (f, nu[, hoop_gain]) with emcee.
 
-Modules: :mod:`.model` (parametrisation, log posterior, start ball), :mod:`.moves` (the
+Modules: :mod:`.log_posterior` (parametrisation, log posterior, start ball), :mod:`.moves` (the
 differential-evolution move inside independent ensembles), :mod:`.ensemble` (settings, start,
 draws), :mod:`.stopping_rule` (the loop of steps and its stopping rule), :mod:`.checkpoint` (saving and resuming),
 :mod:`.results` (what is returned).
@@ -47,7 +47,7 @@ Design
 
 from .ensemble import likelihood_priors, sample_posterior
 from .stopping_rule import integrated_time
-from .model import LogPosterior, _initial_guess, start_ball
+from .log_posterior import LogPosterior, _initial_guess, start_ball
 from .moves import BlockDEMove
 from .results import ConvergenceWarning, PosteriorSamples, Progress, SamplerSettings, stderr_progress
 

@@ -18,7 +18,7 @@ from ..priors import Priors
 from ..stats.streams import legacy_state
 from ..window import StationaryData
 from . import checkpoint
-from .model import LogPosterior, start_ball
+from .log_posterior import LogPosterior, start_ball
 from .moves import BlockDEMove
 from .results import PosteriorSamples, Progress, SamplerSettings
 from .stopping_rule import integrated_time, run_until_steady

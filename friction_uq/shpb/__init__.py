@@ -7,22 +7,22 @@ to do with the confined friction cell.
 
 * :mod:`.record`: the bars, the specimen and the signals of a two-bar record;
 * :mod:`.lanl`: :func:`read_lanl_raw`, the reader of the LANL text format (and the one sign flip);
-* :mod:`.forces`: :func:`two_bar_forces`, the waves at the specimen faces, the forces on both
+* :mod:`.face_forces`: :func:`two_bar_forces`, the waves at the specimen faces, the forces on both
   faces (eq. 2-3) and their balance;
 * :mod:`.waves`: :func:`gauge_waves`, the incident, reflected and transmitted waves at the gauges;
 * :mod:`.balance`: the force balance as a forward model (the transmitted gauge predicted from the
   input gauge) and its misfit;
-* :mod:`.mechanisms`: the bar-level mechanisms (``gauge_gain``, ``wave_speed``, ``dispersion``);
-* :mod:`.fit`, :mod:`.diagnose`: their posteriors, block-LOO ELPD and the forward selection that
+* :mod:`.balance_mechanisms`: the bar-level mechanisms (``gauge_gain``, ``wave_speed``, ``dispersion``);
+* :mod:`.balance_fit`, :mod:`.balance_diagnosis`: their posteriors, block-LOO ELPD and the forward selection that
   names the causes of a misfit (:func:`diagnose_balance`).
 
 Strain from volts (quarter bridge): strain = V (2 / GF) / (gain Vexc).
 """
 
 from .balance import BalanceObservation, BarSettings, Misfit, transmitted_from_input
-from .diagnose import BalanceDiagnosis, diagnose_balance
-from .fit import BalanceFit, fit_balance
-from .forces import (
+from .balance_diagnosis import BalanceDiagnosis, diagnose_balance
+from .balance_fit import BalanceFit, fit_balance
+from .face_forces import (
     BALANCE_LEVEL,
     PULSE_END_FRACTION,
     TwoBarForces,
@@ -31,7 +31,7 @@ from .forces import (
     two_bar_forces,
 )
 from .lanl import HEADER_ROWS, read_lanl_raw
-from .mechanisms import MECHANISMS, combine
+from .balance_mechanisms import MECHANISMS, combine
 from .record import BarProperties, SpecimenProperties, TwoBarRecord
 from .waves import GaugeWaves, gauge_waves
 

@@ -3,7 +3,7 @@
 Volts to strain (:meth:`BarProperties.strain`), each channel's baseline offset and AR(1) noise
 from its pre-pulse segment (:func:`~friction_uq.signals.prepulse_noise`), and the separation of
 the input gauge's signal into the incident and the reflected wave. This is data processing, done
-once per record: the forward models of :mod:`.balance` and :mod:`.forces` start from its output.
+once per record: the forward models of :mod:`.balance` and :mod:`.face_forces` start from its output.
 """
 
 from __future__ import annotations

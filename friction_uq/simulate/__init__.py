@@ -6,7 +6,7 @@ friction, gauge gain errors, bar dispersion, measurement noise.
 
 Modules: :mod:`.config` (TOML format and checks), :mod:`.friction` (registry of friction laws),
 :mod:`.cell` (time integration of plug, sample column and tube), :mod:`.bars` (bar legs and
-gauges), :mod:`.hoop` (tube hoop gauge), :mod:`.model` (the noise-free model),
+gauges), :mod:`.hoop` (tube hoop gauge), :mod:`.model_1d` (the noise-free model),
 :mod:`.measurement` (gains, offsets, noise, quantisation), :mod:`.simulation` (the public calls).
 
 >>> from friction_uq.simulate import load_config, simulate, simulate_to_file   # doctest: +SKIP
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from .config import ChannelSpec, SimulationConfig, load_config, parse_config
 from .friction import LAWS
-from .model import ModelOutput, run_model
+from .model_1d import ModelOutput, run_model
 from .simulation import Simulation, simulate, simulate_to_file
 
 __all__ = [

@@ -3,7 +3,7 @@
 Two kinds of loading:
 
 * the closed-form trapezoid of the striker (design and synthetic work), built inside
-  :func:`friction_uq.simulate.model.run_model` when no loading is given;
+  :func:`friction_uq.simulate.model_1d.run_model` when no loading is given;
 * a **measured** incident wave (:class:`Loading`), as the paper drove its ABAQUS model: the
   input-bar gauge's incident pulse, offset removed, read before the reflected wave reaches the
   gauge, and the same wave transported forward to the plug interface. The simulated test then

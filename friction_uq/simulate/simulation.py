@@ -18,7 +18,7 @@ from ..physics.cell import beta as janssen_beta
 from ..record import write_record
 from .config import SimulationConfig
 from .measurement import measure
-from .model import ModelOutput, run_model
+from .model_1d import ModelOutput, run_model
 
 #: Version of the simulator's model, written to ``/provenance`` and ``/truth``.
 MODEL_VERSION = "1"

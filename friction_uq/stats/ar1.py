@@ -3,7 +3,7 @@ error integrated out (rank-one term: matrix determinant lemma and Sherman-Morris
 of a block of the series given all the rest (the unit of a record's leave-one-block-out ELPD).
 
 Pure algebra of the noise model, no physics: the stationary-phase likelihood (:mod:`friction_uq.likelihood`),
-the whole-record ELPD (:mod:`friction_uq.discrepancy.elpd`) and the two-bar balance
+the whole-record ELPD (:mod:`friction_uq.discrepancy.block_loo`) and the two-bar balance
 (:mod:`friction_uq.shpb`) read it here."""
 
 from __future__ import annotations
@@ -181,7 +181,7 @@ def _block_constants(length: int, rho: float, first: bool, last: bool) -> tuple[
 
 def ar1_block_loo(resid: np.ndarray, *, sd: float, rho: float, block: int) -> np.ndarray:
     """log p(e_b | e_-b) for consecutive blocks of an AR(1) residual series (derived in
-    :mod:`friction_uq.discrepancy.elpd`'s docstring).
+    :mod:`friction_uq.discrepancy.block_loo`'s docstring).
 
     Parameters
     ----------

@@ -9,8 +9,8 @@ simulator's measurement layer. Chosen with ``[model] fidelity = "axisymmetric"``
 Modules: :mod:`.settings` (the ``[model]`` table), :mod:`.mesh` (structured meshes, lumped masses),
 :mod:`.kernels` (element forces, stress update, Drucker-Prager, stability limit), :mod:`.contact`
 (lateral and end-face contact with friction), :mod:`.coupling` (bar ends), :mod:`.solver` (the
-compiled time loop), :mod:`.assembly` (a configuration's cell and its checks), :mod:`.model` (the
-run, gauges and outputs), :mod:`.compare` (1-D against axisymmetric, per phase), :mod:`.statics`
+compiled time loop), :mod:`.assembly` (a configuration's cell and its checks), :mod:`.model_axisymmetric` (the
+run, gauges and outputs), :mod:`.side_by_side` (1-D against axisymmetric, per phase), :mod:`.statics`
 (static solves with the same element, for verification against closed forms).
 """
 
@@ -22,7 +22,7 @@ __all__ = ["run_axisymmetric"]
 
 
 def run_axisymmetric(*args: Any, **kwargs: Any) -> Any:
-    """:func:`.model.run_axisymmetric` (imported on first use: the configuration reader imports this package)."""
-    from .model import run_axisymmetric as run
+    """:func:`.model_axisymmetric.run_axisymmetric` (imported on first use: the configuration reader imports this package)."""
+    from .model_axisymmetric import run_axisymmetric as run
 
     return run(*args, **kwargs)

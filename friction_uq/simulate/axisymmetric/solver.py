@@ -76,7 +76,7 @@ def run_block(k0: int, k1: int, stride: int, par: np.ndarray, flag: np.ndarray, 
               f_i: np.ndarray, f_io: np.ndarray, f_eo: np.ndarray,
               rec_p: np.ndarray, rec_u: np.ndarray, rec_ff: np.ndarray, rec_sz: np.ndarray,
               rec_s: np.ndarray) -> None:
-    """Advance the cell over steps k0 <= k < k1 in place (arrays described in :mod:`.model`).
+    """Advance the cell over steps k0 <= k < k1 in place (arrays described in :mod:`.model_axisymmetric`).
 
     ``body_nodes`` (3, 2): first and last + 1 node index of plug, sample, tube. ``faces`` (3, N_FACE_STATE):
     state of the input, internal and external bar ends. ``fprev`` [0]: F_i of the previous step (for the

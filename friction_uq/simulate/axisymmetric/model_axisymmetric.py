@@ -1,6 +1,6 @@
 """The noise-free axisymmetric model of one test: bars (1-D), plug, sample and tube (2-D), gauges.
 
-Same time base, loading, bar legs and gauges as the 1-D simulator (:mod:`friction_uq.simulate.model`):
+Same time base, loading, bar legs and gauges as the 1-D simulator (:mod:`friction_uq.simulate.model_1d`):
 the cell is advanced in blocks no longer than the shortest bar round trip, each block's returning
 waves computed from the waves that left the cell before it (exact with or without dispersion). The
 hoop gauge reads the tube's outer-face hoop strain u_r / b averaged over the gauge's width, on the
@@ -19,7 +19,7 @@ from .. import bars
 from ..config import SimulationConfig
 from ..friction import LAWS
 from ..loading import Loading
-from ..model import ModelOutput
+from ..model_1d import ModelOutput
 from . import solver as S
 from .assembly import Cell, build_cell
 from .coupling import N_FACE_STATE
@@ -31,7 +31,7 @@ MAX_SUBSTEPS = 400
 
 @dataclass(frozen=True)
 class AxisymmetricOutput(ModelOutput):
-    """:class:`~friction_uq.simulate.model.ModelOutput` plus the 2-D model's own fields.
+    """:class:`~friction_uq.simulate.model_1d.ModelOutput` plus the 2-D model's own fields.
 
     ``axial_stress`` (Pa, compression positive), shape (n, rows): the sample's axial stress averaged
     over each row of elements (row centres at ``row_z``, m from the input face). ``energy``: name ->

@@ -41,13 +41,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from ..discrepancy.elpd import Elpd
+from ..discrepancy.block_loo import Elpd
 from ..models.parameters import Parameter
 from ..stats.ar1 import ar1_block_loo, ar1_loglike
 from ..stats.elpd import psis_loo, weighted_log_mean
 from ..stats.laplace import draw_normal, fd_hessian, importance_weights
 from .balance import BalanceObservation, Misfit
-from .mechanisms import CombinedModel
+from .balance_mechanisms import CombinedModel
 
 #: Length of the blocks left out (s).
 BLOCK = 5e-6

@@ -21,11 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..discrepancy.elpd import elpd_difference
+from ..discrepancy.block_loo import elpd_difference
 from ..stats import RULE
 from .balance import BalanceObservation
-from .fit import BLOCK, N_DRAWS, BalanceFit, fit_balance
-from .mechanisms import MECHANISMS, combine
+from .balance_fit import BLOCK, N_DRAWS, BalanceFit, fit_balance
+from .balance_mechanisms import MECHANISMS, combine
 
 
 @dataclass(frozen=True)

@@ -23,8 +23,8 @@ import numpy as np
 from ...physics.cell import beta, friction_from_ratio
 from .. import bars
 from ..config import SimulationConfig
-from ..model import ModelOutput, run_model
-from .model import AxisymmetricOutput, run_axisymmetric
+from ..model_1d import ModelOutput, run_model
+from .model_axisymmetric import AxisymmetricOutput, run_axisymmetric
 from .settings import ModelSettings
 
 PHASES = ("rise", "stationary", "unloading")
