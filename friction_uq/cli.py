@@ -279,90 +279,102 @@ def _error(message: str) -> int:
     return EXIT_BAD_INPUT
 
 
-def _dispatch(args: argparse.Namespace) -> int:
-    if args.command == "inspect":
-        from .record import read_record
-        from .summary import inspect_text
+def _inspect(args: argparse.Namespace) -> int:
+    from .record import read_record
+    from .summary import inspect_text
 
-        print(inspect_text(read_record(args.file)))
-        return 0
-    if args.command == "analyze":
-        from .analysis import identify, prepare
-        from .record import read_record
-        from .summary import identification_table
+    print(inspect_text(read_record(args.file)))
+    return 0
 
-        rec = read_record(args.file)
-        ident = identify(prepare(rec, window=args.window, dispersion=args.dispersion), nu=args.nu)
-        if args.json:
-            out = ident.to_json()
-            out["test_id"], out["campaign"] = rec.test_id, rec.campaign
-            print(json.dumps(out))
-        else:
-            print(identification_table(rec, ident))
-        return 0
-    if args.command == "design":
+
+def _analyze(args: argparse.Namespace) -> int:
+    from .analysis import identify, prepare
+    from .record import read_record
+    from .summary import identification_table
+
+    rec = read_record(args.file)
+    ident = identify(prepare(rec, window=args.window, dispersion=args.dispersion), nu=args.nu)
+    if args.json:
+        out = ident.to_json()
+        out["test_id"], out["campaign"] = rec.test_id, rec.campaign
+        print(json.dumps(out))
+    else:
+        print(identification_table(rec, ident))
+    return 0
+
+
+def _design(args: argparse.Namespace) -> int:
+    _output_file(args.output, FIGURE_SUFFIXES, "figure")
+    from .record import read_record
+    from .report.design_figure import design_figure
+
+    rec = read_record(args.file)
+    path = design_figure(rec, args.output, nu=args.nu, striker_velocity=args.striker_velocity)
+    print(f"wrote {path}")
+    return 0
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    if args.output is None and args.compare is None:
+        raise OutputError("simulate: give -o RECORD.h5, --compare PAGES.pdf, or both")
+    if args.output is not None:
+        _output_file(args.output, RECORD_SUFFIXES, "record")
+    if args.compare is not None:
+        _output_file(args.compare, (".pdf",), "comparison")
+    _check_config(args.config)
+    from .simulate import load_config, simulate_to_file
+
+    cfg = load_config(args.config)
+    if args.output is not None:
+        print(f"wrote {simulate_to_file(cfg, args.output, seed=args.seed)}")
+    if args.compare is not None:
+        from .report.axisymmetric_pages import compare_to_pdf
+
+        print(compare_to_pdf(cfg, args.compare))
+    return 0
+
+
+def _compare(args: argparse.Namespace) -> int:
+    if args.output:
         _output_file(args.output, FIGURE_SUFFIXES, "figure")
-        from .record import read_record
-        from .report.design_figure import design_figure
+    _check_results(args.results)
+    from .campaigns import compare, comparison_table
 
-        rec = read_record(args.file)
-        path = design_figure(rec, args.output, nu=args.nu, striker_velocity=args.striker_velocity)
-        print(f"wrote {path}")
-        return 0
-    if args.command == "simulate":
-        if args.output is None and args.compare is None:
-            raise OutputError("simulate: give -o RECORD.h5, --compare PAGES.pdf, or both")
-        if args.output is not None:
-            _output_file(args.output, RECORD_SUFFIXES, "record")
-        if args.compare is not None:
-            _output_file(args.compare, (".pdf",), "comparison")
-        _check_config(args.config)
-        from .simulate import load_config, simulate_to_file
+    comp = compare(args.results)
+    print(comparison_table(comp))
+    if args.output:
+        from .report.campaign_figure import campaign_figure
 
-        cfg = load_config(args.config)
-        if args.output is not None:
-            print(f"wrote {simulate_to_file(cfg, args.output, seed=args.seed)}")
-        if args.compare is not None:
-            from .report.axisymmetric_pages import compare_to_pdf
+        print(f"wrote {campaign_figure(comp, args.output)}")
+    return 0
 
-            print(compare_to_pdf(cfg, args.compare))
-        return 0
-    if args.command == "compare":
-        if args.output:
-            _output_file(args.output, FIGURE_SUFFIXES, "figure")
-        _check_results(args.results)
-        from .campaigns import compare, comparison_table
 
-        comp = compare(args.results)
-        print(comparison_table(comp))
-        if args.output:
-            from .report.campaign_figure import campaign_figure
+def _run(args: argparse.Namespace) -> int:
+    """``run`` and ``diagnose``: a bad record or prior file is refused before the analysis' libraries load."""
+    from .record import read_record
 
-            print(f"wrote {campaign_figure(comp, args.output)}")
-        return 0
-    if args.command == "campaign":
-        return _campaign(args)
-    if args.command == "import":
-        return import_command.run(args, build_parser(), _output_file)
-    if args.command == "priors":
-        return priors_command.run(args)
-    if args.command in ("run", "diagnose"):
-        from .record import read_record
+    rec = read_record(args.file)
+    from .priors import default_prior_path, load_priors
 
-        rec = read_record(args.file)  # a bad record or prior file is refused before the analysis' libraries load
-        from .priors import default_prior_path, load_priors
+    load_priors(args.priors or default_prior_path(rec.apparatus.sample.material))
+    from .record_run import run_file
 
-        load_priors(args.priors or default_prior_path(rec.apparatus.sample.material))
-        from .record_run import run_file
+    run_file(
+        args.file, priors_path=args.priors, out_dir=args.out, seed=args.seed, window=args.window,
+        dispersion=args.dispersion, hoop=not args.no_hoop,
+        pdf=not args.no_pdf, progress=not args.quiet,
+        diagnose=args.command == "diagnose" or args.diagnose,
+    )
+    return 0
 
-        run_file(
-            args.file, priors_path=args.priors, out_dir=args.out, seed=args.seed, window=args.window,
-            dispersion=args.dispersion, hoop=not args.no_hoop,
-            pdf=not args.no_pdf, progress=not args.quiet,
-            diagnose=args.command == "diagnose" or args.diagnose,
-        )
-        return 0
-    raise AssertionError(args.command)  # argparse restricts the choices
+
+def _dispatch(args: argparse.Namespace) -> int:
+    """The subcommand's function (argparse restricts the choices)."""
+    commands = {"inspect": _inspect, "analyze": _analyze, "design": _design, "simulate": _simulate,
+                "compare": _compare, "campaign": _campaign, "run": _run, "diagnose": _run,
+                "import": lambda a: import_command.run(a, build_parser(), _output_file),
+                "priors": priors_command.run}
+    return commands[args.command](args)
 
 
 def _workers(text: str) -> int:

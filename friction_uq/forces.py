@@ -133,64 +133,13 @@ def compute_forces(record: Record, *, dispersion: bool = False) -> Forces:
         hollow external bar) when transporting; off by default.
     """
     app = record.apparatus
-    dt = record.sample_interval
-    n = record.n_samples
-    fs = record.sample_rate
-    span = int(app.pulse_duration * fs / 2)
+    span = int(app.pulse_duration * record.sample_rate / 2)
     info: dict[str, ChannelInfo] = {}
-
-    # --- input bar: incident then reflected on one gauge
-    ib = app.input_bar
-    x = record.strain("input_bar")
-    try:
-        noise_in, arr_inc = prepulse_noise(x, span=span, polarity=+1)
-    except SignalError as exc:
-        try:  # a compression front in the negated signal: the gauge (or its bridge) is wired the other way
-            prepulse_noise(-np.asarray(x, float), span=span, polarity=+1)
-        except SignalError:
-            raise SignalError(f"{record.path}: /signals/input_bar: {exc} (no incident wave found)") from None
-        raise SignalError(f"{record.path}: /signals/input_bar: the first pulse is a tension, where the incident wave "
-                          "is a compression: the gauge looks reversed (its wiring, its bridge or the sign convention, "
-                          "elongation positive)") from None
-    y = x - noise_in.offset
-    sep = arr_inc + 2.0 * ib.gauge_delay * fs  # reflected wave's front at the gauge
-    margin = 0.02 * app.pulse_duration * fs
-    echo = arr_inc + 2.0 * ib.length / ib.wave_speed * fs  # far-end echo of the reflected wave
-    inc = np.where(window_mask(n, 0, sep - margin), y, 0.0)
-    ref = np.where(window_mask(n, sep - margin, echo - margin), y, 0.0)
-    eps_i = _transported(inc, ib, +ib.gauge_distance, dt, dispersion)
-    eps_r = _transported(ref, ib, -ib.gauge_distance, dt, dispersion)
-    d_in = ib.gauge_delay * fs
-    valid_until_in = min(echo - d_in, sep + d_in) - margin  # far-end echo, end of the incident window
-    valid_in = window_mask(n, arr_inc + d_in - margin, valid_until_in)
-    eps_i = np.where(valid_in, eps_i, np.nan)
-    eps_r = np.where(valid_in, eps_r, np.nan)
-    info["incident"] = ChannelInfo("incident", noise_in, arr_inc + d_in, valid_until_in)
-    info["input_bar"] = ChannelInfo("input_bar", noise_in, arr_inc, echo - margin)
-
-    # --- output bars: transmitted waves, back by their gauge distance
-    out: dict[str, np.ndarray] = {}
-    for name in ("internal_output_bar", "external_output_bar"):
-        bar = app.bars[name]
-        x = record.strain(name)
-        d = bar.gauge_delay * fs
-        nz, arr, found = _noise_and_arrival(x, earliest=arr_inc + d_in + d, span=span, polarity=+1)
-        echo = arr + 2.0 * (bar.length - bar.gauge_distance) / bar.wave_speed * fs
-        y = np.where(window_mask(n, 0, echo - margin), x - nz.offset, 0.0)
-        eps = _transported(y, bar, -bar.gauge_distance, dt, dispersion)
-        valid_until = echo - d - margin
-        out[name] = np.where(window_mask(n, 0, valid_until), eps, np.nan)
-        info[name] = ChannelInfo(name, nz, arr - d, valid_until, found)
-
-    hoop = None
-    if record.has_hoop:
-        x = record.strain("tube_hoop")
-        # the tube swells: compression-positive hoop strain goes negative
-        nz, arr, found = _noise_and_arrival(x, earliest=arr_inc + d_in, span=span, polarity=-1)
-        hoop = x - nz.offset
-        info["tube_hoop"] = ChannelInfo("tube_hoop", nz, arr, float(n), found)
-
-    io, eo = app.internal_output_bar, app.external_output_bar
+    eps_i, eps_r, incident_at_cell = _input_bar_waves(record, span, dispersion, info)
+    out = {name: _transmitted_wave(record, name, span, incident_at_cell, dispersion, info)
+           for name in ("internal_output_bar", "external_output_bar")}
+    hoop = _hoop_strain(record, span, incident_at_cell, info) if record.has_hoop else None
+    ib, io, eo = app.input_bar, app.internal_output_bar, app.external_output_bar
     eps_io, eps_eo = out["internal_output_bar"], out["external_output_bar"]
     return Forces(
         time=record.time,
@@ -208,3 +157,72 @@ def compute_forces(record: Record, *, dispersion: bool = False) -> Forces:
         channels=info,
         dispersion=dispersion,
     )
+
+
+def _margin(record: Record) -> float:
+    """Samples kept clear of each window's end: 2 % of the pulse."""
+    return 0.02 * record.apparatus.pulse_duration * record.sample_rate
+
+
+def _incident_arrival(record: Record, x: np.ndarray, span: int) -> tuple[NoiseEstimate, float]:
+    """The input gauge's pre-pulse noise and the incident front's arrival; a reversed gauge (a tension first) or
+    no front at all is refused, naming the file and the channel."""
+    try:
+        return prepulse_noise(x, span=span, polarity=+1)
+    except SignalError as exc:
+        try:  # a compression front in the negated signal: the gauge (or its bridge) is wired the other way
+            prepulse_noise(-np.asarray(x, float), span=span, polarity=+1)
+        except SignalError:
+            raise SignalError(f"{record.path}: /signals/input_bar: {exc} (no incident wave found)") from None
+        raise SignalError(f"{record.path}: /signals/input_bar: the first pulse is a tension, where the incident wave "
+                          "is a compression: the gauge looks reversed (its wiring, its bridge or the sign convention, "
+                          "elongation positive)") from None
+
+
+def _input_bar_waves(record: Record, span: int, dispersion: bool,
+                     info: dict[str, ChannelInfo]) -> tuple[np.ndarray, np.ndarray, float]:
+    """The incident and reflected waves at the cell (NaN outside their validity), their channels' entries put in
+    ``info``, and the incident front's arrival at the cell (fractional samples)."""
+    ib, n, dt, fs = record.apparatus.input_bar, record.n_samples, record.sample_interval, record.sample_rate
+    x = record.strain("input_bar")
+    noise_in, arr_inc = _incident_arrival(record, x, span)
+    y = x - noise_in.offset
+    sep = arr_inc + 2.0 * ib.gauge_delay * fs  # reflected wave's front at the gauge
+    margin = _margin(record)
+    echo = arr_inc + 2.0 * ib.length / ib.wave_speed * fs  # far-end echo of the reflected wave
+    inc = np.where(window_mask(n, 0, sep - margin), y, 0.0)
+    ref = np.where(window_mask(n, sep - margin, echo - margin), y, 0.0)
+    eps_i = _transported(inc, ib, +ib.gauge_distance, dt, dispersion)
+    eps_r = _transported(ref, ib, -ib.gauge_distance, dt, dispersion)
+    d_in = ib.gauge_delay * fs
+    valid_until_in = min(echo - d_in, sep + d_in) - margin  # far-end echo, end of the incident window
+    valid_in = window_mask(n, arr_inc + d_in - margin, valid_until_in)
+    info["incident"] = ChannelInfo("incident", noise_in, arr_inc + d_in, valid_until_in)
+    info["input_bar"] = ChannelInfo("input_bar", noise_in, arr_inc, echo - margin)
+    return np.where(valid_in, eps_i, np.nan), np.where(valid_in, eps_r, np.nan), arr_inc + d_in
+
+
+def _transmitted_wave(record: Record, name: str, span: int, incident_at_cell: float, dispersion: bool,
+                      info: dict[str, ChannelInfo]) -> np.ndarray:
+    """Output bar ``name``'s transmitted wave back by its gauge distance (NaN once its far-end echo is in), its
+    channel's entry put in ``info``."""
+    bar, n, fs = record.apparatus.bars[name], record.n_samples, record.sample_rate
+    x = record.strain(name)
+    d = bar.gauge_delay * fs
+    margin = _margin(record)
+    nz, arr, found = _noise_and_arrival(x, earliest=incident_at_cell + d, span=span, polarity=+1)
+    echo = arr + 2.0 * (bar.length - bar.gauge_distance) / bar.wave_speed * fs
+    y = np.where(window_mask(n, 0, echo - margin), x - nz.offset, 0.0)
+    eps = _transported(y, bar, -bar.gauge_distance, record.sample_interval, dispersion)
+    valid_until = echo - d - margin
+    info[name] = ChannelInfo(name, nz, arr - d, valid_until, found)
+    return np.where(window_mask(n, 0, valid_until), eps, np.nan)
+
+
+def _hoop_strain(record: Record, span: int, incident_at_cell: float, info: dict[str, ChannelInfo]) -> np.ndarray:
+    """The tube's hoop strain, offset removed (the tube swells: compression-positive hoop strain goes negative),
+    its channel's entry put in ``info``."""
+    x = record.strain("tube_hoop")
+    nz, arr, found = _noise_and_arrival(x, earliest=incident_at_cell, span=span, polarity=-1)
+    info["tube_hoop"] = ChannelInfo("tube_hoop", nz, arr, float(record.n_samples), found)
+    return x - nz.offset

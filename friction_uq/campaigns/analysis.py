@@ -197,17 +197,7 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     pressure_named = any("log_pc" in LAW_PARAMS[law] for law in supported_laws(ca.weights, ca.ranking))
     first, freed = laws.flag(law_for_flags, offsets, cal, setups, tallies, every_law=two)
     if not freed and two:
-        # every law with and without the second set-up's offset, weighed together: the flag does not hang on which
-        # law the ELPD could not rule out (under a constant law barely not ruled out, whose scatter takes up an
-        # unmodelled trend, an offset of 20 % was not decisive), nor on a pressure term standing for the offset
-        alt = laws.offset_alternative(offsets[0], cal)
-        if alt["without_ruled_out"]:  # the offset, not a law's term, is what the tests need
-            ca.flagged.append(setup_entry(offsets[0], alt["offset"], alt["d_elpd"], alt["d_se"], setups, tallies,
-                                          quantity=data.basis) | {"weight_with_offset": alt["weight_with_offset"]})
-            freed = [offsets[0]]
-        ca.pressure_or_setup = alt
-        if freed or pressure_named:  # said where it flagged the set-up or a pressure term may stand for the offset
-            ca.pressure_or_setup |= {"sentence": offset_sentence(alt, bool(freed), pressure=pressure_named)}
+        freed = _offset_or_pressure(ca, laws, data, offsets[0], cal, setups, tallies, pressure_named=pressure_named)
     if freed:  # the laws again, the flagged set-ups' levels left out (a free offset each): never fitted by them
         done = laws.offset_models(freed[0], cal) if two else None  # with two set-ups: the offset models themselves
         elpds = laws.compare(cal, tuple(freed), {k: v[0] for k, v in done.items()} if done else None)
@@ -220,31 +210,61 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     ca.sentences += verdict(ca.weights, ca.ranking, data.labels)
     if "sentence" in ca.pressure_or_setup and not freed:  # the alternative the named law leaves open
         ca.sentences.append(str(ca.pressure_or_setup["sentence"]))
-    supported = supported_laws(ca.weights, ca.ranking)
-    if len(supported) == 1:
-        ca.best, ca.chosen = supported[0], ca.law_models[supported[0]]
-    else:
-        say("the expected information of one more test at each set-up and speed")
-        ca.next_tests = rank_next_tests({law: ca.fits[m] for law, m in ca.law_models.items()}, ca.weights, supported)
-        tip = advice(ca.next_tests, ca.weights, supported)
-        if tip:
-            ca.sentences.append(tip)
+    _best_or_next_test(ca, say)
     prior0 = load_priors(tests[0].prior_file)["nu"]
     pm, psd = float(prior0.ppf(0.5)), float(np.std(prior0.rvs(np.random.default_rng(seed), 20000)))
     if data.basis == "f" and offsets:
         ca.flagged += stationary_flags(tests, law_for_flags, offsets, setups, tallies, first,
                                        {str(f["setup"]) for f in ca.flagged}, seed=seed)
-    primary = [f for f in ca.flagged if f["basis"] == data.basis]
-    flagged_setups = {str(f["setup"]) for f in primary}
-    if len(setups) == 2 and flagged_setups:
-        flagged_setups = set(setups)
-    trusted = [t for t in tests if t.setup not in flagged_setups] or tests
-    if len(setups) == 2 and primary and "named_by_causes" in primary[0]:
-        trusted = [t for t in tests if t.setup != primary[0]["named_by_causes"]]
-    ca.nu = campaign_nu(trusted, pm, psd)
+    ca.nu = campaign_nu(_trusted(ca, tests, data.basis, setups), pm, psd)
     name = ca.chosen or ca.law_models[max(ca.weights, key=ca.weights.get)]
     ca.law_draws = f_law_draws(ca.fits[name], ca.nu, seed=seed)
     ca.law_posterior = {k: draw_summary(v) for k, v in ca.law_draws.items()}
     chosen_elpd = elpds[name]
     ca.flagged += outlier_tests(chosen_elpd, data.labels)
     return ca
+
+
+def _offset_or_pressure(ca: CampaignAnalysis, laws: LawComparison, data, offset: str, cal: tuple, setups: list,
+                        tallies: dict, *, pressure_named: bool) -> list[str]:
+    """With two set-ups: every law with and without the second set-up's offset, weighed together, so the flag does
+    not hang on which law the ELPD could not rule out (under a constant law barely not ruled out, whose scatter
+    takes up an unmodelled trend, an offset of 20 % was not decisive), nor on a pressure term standing for the
+    offset. The set-up flagged where the laws without the offset are ruled out (returned as freed, else [])."""
+    alt = laws.offset_alternative(offset, cal)
+    freed = []
+    if alt["without_ruled_out"]:  # the offset, not a law's term, is what the tests need
+        ca.flagged.append(setup_entry(offset, alt["offset"], alt["d_elpd"], alt["d_se"], setups, tallies,
+                                      quantity=data.basis) | {"weight_with_offset": alt["weight_with_offset"]})
+        freed = [offset]
+    ca.pressure_or_setup = alt
+    if freed or pressure_named:  # said where it flagged the set-up or a pressure term may stand for the offset
+        ca.pressure_or_setup |= {"sentence": offset_sentence(alt, bool(freed), pressure=pressure_named)}
+    return freed
+
+
+def _best_or_next_test(ca: CampaignAnalysis, say: Callable[[str], None]) -> None:
+    """One supported law: the campaign's law; several: the next test that would tell them apart best."""
+    supported = supported_laws(ca.weights, ca.ranking)
+    if len(supported) == 1:
+        ca.best, ca.chosen = supported[0], ca.law_models[supported[0]]
+        return
+    say("the expected information of one more test at each set-up and speed")
+    ca.next_tests = rank_next_tests({law: ca.fits[m] for law, m in ca.law_models.items()}, ca.weights, supported)
+    tip = advice(ca.next_tests, ca.weights, supported)
+    if tip:
+        ca.sentences.append(tip)
+
+
+def _trusted(ca: CampaignAnalysis, tests: list, basis: str, setups: list) -> list:
+    """The tests the campaign's nu is read from: those of set-ups not flagged (with two set-ups, a flag leaves
+    neither trusted, unless the causes named one), all tests where none is left."""
+    primary = [f for f in ca.flagged if f["basis"] == basis]
+    flagged_setups = {str(f["setup"]) for f in primary}
+    if len(setups) == 2 and flagged_setups:
+        flagged_setups = set(setups)
+    trusted = [t for t in tests if t.setup not in flagged_setups] or tests
+    if len(setups) == 2 and primary and "named_by_causes" in primary[0]:
+        trusted = [t for t in tests if t.setup != primary[0]["named_by_causes"]]
+    return trusted
+

@@ -99,24 +99,15 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
             r = np.full(n_data[0] if n_data else lik.n_samples, 1e3)
         return np.concatenate([r, (z - centre) / width])
 
-    res = None
-    for alt in ({}, *extra_starts):
-        za = np.array([float(p.to_unbounded(alt.get(p.name, start[p.name]))) for p in params])
-        r = optimize.least_squares(residuals, za, method="trf", x_scale=width, diff_step=1e-6, xtol=XTOL, ftol=FTOL,
-                                   max_nfev=60 * (len(z0) + 1))
-        if res is None or r.cost < res.cost:
-            res = r
+    starts = [np.array([float(p.to_unbounded(alt.get(p.name, start[p.name]))) for p in params])
+              for alt in ({}, *extra_starts)]
+    res = _best_mode(residuals, starts, width)
     zm = res.x
     # the precision from central differences over JACOBIAN_STEP: the explicit stick-slip integration makes
     # the prediction jump by a time step's worth where a slip starts one step earlier or later, and a
     # derivative over the optimiser's 1e-6 step can read such a jump as information
     J = central_jacobian(residuals, zm, JACOBIAN_STEP)
-    H = J.T @ J  # Gauss-Newton precision in z (data and the Gaussian stand-ins of the priors)
-    try:
-        cov = np.linalg.inv(H)
-        chol = sym_cholesky(cov)
-    except np.linalg.LinAlgError:
-        cov, chol = None, np.diag(np.full(len(zm), 1e-3))
+    cov, chol = _gauss_newton_covariance(J)
 
     def log_post(z: np.ndarray) -> float:
         vals = values_of(z)
@@ -127,7 +118,7 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
         return lik.loglike(vals) + lp + jac
 
     eps = rng.standard_normal((n_draws, len(zm)))
-    n_data = len(res.fun) - len(zm)
+    n_data = len(res.fun) - len(zm)  # the whitened residuals' count (the rest are the priors' stand-ins)
     laplace = None
     if score_blocks is not None and cov is not None:
         laplace = {p.name: np.asarray(p.from_unbounded(zm[i] + eps @ chol[i]), float) for i, p in enumerate(params)}
@@ -146,3 +137,26 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     return WholeRecordFit(names=names, mode=mode, draws=draws, log_weights=log_w, pareto_k=k,
                           loglike_mode=lik.loglike(mode), n_calls=calls + (n_draws if importance else 0),
                           cov_z=cov, jacobian=J[:n_data], whitened=res.fun[:n_data], laplace_draws=laplace)
+
+
+def _best_mode(residuals: Callable[[np.ndarray], np.ndarray], starts: list[np.ndarray],
+               width: np.ndarray) -> optimize.OptimizeResult:
+    """The least-squares mode from each start (trust-region reflective, scaled by the priors' widths); the lowest
+    cost kept."""
+    res = None
+    for za in starts:
+        r = optimize.least_squares(residuals, za, method="trf", x_scale=width, diff_step=1e-6, xtol=XTOL, ftol=FTOL,
+                                   max_nfev=60 * (len(za) + 1))
+        if res is None or r.cost < res.cost:
+            res = r
+    return res
+
+
+def _gauss_newton_covariance(J: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
+    """The covariance in z from the Gauss-Newton precision J^T J (data and the Gaussian stand-ins of the priors)
+    and its symmetric square root; (None, a 1e-3 diagonal) where the precision is singular."""
+    try:
+        cov = np.linalg.inv(J.T @ J)
+        return cov, sym_cholesky(cov)
+    except np.linalg.LinAlgError:
+        return None, np.diag(np.full(J.shape[1], 1e-3))

@@ -56,13 +56,49 @@ def _entry(r: Ranked, verdict=None) -> dict[str, object]:
             "draws": int(len(r.fit.f_effective)), "ess": _ess(r.fit.fit.log_weights)}
 
 
+#: The naming rule in words (the JSON's ``rule``).
+RULE_TEXT = ("a cause is named only of a misfit the whole-record check found, when its dELPD over the model without "
+             "it exceeds 4 and 2 SE with the 5 % of blocks that favour it most left out (spread over the record; "
+             "the whole record's sum is larger still), and rules out every other extended model (by the same "
+             "margin, over the whole record or with the 5 % of blocks most in its favour against that model left "
+             "out, or by the stacking weight: "
+             "more than 4 behind with the 5 % of blocks that favour the best left out, under 0.1 of the weight with "
+             "the models as far behind that predict alike); several it does not rule out are candidates, a misfit "
+             "none explains is unexplained, and f is then the stacking mixture of the models that carry the weight "
+             "(in equal parts with the stationary analysis' f when "
+             "nothing is named, with run); after a named cause the search goes on with it in the model; a candidate "
+             "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
+             "left open by the same rule, and the model without it, which the whole-record check must then flag "
+             "(where its round left no rival open, by the rule alone; swaps); else it is superfluous and not "
+             "named; a later round whose reference the whole-record check does not flag names an entry of the "
+             "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
+             f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
+             "the entry stays in the model within the check's tolerance (within_tolerance), not named")
+#: How the ELPD is computed, in words (the JSON's ``elpd``).
+ELPD_TEXT = ("exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "
+             "plus the calibration data (hoop gauge factor 1 +- 5 %, the header's sample modulus +- 10 %) each left "
+             "out in turn (calibration_elpd per model)")
+
+
 def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[str, float] | None = None
             ) -> dict[str, object]:
-    """The JSON ``discrepancy`` block: the posteriors' summaries (given the bars' header values) and the sentence,
-    which quotes ``f_without_quoted`` (the stationary f with the bars' calibration, as the JSON's ``f``; default
-    ``f_without``) where the stationary f stands."""
+    """The JSON ``discrepancy`` block: the verdict and its rounds (:func:`_verdict_json`), the posteriors' summaries
+    given the bars' header values (:func:`_posterior_json`), the rule, and the sentence, which quotes
+    ``f_without_quoted`` (the stationary f with the bars' calibration, as the JSON's ``f``; default ``f_without``)
+    where the stationary f stands."""
+    return _verdict_json(dg) | _posterior_json(dg, f_without) | {
+        "rule": RULE_TEXT,
+        "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
+                             for m in dg.misfits],
+        "elpd": ELPD_TEXT,
+        "seconds": dg.seconds,
+        "sentence": sentence(dg, f_without if f_without_quoted is None else f_without_quoted),
+    }
+
+
+def _verdict_json(dg: Diagnosis) -> dict[str, object]:
+    """What the rounds found: the verdict, the causes, the candidates and the rankings."""
     cause = dg.cause
-    hoop = dg.final.hoop_gain
     v = dg.verdict
     return {
         # the record's: named when a cause is (a round's candidates resolved by later rounds count); candidates
@@ -101,6 +137,13 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "ranking": [_entry(r, v) for r in dg.ranking],
         "rounds": [[_entry(r, dg.verdicts[k + 1] if k + 1 < len(dg.verdicts) else None) for r in rnd]
                    for k, rnd in enumerate(dg.rounds[1:])],
+    }
+
+
+def _posterior_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, object]:
+    """The final model's posterior and the baseline's beside it, the hoop gauge's factor, the residuals."""
+    hoop = dg.final.hoop_gain
+    return {
         "model": dg.final.label,
         "f_extended": dg.final.f_summary(),
         "posterior_method": dg.posterior_method,
@@ -123,30 +166,6 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
                                  "whole-record fit: its most probable value under a 5 % prior"},
         "residual_rms": {ch: {ph: {"before": b, "after": a} for ph, (b, a) in phases.items()}
                          for ch, phases in dg.rms.items()},
-        "rule": "a cause is named only of a misfit the whole-record check found, when its dELPD over the model without "
-                "it exceeds 4 and 2 SE with the 5 % of blocks that favour it most left out (spread over the record; "
-                "the whole record's sum is larger still), and rules out every other extended model (by the same "
-                "margin, over the whole record or with the 5 % of blocks most in its favour against that model left "
-                "out, or by the stacking weight: "
-                "more than 4 behind with the 5 % of blocks that favour the best left out, under 0.1 of the weight with "
-                "the models as far behind that predict alike); several it does not rule out are candidates, a misfit "
-                "none explains is unexplained, and f is then the stacking mixture of the models that carry the weight "
-                "(in equal parts with the stationary analysis' f when "
-                "nothing is named, with run); after a named cause the search goes on with it in the model; a candidate "
-                "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
-                "left open by the same rule, and the model without it, which the whole-record check must then flag "
-                "(where its round left no rival open, by the rule alone; swaps); else it is superfluous and not "
-                "named; a later round whose reference the whole-record check does not flag names an entry of the "
-                "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
-                f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
-                "the entry stays in the model within the check's tolerance (within_tolerance), not named",
-        "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
-                             for m in dg.misfits],
-        "elpd": "exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "
-                "plus the calibration data (hoop gauge factor 1 +- 5 %, the header's sample modulus +- 10 %) each left "
-                "out in turn (calibration_elpd per model)",
-        "seconds": dg.seconds,
-        "sentence": sentence(dg, f_without if f_without_quoted is None else f_without_quoted),
     }
 
 

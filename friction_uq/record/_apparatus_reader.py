@@ -28,6 +28,17 @@ _SIGNED = {"gauge_offset"}
 
 def read_apparatus(app: Any, r: Reader) -> Apparatus:
     """The checked apparatus of the open ``/apparatus`` group ``app``; ``r`` names the file in errors."""
+    parts = _read_parts(app, r)
+    plug = None
+    g = r.member(app, "plug", "/apparatus/plug")
+    if g is not None:
+        plug = Plug(**{n: r.positive(g, "/apparatus/plug", n) for n in _PLUG_ATTRS})
+    _cross_check(parts, r)
+    return _apparatus(parts, plug)
+
+
+def _read_parts(app: Any, r: Reader) -> dict[str, dict[str, Any]]:
+    """Each required part's attributes, each checked alone (a bar's Poisson ratio defaults when absent)."""
     import h5py
 
     parts: dict[str, dict[str, Any]] = {}
@@ -53,12 +64,11 @@ def read_apparatus(app: Any, r: Reader) -> Apparatus:
             vals["poisson_ratio"] = DEFAULT_BAR_POISSON_RATIO if nu is None else nu
         parts[part] = vals
 
-    plug = None
-    g = r.member(app, "plug", "/apparatus/plug")
-    if g is not None:
-        plug = Plug(**{n: r.positive(g, "/apparatus/plug", n) for n in _PLUG_ATTRS})
+    return parts
 
-    # cross-checks
+
+def _cross_check(parts: dict[str, dict[str, Any]], r: Reader) -> None:
+    """The checks between parts' attributes: gauges on their bars, diameters that fit, the sample in the tube."""
     for part in ("input_bar", "internal_output_bar", "external_output_bar"):
         v = parts[part]
         if v["gauge_distance"] >= v["length"]:
@@ -109,6 +119,10 @@ def read_apparatus(app: Any, r: Reader) -> Apparatus:
             f"is {tube['gauge_offset']!r} m, outside the tube (half length {tube['length'] / 2!r} m)",
         )
 
+
+
+def _apparatus(parts: dict[str, dict[str, Any]], plug: Plug | None) -> Apparatus:
+    """The apparatus of checked parts."""
     def bar(name: str) -> Bar:
         v = parts[name]
         return Bar(
@@ -127,7 +141,7 @@ def read_apparatus(app: Any, r: Reader) -> Apparatus:
         input_bar=bar("input_bar"),
         internal_output_bar=bar("internal_output_bar"),
         external_output_bar=bar("external_output_bar"),
-        tube=Tube(**tube),
-        sample=Sample(**sample),
+        tube=Tube(**parts["tube"]),
+        sample=Sample(**parts["sample"]),
         plug=plug,
     )

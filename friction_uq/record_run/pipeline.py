@@ -90,14 +90,7 @@ def run_file(
     t_start = time.perf_counter()
     seed = check_seed(seed)
     stages: dict[str, float] = {}
-    said: list[str] = []
-    say = (lambda msg: print(f"friction-uq: {msg}", file=sys.stderr, flush=True)) if progress else (lambda msg: None)
-
-    def note(msg: str) -> None:
-        said.append(msg)
-        if notes:
-            print(f"friction-uq: note: {msg}", file=sys.stderr, flush=True)
-
+    voice = _Voice(progress=progress, notes=notes)
     out = Path(out_dir)
     s = set_up(path, priors_path, out, window=window, dispersion=dispersion, hoop=hoop)
     stages["signals"] = time.perf_counter() - t_start
@@ -111,55 +104,95 @@ def run_file(
           Background(alongside if check else None, s.prepared, s.priors, whole_record_start(s.lab, s.priors),
                      hoop=s.use_hoop, seed=seed, check=check, pages=pdf) as side_job,
           output_lock(out, s.stem)):
-        backend = out / f".{s.stem}.checkpoint.npz"
-        remove_orphans(out, [p.name for p in s.names.values()] + [backend.name])
-        old_backend = out / f".{s.stem}.chains.h5"  # an earlier version's emcee backend
-        if old_backend.exists():
-            old_backend.unlink()
-        say(f"{s.record.campaign} {s.record.test_id}: window {s.prepared.window.t0 * 1e6:.1f}-"
-            f"{s.prepared.window.t1 * 1e6:.1f} us, hoop term {'on' if s.use_hoop else 'off'}, priors {s.prior_path}")
-        if s.hoop_left_out:
-            note(f"the hoop gauge is left out of the likelihood: {s.hoop_left_out}")
-        if check:
-            say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if side_job.forked
-                                                                         else "(after the sampling)"))
-        post = stationary_posterior(s, seed=seed, backend=backend, progress=progress, say=say, note=note,
-                                    stages=stages)
+        backend = _fresh_backend(out, s)
+        _announce(s, voice, check=check, alongside=side_job.forked)
+        post = stationary_posterior(s, seed=seed, backend=backend, progress=progress, say=voice.say,
+                                    note=voice.note, stages=stages)
         t = time.perf_counter()
         inputs, posterior_part = _posterior_pages(s, post) if pdf else (None, None)  # while the other core finishes
         stages["pdf"] = time.perf_counter() - t
         t = time.perf_counter()  # whole_record: what is left of the check when this process gets to it, and diagnose
         wrc, record_part = side_job.result() if check else (None, None)
-        diag = _record_check(s, post, wrc, diagnose=diagnose, seed=seed, say=say) if wrc is not None else None
+        diag = _record_check(s, post, wrc, diagnose=diagnose, seed=seed, say=voice.say) if wrc is not None else None
         stages["whole_record"] = time.perf_counter() - t
         warns = _warnings(s, post, wrc, diag)
         _complete_datatree(post, s, seed)  # the DataTree is complete: nothing below changes it
-        # the netCDF on the other core (its writer loads dask and xarray's backends, ~0.6 s) while this one
-        # draws the report's last pages; in line where this process may not fork
-        with Background(netcdf_bytes, post.datatree) as nc_job:
-            t = time.perf_counter()
-            pdf_bytes = None
-            if inputs is not None:
-                from ..report.pdf import render_report
-
-                inputs = dataclasses.replace(inputs, whole_record=wrc, diagnosis=diag, warnings=tuple(warns))
-                pdf_bytes = render_report(inputs, record_part=record_part, posterior_part=posterior_part)
-            stages["pdf"] += time.perf_counter() - t
-            t = time.perf_counter()
-            nc_bytes = nc_job.result()
-        seconds = time.perf_counter() - t_start
-        doc = run_document(s, post, seed=seed, seconds=seconds, warns=warns, notes=said, wrc=wrc, diag=diag,
-                           dispersion=dispersion, nc_bytes=nc_bytes, pdf_bytes=pdf_bytes)
-        js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
-        write_together({s.names["netcdf"]: nc_bytes, s.names["pdf"]: pdf_bytes, s.names["json"]: js_bytes},
-                       last=s.names["json"])
+        if inputs is not None:
+            inputs = dataclasses.replace(inputs, whole_record=wrc, diagnosis=diag, warnings=tuple(warns))
+        doc, pdf_bytes, seconds = _write_outputs(s, post, inputs, (record_part, posterior_part), wrc=wrc, diag=diag,
+                                                 warns=warns, notes=voice.said, seed=seed, dispersion=dispersion,
+                                                 stages=stages, t_start=t_start)
         backend.unlink(missing_ok=True)
-        stages["outputs"] = time.perf_counter() - t  # the netCDF's wait, the JSON and the writes
     outputs = {k: p for k, p in s.names.items() if k != "pdf" or pdf_bytes is not None}
     if table:
         _print_summary(s, post, wrc, diag, doc, warns, outputs, seconds, page=pdf_bytes is not None)
     return RunResult(s.prepared, post.samples, post.summary, post.convergence, s.lab, outputs, seconds, post.conflict,
-                     tuple(said), stages, post.sensitivity, wrc, diag, tuple(warns))
+                     tuple(voice.said), stages, post.sensitivity, wrc, diag, tuple(warns))
+
+
+class _Voice:
+    """What a run says on stderr: progress lines (``progress``) and one-line notices (``notes``); the notices
+    are kept (``said``) for the JSON and ``RunResult.notes`` whether printed or not."""
+
+    def __init__(self, *, progress: bool, notes: bool) -> None:
+        self.progress, self.notes, self.said = progress, notes, []
+
+    def say(self, msg: str) -> None:
+        if self.progress:
+            print(f"friction-uq: {msg}", file=sys.stderr, flush=True)
+
+    def note(self, msg: str) -> None:
+        self.said.append(msg)
+        if self.notes:
+            print(f"friction-uq: note: {msg}", file=sys.stderr, flush=True)
+
+
+def _fresh_backend(out: Path, s: RunSetup) -> Path:
+    """The checkpoint's path, after the temporary files an interrupted run left and an earlier version's emcee
+    backend are removed (the lock is held)."""
+    backend = out / f".{s.stem}.checkpoint.npz"
+    remove_orphans(out, [p.name for p in s.names.values()] + [backend.name])
+    (out / f".{s.stem}.chains.h5").unlink(missing_ok=True)  # an earlier version's emcee backend
+    return backend
+
+
+def _announce(s: RunSetup, voice: _Voice, *, check: bool, alongside: bool) -> None:
+    """The run's first lines: the record, its window, the hoop term and the priors; what is left out; where the
+    whole-record check runs."""
+    voice.say(f"{s.record.campaign} {s.record.test_id}: window {s.prepared.window.t0 * 1e6:.1f}-"
+              f"{s.prepared.window.t1 * 1e6:.1f} us, hoop term {'on' if s.use_hoop else 'off'}, priors {s.prior_path}")
+    if s.hoop_left_out:
+        voice.note(f"the hoop gauge is left out of the likelihood: {s.hoop_left_out}")
+    if check:
+        voice.say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if alongside
+                                                                           else "(after the sampling)"))
+
+
+def _write_outputs(s: RunSetup, post: StationaryPosterior, inputs: object | None, parts: tuple, *,
+                   wrc: WholeRecordCheck | None, diag: object | None, warns: list[str], notes: list[str], seed: int,
+                   dispersion: bool, stages: dict[str, float], t_start: float) -> tuple[dict, bytes | None, float]:
+    """The netCDF (on the other core, its writer loads dask and xarray's backends, ~0.6 s; in line where this
+    process may not fork) while this one draws the report's last pages (``inputs`` None: no PDF); then the JSON,
+    and the three written together, the JSON last. (The JSON, the PDF's bytes or None, the run's seconds.)"""
+    with Background(netcdf_bytes, post.datatree) as nc_job:
+        t = time.perf_counter()
+        pdf_bytes = None
+        if inputs is not None:
+            from ..report.pdf import render_report
+
+            record_part, posterior_part = parts
+            pdf_bytes = render_report(inputs, record_part=record_part, posterior_part=posterior_part)
+        stages["pdf"] += time.perf_counter() - t
+        t = time.perf_counter()
+        nc_bytes = nc_job.result()
+    seconds = time.perf_counter() - t_start
+    doc = run_document(s, post, seed=seed, seconds=seconds, warns=warns, notes=notes, wrc=wrc, diag=diag,
+                       dispersion=dispersion, nc_bytes=nc_bytes, pdf_bytes=pdf_bytes)
+    js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
+    write_together({s.names["netcdf"]: nc_bytes, s.names["pdf"]: pdf_bytes, s.names["json"]: js_bytes},
+                   last=s.names["json"])
+    stages["outputs"] = time.perf_counter() - t  # the netCDF's wait, the JSON and the writes
+    return doc, pdf_bytes, seconds
 
 
 def _posterior_pages(s: RunSetup, post: StationaryPosterior) -> tuple[object, bytes]:

@@ -97,9 +97,28 @@ def page_summary(r: ReportInputs) -> Figure:
     rec = r.prepared.record
     fig, ax = figure(f"friction-uq report: {rec.campaign} {rec.test_id} (sample {rec.apparatus.sample.material})")
     ax.axis("off")
+    # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
+    # together where they would run into the table below them
+    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings), hoop=r.samples.hoop), 100))
+    ax.text(0.0, 1.0, first, fontsize=13, va="top", transform=ax.transAxes, weight="bold",
+            color="firebrick" if r.warnings else "black")
+    _draw_lines(fig, ax, _summary_lines(r), below=first.count("\n") + 1)
+    # one monospace text block: a matplotlib table draws every cell as its own text and frame
+    ax.text(0.0, 0.05, _summary_table(r), fontsize=10, family="monospace", va="bottom", transform=ax.transAxes,
+            bbox={"facecolor": "white", "edgecolor": "0.6", "pad": 6})
+    prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
+            f"seed {r.samples.seed}, friction-uq {r.version}")
+    ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
+    ax.text(0.875, SUMMARY_TABLE_TOP - 0.02, _contents(r), fontsize=8, va="top", transform=ax.transAxes,
+            family="monospace")
+    return fig
+
+
+def _summary_lines(r: ReportInputs) -> list[str]:
+    """The summary page's sentences under the headline: warnings first, then the stationary analysis, nu and
+    kappa, the window, the lab's estimate, convergence, the checks and the diagnosis."""
     s = r.summary
     f, nu = s["f"], s["nu"]
-    share = r.nu_share
     named = None if r.diagnosis is None else outcome_headline(r.diagnosis)  # the JSON's f (the f to quote)
     stationary = "The stationary analysis: "
     if named is not None and r.diagnosis.named_causes:
@@ -114,7 +133,7 @@ def page_summary(r: ReportInputs) -> Figure:
         "the first line includes).",
         f"Poisson ratio nu = {nu.q50:.3f} [{nu.q05:.3f}, {nu.q95:.3f}]; the forces fix only "
         f"kappa = f nu/(1-nu) = {s['kappa'].q50:.4f} [{s['kappa'].q05:.4f}, {s['kappa'].q95:.4f}] (eq. 17).",
-        f"{100 * share:.0f} % of the variance of f comes from the uncertainty of nu (law of total variance).",
+        f"{100 * r.nu_share:.0f} % of the variance of f comes from the uncertainty of nu (law of total variance).",
         f"Stationary phase {r.prepared.window.t0 * 1e6:.1f} - {r.prepared.window.t1 * 1e6:.1f} us "
         f"({'automatic' if r.prepared.window.automatic else 'given by hand'}); sliding velocity "
         f"V = {r.V.q50:.2f} m/s, mean wall pressure p_mean = {s['p_mean'].q50 / 1e6:.1f} MPa." + _halves_text(r),
@@ -134,14 +153,15 @@ def page_summary(r: ReportInputs) -> Figure:
         from ..discrepancy.diagnosis_words import sentence
 
         lines.append(f"Diagnosis (page {whole_record_page(r) + 2}): " + sentence(r.diagnosis, stationary_quoted(r)))
-    # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
-    # together where they would run into the table below them
-    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings), hoop=r.samples.hoop), 100))
-    ax.text(0.0, 1.0, first, fontsize=13, va="top", transform=ax.transAxes, weight="bold",
-            color="firebrick" if r.warnings else "black")
+    return lines
+
+
+def _draw_lines(fig: Figure, ax, lines: list[str], *, below: int) -> None:
+    """The sentences under a headline of ``below`` 13 pt lines, shrunk together to end above the table; warnings
+    in red."""
     point = 1.0 / (ax.get_position().height * fig.get_figheight() * 72.0)  # one point, in axes fraction
     line = 10.0 * LINE_SPACING * point  # a 10 pt line
-    top = 1.0 - 13.0 * LINE_SPACING * point * (first.count("\n") + 1) - line
+    top = 1.0 - 13.0 * LINE_SPACING * point * below - line
     texts, k = _shrink_to_fit(lines, top - SUMMARY_TABLE_TOP, line)
     y = top
     for line_, text in zip(lines, texts):
@@ -152,29 +172,29 @@ def page_summary(r: ReportInputs) -> Figure:
             ax.text(0.0, y - k * (10.0 * point + j * line), row, fontsize=10 * k, va="baseline",
                     transform=ax.transAxes, color=color)
         y -= k * line * (text.count("\n") + 1.5)
+
+
+def _summary_table(r: ReportInputs) -> str:
+    """The posterior summary of every variable, one monospace row each."""
     rows = []
-    for name, v in list(s.items()) + [("V", r.V)]:
+    for name, v in list(r.summary.items()) + [("V", r.V)]:
         unit, scale = UNITS.get(name, ("", 1.0))
         rows.append([name, unit, _fmt(v.mean * scale), _fmt(v.sd * scale), _fmt(v.q05 * scale), _fmt(v.q50 * scale),
                      _fmt(v.q95 * scale), f"{v.r_hat:.4f}" if np.isfinite(v.r_hat) else "-",
                      f"{v.ess_bulk:.0f}" if np.isfinite(v.ess_bulk) else "-"])
     head = ["quantity", "unit", "mean", "sd", "q05", "q50", "q95", "R-hat", "ESS"]
-    table = "\n".join(f"{c[0]:<10}{c[1]:<5}" + "".join(f"{x:>11}" for x in c[2:]) for c in [head] + rows)
-    # one monospace text block: a matplotlib table draws every cell as its own text and frame
-    ax.text(0.0, 0.05, table, fontsize=10, family="monospace", va="bottom", transform=ax.transAxes,
-            bbox={"facecolor": "white", "edgecolor": "0.6", "pad": 6})
-    prov = (f"record {rec.path} (sha256 {rec.sha256[:12]}), priors {r.samples.prior_path}, "
-            f"seed {r.samples.seed}, friction-uq {r.version}")
-    ax.text(0.0, 0.0, prov, fontsize=8, transform=ax.transAxes)
-    ax.text(0.875, SUMMARY_TABLE_TOP - 0.02, "Pages\n 2 raw gauges\n 3 waves, forces, equilibrium\n 4 window and noise\n"
+    return "\n".join(f"{c[0]:<10}{c[1]:<5}" + "".join(f"{x:>11}" for x in c[2:]) for c in [head] + rows)
+
+
+def _contents(r: ReportInputs) -> str:
+    """The report's pages, as they are in this one."""
+    return ("Pages\n 2 raw gauges\n 3 waves, forces, equilibrium\n 4 window and noise\n"
             " 5 posterior vs prior\n 6 nu -> f\n 7 convergence\n 8 predictive check"
             + ("\n 9 hoop gauge vs model" if r.samples.hoop else "")
             + (f"\n{_span(whole_record_page(r), page_count(r.whole_record))} whole test vs gauges"
                if r.whole_record is not None else "")
             + (f"\n{whole_record_page(r) + 2:2d} mechanisms ranked\n{whole_record_page(r) + 3:2d} extended fit"
-               if r.diagnosis is not None else ""),
-            fontsize=8, va="top", transform=ax.transAxes, family="monospace")
-    return fig
+               if r.diagnosis is not None else ""))
 
 
 def _render(builders: list[Callable[[], Figure]]) -> bytes:
