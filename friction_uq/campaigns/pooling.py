@@ -115,7 +115,12 @@ def _quantiles(values: np.ndarray, weights: np.ndarray) -> dict[str, float]:
 def pool(tests: Sequence[StoredDraws], variable: str, *, n_mu: int = 81, n_sigma: int = 60,
          basis: str = "stationary") -> Pooled:
     """Hyper-posterior of (mu, sigma) on a grid; refused (with the reason) where the estimate is too noisy.
-    ``basis`` says whose draws these are (:attr:`Pooled.basis`)."""
+    ``basis`` says whose draws these are (:attr:`Pooled.basis`).
+
+    The grid of mu first spans the tests' medians +- 2 of their largest sd; where mu's marginal posterior
+    still has mass at its ends (a wide scatter among few tests: mu's posterior sd runs to sigma / sqrt(N)),
+    it is widened (:func:`mu_grid`) until it holds the posterior to :data:`MU_EDGE_MASS`, or the pooling is
+    refused."""
     labels = [t.label for t in tests]
     if len(tests) < 2:
         return Pooled(variable, labels, refused=f"pooling {variable} needs at least 2 analysed tests, "
@@ -123,22 +128,13 @@ def pool(tests: Sequence[StoredDraws], variable: str, *, n_mu: int = 81, n_sigma
     med = np.array([np.median(t.draws) for t in tests])
     sds = np.array([np.std(t.draws) for t in tests])
     span = float(np.ptp(med) + 4 * np.max(sds))
-    mu = np.linspace(med.min() - 2 * sds.max(), med.max() + 2 * sds.max(), n_mu)
     sigma = np.linspace(span / n_sigma, span, n_sigma)
-    log_l = np.zeros((n_sigma, n_mu))
-    var = np.zeros((n_sigma, n_mu))
-    for t in tests:
-        n = t.draws.size
-        for a in range(0, n_sigma, 10):  # chunks keep the (sigma, mu, draw) array near 10 MB
-            sg = sigma[a:a + 10, None, None]
-            log_w = (-0.5 * ((t.draws[None, None, :] - mu[None, :, None]) / sg) ** 2 - np.log(sg)
-                     - 0.5 * np.log(2 * np.pi) - t.log_prior[None, None, :])
-            top = log_w.max(axis=2)
-            w = np.exp(log_w - top[..., None])
-            s1, s2 = w.sum(axis=2), np.einsum("ijk,ijk->ij", w, w)
-            log_l[a:a + 10] += top + np.log(s1) - np.log(n)
-            # Var of log(mean w) ~ Var(w) / (n mean(w)^2) = (n sum w^2 / (sum w)^2 - 1) / n
-            var[a:a + 10] += (n * s2 / s1**2 - 1.0) / n
+    for widen in range(MU_WIDENINGS + 1):
+        mu = mu_grid(med, sds, n_mu, widen)
+        log_l, var = _hyper_log_likelihood(tests, mu, sigma)
+        edge = mu_edge_mass(np.exp(log_l - logsumexp(log_l)).sum(axis=0))
+        if edge <= MU_EDGE_MASS:
+            break
     log_post = log_l - logsumexp(log_l)
     p = np.exp(log_post)
     mc_var = float(np.sum(p * var))
@@ -157,7 +153,58 @@ def pool(tests: Sequence[StoredDraws], variable: str, *, n_mu: int = 81, n_sigma
                    f"(> {MAX_MC_VARIANCE:g}); too few draws carry weight (smallest effective sample size "
                    f"{ess[worst]:.0f}, test {worst}): the population is narrower than the per-test posteriors, "
                    "store more draws or pool a quantity the tests measure less precisely")
+    elif edge > MU_EDGE_MASS:
+        refused = (f"pooling {variable} refused: the population mean's posterior runs to the edge of its grid "
+                   f"([{mu[0]:.3g}, {mu[-1]:.3g}], {2 ** MU_WIDENINGS} times the tests' spread); the tests scatter "
+                   "too widely for their number to place it")
     elif sigma_q["q95"] > 0.95 * sigma[-1]:
         refused = (f"pooling {variable} refused: the between-test scatter runs to the edge of its grid "
                    f"({sigma[-1]:.3g}); the tests disagree too much for one normal population")
     return Pooled(variable, labels, mu_q, sigma_q, ess, mc_var, refused, mu, sigma, log_post, basis)
+
+#: Largest posterior mass of mu allowed in the outer 2.5 % of its grid at either end: a numerical tolerance of
+#: the quadrature, not a statistical threshold. On 400 random campaigns (2-8 tests of normal posteriors, sd
+#: 0.002-0.03, scatter 0-0.06, the closed-form hyper-likelihood on a wide grid) a grid within it left at most
+#: 7e-4 of mu's posterior outside (9e-3 at 1e-3); the first grid was within it on 51 of the 400.
+MU_EDGE_MASS = 1e-4
+#: Times the grid of mu is doubled in width before the pooling is refused.
+MU_WIDENINGS = 3
+
+
+def mu_grid(med: np.ndarray, sds: np.ndarray, n_mu: int, widen: int) -> np.ndarray:
+    """The grid of mu: the medians' range +- 2 of the largest sd (``widen`` 0), its width doubled ``widen``
+    times about the same centre with the spacing kept, (n_mu - 1) 2^widen + 1 points."""
+    lo, hi = med.min() - 2 * sds.max(), med.max() + 2 * sds.max()
+    if widen == 0:
+        return np.linspace(lo, hi, n_mu)
+    extra = (2 ** widen - 1) * (hi - lo) / 2
+    return np.linspace(lo - extra, hi + extra, (n_mu - 1) * 2 ** widen + 1)
+
+
+def mu_edge_mass(p_mu: np.ndarray) -> float:
+    """The larger of the masses of mu's marginal posterior (on its grid) in the outer 2.5 % of the grid at
+    either end."""
+    k = max(1, len(p_mu) // 40)
+    return float(max(p_mu[:k].sum(), p_mu[-k:].sum()) / p_mu.sum())
+
+
+def _hyper_log_likelihood(tests: Sequence[StoredDraws], mu: np.ndarray,
+                          sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """log L(mu, sigma) on the grid (module docstring) and the Monte Carlo variance of its estimate."""
+    n_sigma, n_mu = len(sigma), len(mu)
+    rows = max(1, 810 // n_mu)  # chunks keep the (sigma, mu, draw) array near 10 MB
+    log_l = np.zeros((n_sigma, n_mu))
+    var = np.zeros((n_sigma, n_mu))
+    for t in tests:
+        n = t.draws.size
+        for a in range(0, n_sigma, rows):
+            sg = sigma[a:a + rows, None, None]
+            log_w = (-0.5 * ((t.draws[None, None, :] - mu[None, :, None]) / sg) ** 2 - np.log(sg)
+                     - 0.5 * np.log(2 * np.pi) - t.log_prior[None, None, :])
+            top = log_w.max(axis=2)
+            w = np.exp(log_w - top[..., None])
+            s1, s2 = w.sum(axis=2), np.einsum("ijk,ijk->ij", w, w)
+            log_l[a:a + rows] += top + np.log(s1) - np.log(n)
+            # Var of log(mean w) ~ Var(w) / (n mean(w)^2) = (n sum w^2 / (sum w)^2 - 1) / n
+            var[a:a + rows] += (n * s2 / s1**2 - 1.0) / n
+    return log_l, var
