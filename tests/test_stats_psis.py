@@ -42,3 +42,20 @@ def test_equal_and_non_finite_ratios():
     res = psis(np.array([[0.0, 0.0, 0.0, 0.0], [1.0, -np.inf, 1.0, 1.0]]))
     np.testing.assert_allclose(np.exp(res.log_weights[0]), 0.25)
     assert np.exp(res.log_weights[1, 1]) == 0.0 and np.exp(res.log_weights[1]).sum() == pytest.approx(1.0)
+
+
+def test_a_tail_tied_at_its_smallest_value_is_unreliable_not_nan():
+    """A density flat for 94 % of the draws (a parameter that acts in a few only): the tail's Pareto fit fails
+    without an error (arviz_stats' k is nan). Its k is inf, which a ``k > threshold`` test and a maximum both see,
+    and its weights are the raw ones."""
+    from friction_uq.stats.elpd import psis_loo
+
+    rng = np.random.default_rng(0)
+    ll = np.zeros((1000, 1))
+    ll[:60, 0] = -rng.exponential(3.0, 60)
+    res = psis(-ll.T)
+    assert res.pareto_k[0] == math.inf
+    raw = -ll[:, 0] - np.logaddexp.reduce(-ll[:, 0])
+    np.testing.assert_allclose(res.log_weights[0], raw, atol=1e-12)
+    loo = psis_loo(ll, np.zeros(1000))
+    assert loo.pareto_k_max == math.inf and bool(loo.pareto_k[0] > 0.7)

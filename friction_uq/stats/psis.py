@@ -35,7 +35,9 @@ def psis(log_ratios: np.ndarray) -> PSIS:
     """Smoothed, normalised log weights and Pareto k of log importance ratios (the last axis: draws).
 
     Non-finite ratios get weight 0. A set whose ratios are all equal needs no smoothing (k = -inf);
-    a set whose tail cannot be fitted (too few distinct values) keeps its raw weights with k = inf.
+    a set whose tail cannot be fitted (too few distinct values, or a quarter or more of it tied at its smallest
+    value, where arviz_stats returns k = nan) keeps its raw weights with k = inf, which every check reads as
+    unreliable (a nan would pass a ``k > threshold`` test and vanish from a ``nanmax``).
     """
     from arviz_stats.base import array_stats
 
@@ -57,6 +59,8 @@ def psis(log_ratios: np.ndarray) -> PSIS:
             lw, k[i] = np.asarray(lw, float), float(np.asarray(ki).ravel()[0])
         except ValueError:  # a tail of identical values: no Pareto fit
             lw, k[i] = x, math.inf
+        if math.isnan(k[i]):  # a tail mostly tied at its smallest value: arviz_stats returns k = nan, raw weights
+            k[i] = math.inf
         out[i, ok] = lw - np.logaddexp.reduce(lw)
     return PSIS(out.reshape(lr.shape), k.reshape(lr.shape[:-1]))
 
