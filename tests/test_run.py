@@ -34,7 +34,8 @@ def test_run_writes_the_three_outputs(paper_run):
 
 def test_json_has_the_contract_keys(paper_run):
     _, out, rec = paper_run
-    doc = json.loads((out / "paper_P-01.json").read_text())
+    # strict JSON (RFC 8259): no NaN or Infinity, which JavaScript's JSON.parse and most parsers refuse
+    doc = json.loads((out / "paper_P-01.json").read_text(), parse_constant=lambda name: pytest.fail(name))
     for k in JSON_KEYS:
         assert set(STATS) <= set(doc[k]), k
         assert doc[k]["q05"] <= doc[k]["q50"] <= doc[k]["q95"]

@@ -41,6 +41,7 @@ from typing import Any
 
 from .. import __version__
 from .._atomic import atomic_path
+from .._json_text import json_text
 from ..errors import FrictionUQError, LockedError
 from ..window_halves import WindowHalves
 
@@ -154,7 +155,7 @@ def result_path(out_dir: str | os.PathLike[str], stem: str) -> Path:
 
 def write_result(result: RecordResult, path: str | os.PathLike[str]) -> Path:
     with atomic_path(path) as tmp:
-        Path(tmp).write_text(json.dumps(result.to_json(), indent=2) + "\n")
+        Path(tmp).write_text(json_text(result.to_json()))
     return Path(path)
 
 

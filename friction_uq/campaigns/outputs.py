@@ -33,7 +33,6 @@ the law's, or, for a diagnosed campaign, also ``kappa`` of the stationary analys
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -43,6 +42,7 @@ import numpy as np
 
 from .. import __version__
 from .._atomic import atomic_path, write_bytes
+from .._json_text import json_text
 from .analysis import CampaignAnalysis, f_law_draws, supported_laws
 from .job import RecordResult
 
@@ -168,7 +168,7 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
 
 def write_json(doc: dict[str, Any], path: Path) -> Path:
     with atomic_path(path) as tmp:
-        Path(tmp).write_text(json.dumps(doc, indent=2, default=float) + "\n")
+        Path(tmp).write_text(json_text(doc))
     return path
 
 

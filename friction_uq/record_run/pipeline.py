@@ -13,7 +13,6 @@ The checkpoint is removed once the outputs are written.
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 import sys
 import time
@@ -23,6 +22,7 @@ from pathlib import Path
 
 from .. import __version__
 from .._atomic import output_folder, output_lock, remove_orphans, write_together
+from .._json_text import json_text
 from .._parallel import Background
 from ..analysis import Identification, Prepared
 from ..diagnostics import Convergence, VariableSummary
@@ -188,7 +188,7 @@ def _write_outputs(s: RunSetup, post: StationaryPosterior, inputs: object | None
     seconds = time.perf_counter() - t_start
     doc = run_document(s, post, seed=seed, seconds=seconds, warns=warns, notes=notes, wrc=wrc, diag=diag,
                        dispersion=dispersion, nc_bytes=nc_bytes, pdf_bytes=pdf_bytes)
-    js_bytes = (json.dumps(doc, indent=2) + "\n").encode()
+    js_bytes = json_text(doc).encode()
     write_together({s.names["netcdf"]: nc_bytes, s.names["pdf"]: pdf_bytes, s.names["json"]: js_bytes},
                    last=s.names["json"])
     stages["outputs"] = time.perf_counter() - t  # the netCDF's wait, the JSON and the writes
