@@ -91,7 +91,7 @@ def read_result(path: str | os.PathLike[str]) -> Result:
         doc = json.loads(js.read_text(encoding="utf-8"))
     except OSError as exc:
         raise FrictionUQError(f"{js}: cannot be read ({exc.strerror or exc})") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+    except (ValueError, RecursionError) as exc:  # not JSON, not UTF-8, nested too deep, a 4300-digit integer
         raise FrictionUQError(f"{js}: not a friction-uq result file (not JSON: {exc})") from None
     if not isinstance(doc, dict) or doc.get("schema") != RUN_SCHEMA:
         raise FrictionUQError(f"{js}: not a run result (key 'schema' is not {RUN_SCHEMA!r})")

@@ -111,7 +111,7 @@ def _check_results(paths: Sequence[Path]) -> None:
         text = _check_text_file(path, "result file (JSON written by run)", FrictionUQError)
         try:
             json.loads(text)
-        except (json.JSONDecodeError, RecursionError) as exc:
+        except (ValueError, RecursionError) as exc:  # JSONDecodeError, or an integer of more than 4300 digits
             raise FrictionUQError(f"{path}: not a friction-uq result file (not JSON: {exc})") from None
 
 

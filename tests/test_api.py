@@ -50,6 +50,12 @@ def test_read_result_reads_the_json_and_refuses_others(tmp_path):
     (tmp_path / "x.json").write_text(json.dumps({"schema": "friction-uq/campaign"}))
     with pytest.raises(FrictionUQError, match=r"x.json: not a run result"):
         fu.read_result(tmp_path / "x.json")
+    (tmp_path / "y.json").write_text('{"x": ' + "9" * 5000 + "}")  # an integer past Python's 4300 digits
+    with pytest.raises(FrictionUQError, match=r"y.json: not a friction-uq result file \(not JSON"):
+        fu.read_result(tmp_path / "y.json")
+    (tmp_path / "z.json").write_bytes(b'{"x": "\xff"}')  # not UTF-8
+    with pytest.raises(FrictionUQError, match=r"z.json: not a friction-uq result file"):
+        fu.read_result(tmp_path / "z.json")
 
 
 @pytest.mark.slow

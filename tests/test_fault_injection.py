@@ -420,6 +420,7 @@ def _result_json(**change) -> str:
      "key(s) f, kappa, nu, V, p_mean, test_id, campaign missing"),
     ("{", "not JSON"),
     ("[" * 100_000, "not JSON"),
+    ('{"x": ' + "9" * 5000 + "}", "not JSON"),  # past Python's 4300-digit limit on integers: a ValueError
     (_result_json(f=[1, 2]), "key 'f' must hold finite numbers"),
     (_result_json(f={"mean": "0.05"}), "key 'f' must hold finite numbers"),
     (_result_json(nu={"mean": float("nan"), "sd": 1, "q05": 0, "q50": 0, "q95": 0}), "key 'nu' must hold finite"),

@@ -126,7 +126,7 @@ def read_result(path: str | os.PathLike[str]) -> RecordResult:
     p = Path(path)
     try:
         doc = json.loads(p.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+    except (OSError, ValueError, RecursionError) as exc:  # unreadable, not JSON, nested too deep, a huge integer
         raise FrictionUQError(f"{p}: not a campaign record result ({exc})") from None
     if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
         raise FrictionUQError(f"{p}: not a campaign record result (key 'schema' is not {SCHEMA!r})")
