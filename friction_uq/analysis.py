@@ -15,7 +15,7 @@ import numpy as np
 from .forces import Forces, compute_forces
 from .physics import cell
 from .errors import NoStationaryPhase, SignalError
-from .gauge_check import gauge_findings
+from .gauge_check import gauge_findings, scale_findings
 from .record import Record
 from .signals import moving_average
 from .stats.ar1 import ar1_mean_sd
@@ -53,7 +53,10 @@ def prepare(
     wired = [g for g in findings if g.kind in ("reversed", "swapped")]
     if wired:  # a wiring fault: the record is to be mended at its source, not analysed
         raise SignalError(f"{record.path}: {wired[0].sentence}")
-    notes = tuple(g.sentence for g in findings)
+    # a channel's scale off by a factor (a gauge factor, a unit: eq. 5, 6 and 14) leaves f's ratio as it is when every
+    # channel shares it, but not the forces, the pressure and the velocity: said, as the balance's notes are
+    scaled = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
+    notes = tuple(g.sentence for g in findings + scaled)
     if window is None:
         win, notes = _automatic_window(record, forces, criterion, notes)
     else:

@@ -293,13 +293,15 @@ def _analyze(args: argparse.Namespace) -> int:
     from .summary import identification_table
 
     rec = read_record(args.file)
-    ident = identify(prepare(rec, window=args.window, dispersion=args.dispersion), nu=args.nu)
+    prep = prepare(rec, window=args.window, dispersion=args.dispersion)
+    ident = identify(prep, nu=args.nu)
     if args.json:
         out = ident.to_json()
         out["test_id"], out["campaign"] = rec.test_id, rec.campaign
+        out["gauge_notes"] = list(prep.gauge_notes)
         print(json.dumps(out))
     else:
-        print(identification_table(rec, ident))
+        print(identification_table(rec, ident) + "".join(f"\ngauge note: {n}" for n in prep.gauge_notes))
     return 0
 
 

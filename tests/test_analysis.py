@@ -1,6 +1,7 @@
 """The deterministic identification on closed-form records (truth known by construction)."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -115,3 +116,27 @@ def test_a_reversed_output_gauge_is_refused(tmp_path):
     with pytest.raises(SignalError, match=r"rev\.h5: /signals/external_output_bar reads tension through the "
                                           r"loading .* looks reversed"):
         prepare(read_record(p))
+
+
+def test_every_gauge_read_a_thousand_times_small_is_said_not_passed(tmp_path, capsys):
+    """All four channels scaled by 1e-3 (strain_per_volt in the wrong unit): f's ratio is unchanged, the forces and
+    pressures are a thousand times small. The incident wave against the striker's speed (eq. 14) says so, in the
+    prepared record's notes (which become a run's warning) and under analyze's table and in its JSON."""
+    import shutil
+
+    import h5py
+
+    from friction_uq.cli import main
+
+    path = tmp_path / "milli.h5"
+    shutil.copy(Path(__file__).parents[1] / "data" / "A" / "A-01.h5", path)
+    with h5py.File(path, "r+") as fh:
+        for name in ("input_bar", "internal_output_bar", "external_output_bar", "tube_hoop"):
+            fh["signals"][name][...] = fh["signals"][name][()] * 1e-3
+    notes = prepare(read_record(path)).gauge_notes
+    assert any("/signals/input_bar reads an incident wave 0.00099 times" in n and "eq. 14" in n for n in notes), notes
+    assert prepare(read_record(Path(__file__).parents[1] / "data" / "A" / "A-01.h5")).gauge_notes == ()
+    assert main(["analyze", str(path)]) == 0
+    assert "gauge note: /signals/input_bar reads an incident wave 0.00099" in capsys.readouterr().out
+    assert main(["analyze", str(path), "--json"]) == 0
+    assert any("eq. 14" in n for n in json.loads(capsys.readouterr().out)["gauge_notes"])
