@@ -356,9 +356,9 @@ def _run(args: argparse.Namespace) -> int:
     from .record import read_record
 
     rec = read_record(args.file)
-    from .priors import default_prior_path, load_priors
+    from .priors import load_priors, record_prior_path
 
-    load_priors(args.priors or default_prior_path(rec.apparatus.sample.material))
+    load_priors(args.priors or record_prior_path(rec.path, rec.apparatus.sample.material))
     from .record_run import run_file
 
     run_file(

@@ -438,6 +438,15 @@ def default_prior_path(material: str, *, directory: str | Path | None = None) ->
     return path
 
 
+def record_prior_path(record_path: str | Path, material: str) -> Path:
+    """The prior file of a record's sample material (:func:`default_prior_path`); a material that names none, or
+    is not a name, is refused naming the record and its field ``/apparatus/sample@material``."""
+    try:
+        return default_prior_path(material)
+    except PriorError as exc:
+        raise PriorError(f"{record_path}: /apparatus/sample@material: {exc}") from None
+
+
 #: Infix of a nu alternative's file name: ``<material>-nu-<label>.toml``.
 ALTERNATIVE_INFIX = "-nu-"
 

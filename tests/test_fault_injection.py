@@ -316,7 +316,8 @@ def test_a_material_is_a_name_never_a_path(record_copy, tmp_path, capsys):
     assert check_material_name("I1-nu_tight2") == "I1-nu_tight2"
     path = _edit(record_copy(), _set("/apparatus/sample", material=str(tmp_path / "evil")))
     assert _code(["run", path, "--out", tmp_path / "out", "--quiet", "--no-pdf"]) == 2
-    assert "is not a material name" in _one_sentence(capsys)
+    msg = _one_sentence(capsys)
+    assert "is not a material name" in msg and f"{path}: /apparatus/sample@material: " in msg
     assert not (tmp_path / "out").exists()
 
 

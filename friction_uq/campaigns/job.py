@@ -208,7 +208,7 @@ def _peak_rss_mb() -> float:
 
 def run_record(task: RecordTask) -> RecordResult:
     """Analyse one record (or find it up to date); never prints, never raises for a bad record."""
-    from ..priors import default_prior_path
+    from ..priors import record_prior_path
     from ..record import read_record
     from ..record_run import run_file, safe_stem
 
@@ -223,7 +223,7 @@ def run_record(task: RecordTask) -> RecordResult:
     try:
         record = read_record(task.path)
         material = record.apparatus.sample.material
-        prior = Path(task.priors_path) if task.priors_path else default_prior_path(material)
+        prior = Path(task.priors_path) if task.priors_path else record_prior_path(record.path, material)
         stem = safe_stem(record.campaign, record.test_id)
         base = dataclasses.replace(
             base, campaign=record.campaign, test_id=record.test_id, material=material,

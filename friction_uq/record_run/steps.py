@@ -30,10 +30,10 @@ from ..diagnostics import (
     ratio_ppc,
     summarize,
 )
-from ..errors import OutputError, PriorError, SamplingError
+from ..errors import OutputError, SamplingError
 from ..likelihood import Likelihood
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
-from ..priors import Priors, default_prior_path, load_priors
+from ..priors import Priors, load_priors, record_prior_path
 from ..quoted import quoted_summary
 from ..record import Record, read_record
 from ..sampler import PosteriorSamples, likelihood_priors, sample_posterior, stderr_progress
@@ -70,10 +70,7 @@ def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | N
            window: tuple[float, float] | None, dispersion: bool, hoop: bool) -> RunSetup:
     """Every input checked (record, priors, the output folder and names) and the signals prepared."""
     record = read_record(path)
-    try:
-        p_path = Path(priors_path) if priors_path else default_prior_path(record.apparatus.sample.material)
-    except PriorError as exc:  # the record's material names no prior file: say which record and field
-        raise PriorError(f"{record.path}: /apparatus/sample@material: {exc}") from None
+    p_path = Path(priors_path) if priors_path else record_prior_path(record.path, record.apparatus.sample.material)
     priors = load_priors(p_path)  # every input is checked before the signals' work, the busy folder too
     stem = safe_stem(record.campaign, record.test_id)
     check_unlocked(out_dir, stem)
