@@ -132,6 +132,9 @@ def test_the_written_record_follows_the_contract(tmp_path: Path) -> None:
                                                  "units 'V' need it"),
         ("[channels.input_bar]\nunits = \"volt\"\n", "key 'channels.input_bar.units' is 'volt', allowed values: "
                                                     "strain, microstrain, V"),
+        # the reader's range (plausible.RANGES): a configuration may not write a record that read_record refuses
+        ("[channels.input_bar]\nunits = \"V\"\nstrain_per_volt = 1e-11\n",
+         "key 'channels.input_bar.strain_per_volt' must lie in [1e-09, 1], got 1e-11"),
         ("[channels.hoop]\nwhite = 1e-6\n", "unknown section [channels.hoop]; allowed channels: input_bar"),
         ("[cell]\ntube_compliance = 1\n", "key 'cell.tube_compliance' must be true or false, got 1"),
         ("[numerics]\nelements = 20.5\n", "key 'numerics.elements' must be an integer, got 20.5"),

@@ -292,7 +292,8 @@ def _channels(source: str, table: Any) -> Mapping[str, ChannelSpec]:
         spec = ChannelSpec(
             enabled=s.boolean("enabled", True),
             units=s.string("units", "strain", choices=tuple(UNITS)),
-            strain_per_volt=s.number("strain_per_volt", math.nan, low=1e-12, high=1.0)
+            strain_per_volt=s.number("strain_per_volt", math.nan, low=RANGES["signals.strain_per_volt"][0],
+                                     high=RANGES["signals.strain_per_volt"][1])  # the reader's range
             if "strain_per_volt" in s else None,
             gain=s.number("gain", 1.0, low=0.0, high=10.0, low_open=True),
             offset=s.number("offset", 0.0, low=-1e-2, high=1e-2),
