@@ -634,3 +634,39 @@ def test_unknown_additions_are_ignored(good_record: Path, record_copy: Callable[
     assert rec.provenance["gains"] == [1.0, 2.0, 0.5]
     assert rec.provenance["channels"] == ["ch1", "ch2"]
     assert rec.provenance["scope"].startswith("LeCroy ")
+
+
+def test_a_channel_in_too_many_chunks_is_refused_before_it_is_read(record_copy, monkeypatch) -> None:
+    """A chunk a sample made a million-sample record take 4 GB to read; the chunk count is checked from the
+    dataset's layout first (here against a limit lowered to 100, so that a short record shows it)."""
+    from friction_uq.record import reader
+
+    monkeypatch.setattr(reader, "MAX_CHUNKS", 100)
+    path = record_copy()
+    with h5py.File(path, "r+") as fh:
+        attrs, data = dict(fh["signals/tube_hoop"].attrs), fh["signals/tube_hoop"][()]
+        del fh["signals/tube_hoop"]
+        ds = fh["signals"].create_dataset("tube_hoop", data=data, chunks=(10,))
+        ds.attrs.update(attrs)
+    n = -(-data.size // 10)
+    with pytest.raises(RecordError, match=rf"^{re.escape(str(path))}: /signals/tube_hoop: is stored in {n} chunks "
+                                          r"of 10 samples, more than the 100 a channel may have"):
+        read_record(path)
+    monkeypatch.setattr(reader, "MAX_CHUNKS", n)
+    read_record(path)
+
+
+def test_a_channel_through_a_filter_not_installed_is_named(record_copy) -> None:
+    """HDF5 reports a dataset whose filter is missing as a damaged file; the reader names the channel and the
+    filter before reading it."""
+    path = record_copy()
+    with h5py.File(path, "r+") as fh:
+        attrs, data = dict(fh["signals/tube_hoop"].attrs), fh["signals/tube_hoop"][()]
+        del fh["signals/tube_hoop"]
+        ds = fh["signals"].create_dataset("tube_hoop", shape=data.shape, dtype=data.dtype, chunks=data.shape,
+                                          compression=32001, allow_unknown_filter=True)
+        ds.id.write_direct_chunk((0,), data.tobytes())
+        ds.attrs.update(attrs)
+    with pytest.raises(RecordError, match=rf"^{re.escape(str(path))}: /signals/tube_hoop: is compressed with HDF5 "
+                                          r"filter 32001 .* which this installation cannot read"):
+        read_record(path)

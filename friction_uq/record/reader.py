@@ -26,6 +26,7 @@ from ..errors import RecordError
 from ._apparatus_reader import read_apparatus
 from ..plausible import (
     MAX_ATTRIBUTE_BYTES,
+    MAX_CHUNKS,
     MAX_ID_CHARS,
     MAX_RECORD_BYTES,
     MAX_SAMPLES,
@@ -242,6 +243,28 @@ def _check_dataset(ds: Any, where: str, r: Reader) -> None:
     if ds.shape[0] > MAX_SAMPLES:
         raise r.fail(where, f"declares {ds.shape[0]} samples, more than the {MAX_SAMPLES} a channel may have "
                      "(docs/limits.md)")
+    _check_storage(ds, where, r)
+
+
+def _check_storage(ds: Any, where: str, r: Reader) -> None:
+    """A channel's storage, before it is read: no more chunks than :data:`MAX_CHUNKS` (a chunk a sample holds
+    a 4-channel record of a million samples in 4 GB of HDF5's index), and every filter it was written through
+    available here (else HDF5 reports the whole file as damaged)."""
+    import h5py
+
+    if ds.chunks is not None:
+        n_chunks = -(-ds.shape[0] // ds.chunks[0]) if ds.shape[0] else 0
+        if n_chunks > MAX_CHUNKS:
+            raise r.fail(where, f"is stored in {n_chunks} chunks of {ds.chunks[0]} samples, more than the "
+                         f"{MAX_CHUNKS} a channel may have (docs/limits.md): write it contiguous or in larger chunks "
+                         "(h5repack -l CONTI)")
+    plist = ds.id.get_create_plist()
+    for i in range(plist.get_nfilters()):
+        code, _, _, name = plist.get_filter(i)
+        if not h5py.h5z.filter_avail(code):
+            label = name.decode(errors="replace") if isinstance(name, bytes) else str(name)
+            raise r.fail(where, f"is compressed with HDF5 filter {code} ({label or 'unnamed'}), which this "
+                         "installation cannot read: write it uncompressed or with gzip")
 
 
 def _read_channel(ds: Any, name: str, where: str, r: Reader, read: dict[str, Channel]) -> Channel:
