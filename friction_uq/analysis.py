@@ -60,7 +60,10 @@ def prepare(
     if window is None:
         win, notes = _automatic_window(record, forces, criterion, notes)
     else:
-        win = window_from_times(forces, *window)
+        try:
+            win = window_from_times(forces, *window)
+        except SignalError as exc:
+            raise SignalError(f"{record.path}: the window given by hand (--window) {exc}") from None
     data = stationary_data(
         forces, record.apparatus, win, test_id=record.test_id, campaign=record.campaign,
         striker_velocity=record.striker_velocity,

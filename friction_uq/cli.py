@@ -138,6 +138,8 @@ def _window(text: str) -> tuple[float, float]:
     if not (m[0].group(2) or unit_b) and max(abs(v) for v in vals) > 1.0:
         raise argparse.ArgumentTypeError(f"window {text!r}: {vals[0]:g} to {vals[1]:g} s is longer than any record; "
                                          f"for microseconds write {parts[0]}us:{parts[1]}us")
+    if not vals[1] > vals[0]:
+        raise argparse.ArgumentTypeError(f"window {text!r}: T1 must be after T0")
     return vals[0], vals[1]
 
 

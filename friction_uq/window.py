@@ -202,26 +202,27 @@ def find_stationary_window(
 
 
 def window_from_times(forces: Forces, t0: float, t1: float) -> Window:
-    """A window given by hand (seconds on the record's time base), checked against the valid waves."""
+    """A window given by hand (seconds on the record's time base), checked against the valid waves; a refusal starts
+    with the times (its caller names the record and the option)."""
     t = forces.time
     if not t1 > t0:
-        raise SignalError(f"window {t0}:{t1}: T1 must be after T0")
+        raise SignalError(f"{t0}:{t1} s: T1 must be after T0")
     if t0 < t[0] or t1 > t[-1]:
-        raise SignalError(f"window {t0}:{t1} s lies outside the record ({t[0]:.6g} to {t[-1]:.6g} s)")
+        raise SignalError(f"{t0}:{t1} s lies outside the record ({t[0]:.6g} to {t[-1]:.6g} s)")
     i0 = int(np.searchsorted(t, t0))
     i1 = int(np.searchsorted(t, t1, side="right"))
     seg = slice(i0, i1)
     if i1 - i0 < 8:
-        raise SignalError(f"window {t0}:{t1} s holds {i1 - i0} samples, at least 8 are needed")
+        raise SignalError(f"{t0}:{t1} s holds {i1 - i0} samples, at least 8 are needed")
     for name, arr in (("F_io", forces.F_io), ("F_eo", forces.F_eo)):
         if not np.all(np.isfinite(arr[seg])):
             raise SignalError(
-                f"window {t0}:{t1} s reaches outside the time where {name} is valid (after the bar's "
+                f"{t0}:{t1} s reaches outside the time where {name} is valid (after the bar's "
                 "far-end echo reaches the gauge)"
             )
     if np.mean(forces.F_io[seg]) < 0.2 * np.nanmax(forces.F_io):
         raise SignalError(
-            f"window {t0}:{t1} s: the cell is not loaded there (mean F_io {np.mean(forces.F_io[seg]):.0f} N, "
+            f"{t0}:{t1} s: the cell is not loaded there (mean F_io {np.mean(forces.F_io[seg]):.0f} N, "
             f"less than 20 % of its peak {np.nanmax(forces.F_io):.0f} N)"
         )
     return Window(float(t[i0]), float(t[i1 - 1]), i0, i1, automatic=False)

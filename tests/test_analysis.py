@@ -1,6 +1,7 @@
 """The deterministic identification on closed-form records (truth known by construction)."""
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -67,8 +68,11 @@ def test_manual_window_overrides(paper_record):
     prep = prepare(rec, window=(4.0e-4, 5.0e-4))
     assert prep.window.t0 == pytest.approx(4.0e-4, abs=rec.sample_interval)
     assert not prep.window.automatic
-    with pytest.raises(SignalError, match="outside the record"):
+    given = rf"^{re.escape(str(rec.path))}: the window given by hand \(--window\) "  # the record and the option
+    with pytest.raises(SignalError, match=given + r"-1\.0:0\.0005 s lies outside the record"):
         prepare(rec, window=(-1.0, 5.0e-4))
+    with pytest.raises(SignalError, match=given + r"0\.0005:0\.0004 s: T1 must be after T0"):
+        prepare(rec, window=(5.0e-4, 4.0e-4))
     with pytest.raises(SignalError, match="outside the time where F_io is valid"):
         prepare(rec, window=(1.1e-3, 1.2e-3))
     with pytest.raises(SignalError, match="the cell is not loaded there"):

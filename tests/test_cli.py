@@ -59,6 +59,10 @@ def test_bad_window_is_a_usage_error(record, capsys):
         main(["analyze", str(record), "--window", "abc"])
     assert e.value.code == 2
     assert "T0:T1" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as e:
+        main(["analyze", str(record), "--window", "600us:400us"])
+    assert e.value.code == 2
+    assert "argument --window: window '600us:400us': T1 must be after T0" in capsys.readouterr().err
 
 
 def test_window_takes_seconds_or_a_unit(record, capsys):

@@ -250,6 +250,8 @@ CASES = [
     Case("sample-missing", delete(f"{A}/sample"), f"{A}/sample", "required group is missing"),
     Case("sample-is-a-dataset", replace_by(f"{A}/sample", lambda g, n: g.create_dataset(n, data=[0.01])),
          f"{A}/sample", "must be a group"),
+    Case("plug-is-a-dataset", h5edit(lambda fh: fh[A].create_dataset("plug", data=[0.01])), f"{A}/plug",
+         "must be a group"),
     # ---- /signals attributes ----
     Case("sample-rate-missing", del_attr(S, "sample_rate"), S, "required attribute 'sample_rate' is missing"),
     Case("sample-rate-zero", set_attr(S, "sample_rate", 0.0), f"{S}@sample_rate", r"must be > 0 Hz, got 0\.0",

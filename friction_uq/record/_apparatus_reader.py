@@ -32,6 +32,10 @@ def read_apparatus(app: Any, r: Reader) -> Apparatus:
     plug = None
     g = r.member(app, "plug", "/apparatus/plug")
     if g is not None:
+        import h5py
+
+        if not isinstance(g, h5py.Group):
+            raise r.fail("/apparatus/plug", "must be a group")
         plug = Plug(**{n: r.positive(g, "/apparatus/plug", n) for n in _PLUG_ATTRS})
     _cross_check(parts, r)
     return _apparatus(parts, plug)
