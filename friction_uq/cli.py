@@ -161,8 +161,11 @@ def _nu(text: str) -> float:
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"nu {text!r} is not a number") from None
-    if not 0.0 < v < 0.5:
-        raise argparse.ArgumentTypeError(f"nu must lie in (0, 0.5), got {v}")
+    from .plausible import out_of_range
+
+    problem = out_of_range("sample.poisson_ratio", v)
+    if problem:
+        raise argparse.ArgumentTypeError(f"nu {problem}")
     return v
 
 

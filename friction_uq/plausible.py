@@ -33,6 +33,8 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
     "sample.length": (1e-4, 0.2, "m", "samples 0.1 mm to 20 cm long"),
     "sample.young_modulus": (1e5, 1e12, "Pa", "rubbers (0.1 MPa) to ceramics"),
     "sample.density": (100.0, 25000.0, "kg/m^3", "foams to osmium"),
+    "sample.poisson_ratio": (0.01, 0.4999, "", "a sample that swells sideways at all, short of incompressible; eq. 17's f "
+                             "grows as 1/nu below"),
     "plug.length": (1e-4, 0.5, "m", "plugs"),
     "plug.young_modulus": (1e8, 1e12, "Pa", "polymer to carbide plugs"),
     "plug.density": (100.0, 25000.0, "kg/m^3", "foams to osmium"),

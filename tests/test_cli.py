@@ -65,6 +65,15 @@ def test_bad_window_is_a_usage_error(record, capsys):
     assert "argument --window: window '600us:400us': T1 must be after T0" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("nu", ["1e-300", "0", "0.5", "nan", "-0.1"])
+def test_an_implausible_nu_is_a_usage_error(record, capsys, nu):
+    """eq. 17's f grows as 1/nu: nu = 1e-300 gave f = 3e298; the sample's Poisson ratio has a plausible range."""
+    with pytest.raises(SystemExit) as e:
+        main(["analyze", str(record), "--nu", nu])
+    assert e.value.code == 2
+    assert "argument --nu: nu is" in capsys.readouterr().err
+
+
 def test_window_takes_seconds_or_a_unit(record, capsys):
     """--window 400us:600us, 0.4ms:0.6ms and 4e-4:6e-4 are the same window; bare numbers too large for seconds
     are refused with the microsecond spelling."""
