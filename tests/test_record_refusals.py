@@ -672,3 +672,12 @@ def test_a_channel_through_a_filter_not_installed_is_named(record_copy) -> None:
     with pytest.raises(RecordError, match=rf"^{re.escape(str(path))}: /signals/tube_hoop: is compressed with HDF5 "
                                           r"filter 32001 .* which this installation cannot read"):
         read_record(path)
+
+
+def test_a_provenance_attribute_hdf5_cannot_read_is_named(record_copy) -> None:
+    """A null-dataspace attribute: HDF5 cannot size it, and the error named the file's root as damaged."""
+    path = record_copy()
+    with h5py.File(path, "r+") as fh:
+        fh.require_group("provenance").attrs["x"] = h5py.Empty("f8")
+    with pytest.raises(RecordError, match=rf"^{re.escape(str(path))}: /provenance@x: cannot be read"):
+        read_record(path)

@@ -299,10 +299,14 @@ def _read_provenance(fh: Any, r: Reader) -> dict[str, Any]:
     prov = r.member(fh, "provenance", "/provenance")
     if prov is None:
         return {}
+    provenance = {}
     for k in prov.attrs:
-        if prov.attrs.get_id(k).get_storage_size() > MAX_ATTRIBUTE_BYTES:
-            raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
-    provenance = {k: plain(v) for k, v in prov.attrs.items()}
+        try:  # an attribute HDF5 cannot size or read (a null dataspace, a type it lacks): named, not "damaged"
+            if prov.attrs.get_id(k).get_storage_size() > MAX_ATTRIBUTE_BYTES:
+                raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
+            provenance[k] = plain(prov.attrs[k])
+        except (KeyError, OSError, RuntimeError, TypeError, ValueError) as exc:
+            raise r.fail(f"/provenance@{k}", f"cannot be read ({exc})") from None
     for k, v in provenance.items():  # a variable-length string is stored apart: its storage size does not count it
         if isinstance(v, str) and text_bytes(v) > MAX_ATTRIBUTE_BYTES:
             raise r.fail(f"/provenance@{k}", f"is larger than the {MAX_ATTRIBUTE_BYTES} bytes an attribute may be")
