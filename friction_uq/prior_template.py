@@ -43,11 +43,17 @@ note = "lognormal around 1, 5 %: gauge factor, bonding, kernel fit"
 """
 
 
+#: Smallest uncertainty of nu a prior file may state: what a dedicated measurement gives (the tight alternative's
+#: floor too); a narrower one would let the prior, not the data, fix f (eq. 17 reads only f nu / (1 - nu)).
+MIN_NU_SD = 0.005
+
+
 def _check(nu: float, sd: float) -> None:
     if not 0.0 < nu < 0.5:
         raise ValueError(f"--nu must lie in (0, 0.5), the Poisson ratio of an elastic solid, got {nu:g}")
-    if not 0.0 < sd <= 0.25:
-        raise ValueError(f"--nu-sd must lie in (0, 0.25], got {sd:g}")
+    if not MIN_NU_SD <= sd <= 0.25:
+        raise ValueError(f"--nu-sd must lie in [{MIN_NU_SD:g}, 0.25] (a measurement of nu knows it to {MIN_NU_SD:g} at "
+                         f"best), got {sd:g}")
 
 
 def _check_source(source: str) -> None:
@@ -90,7 +96,7 @@ def default_text(material: str, nu: float, sd: float, source: str = "") -> str:
 def tight_text(material: str, nu: float, sd: float) -> str:
     """The text of ``MATERIAL-nu-tight.toml`` (nu as a measurement would know it)."""
     _check(nu, sd)
-    tight = max(sd / 3.0, 0.005)
+    tight = max(sd / 3.0, MIN_NU_SD)
     return (_head(material, f"{material} sensitivity: nu measured, {nu:g} +- {tight:.3g}",
                   "Sensitivity alternative: how f would tighten if nu were measured (e.g. by ultrasonic wave speeds).")
             + _COMMON_F + "\n"

@@ -51,4 +51,7 @@ def test_new_material_files_encode_the_estimate(tmp_path, capsys):
     assert "exists; choose another --out or give --force" in capsys.readouterr().err
     assert main(["priors", "PMMA", "--nu", "0.6", "--nu-sd", "0.03", "--out", str(tmp_path), "--force"]) == 2
     assert "--nu must lie in (0, 0.5)" in capsys.readouterr().err
+    # an uncertainty of nu narrower than a measurement gives (1e-300 wrote files that run then refused)
+    assert main(["priors", "PMMA", "--nu", "0.35", "--nu-sd", "1e-300", "--out", str(tmp_path), "--force"]) == 2
+    assert "--nu-sd must lie in [0.005, 0.25]" in capsys.readouterr().err
     assert tomllib.loads((tmp_path / "PMMA.toml").read_text())["nu"]["mean"] == 0.35
