@@ -428,6 +428,9 @@ def _result_json(**change) -> str:
     (_result_json(kappa={"mean": 1, "sd": 0, "q05": 0, "q50": 0, "q95": 0}), "key 'kappa': sd is 0"),
     (_result_json(V={"mean": True, "sd": 1, "q05": 0, "q50": 0, "q95": 0}), "key 'V' must hold finite numbers"),
     (_result_json(test_id=7), "key 'test_id' is '7', not an id"),
+    (_result_json(f={"mean": -5, "sd": 1, "q05": -6, "q50": -5, "q95": -4}), "key 'f': mean is -5, outside [0, inf]"),
+    (_result_json(V={"mean": -1e300, "sd": 1, "q05": 0, "q50": 0, "q95": 0}), "key 'V': mean is -1e+300, outside"),
+    (_result_json(nu={"mean": 0.7, "sd": 0.01, "q05": 0.69, "q50": 0.7, "q95": 0.71}), "key 'nu': mean is 0.7"),
     (_result_json(campaign="A\nfriction-uq: error: fake"), "key 'campaign' is"),
 ])
 def test_compare_refuses_malformed_results(tmp_path, capsys, text, words):
@@ -436,6 +439,17 @@ def test_compare_refuses_malformed_results(tmp_path, capsys, text, words):
     assert _code(["compare", path]) == 2
     msg = _one_sentence(capsys)
     assert str(path) in msg and words in msg
+
+
+def test_compare_counts_a_test_once(tmp_path, capsys):
+    """The same test twice (one file given twice, or two files of one test) would weigh twice in the trends."""
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.write_text(_result_json())
+    b.write_text(_result_json())
+    for paths in ([a, a], [a, b]):
+        assert _code(["compare", *paths]) == 2
+        msg = _one_sentence(capsys)
+        assert "test A A-01 is also given as" in msg and "a test counts once" in msg
 
 
 def test_compare_of_tests_at_one_speed_fits_no_trend_it_cannot(tmp_path, capsys):

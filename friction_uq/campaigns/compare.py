@@ -12,6 +12,7 @@ either is confounded; a second campaign with another impedance ratio puts the te
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -55,11 +56,15 @@ class TrendFit:
         return float(self.coef[j] / self.se[j])
 
 
+#: Where a run's summaries lie (a friction coefficient, a Poisson ratio, a sliding speed and a pressure are not
+#: negative; nu is below 0.5): a result file outside is not what a run wrote.
+SUMMARY_RANGES = {"f": (0.0, math.inf), "kappa": (0.0, math.inf), "nu": (0.0, 0.5), "V": (0.0, math.inf),
+                  "p_mean": (0.0, math.inf)}
+
+
 def _check_summary(p: Path, key: str, v: object, *, positive_sd: bool = False) -> None:
     """Refuse, naming the file and the key, a summary that is not finite numbers ``STATISTICS`` with sd >= 0 (> 0
-    with ``positive_sd``)."""
-    import math
-
+    with ``positive_sd``), or whose mean or median lies outside :data:`SUMMARY_RANGES`."""
     bad = [s for s in STATISTICS if not isinstance(v, dict) or isinstance(v.get(s), bool)
            or not isinstance(v.get(s), (int, float)) or not math.isfinite(v[s])]
     if bad:
@@ -68,6 +73,11 @@ def _check_summary(p: Path, key: str, v: object, *, positive_sd: bool = False) -
     assert isinstance(v, dict)
     if v["sd"] < 0 or (positive_sd and v["sd"] == 0):
         raise FrictionUQError(f"{p}: key '{key}': sd is {v['sd']!r}, it must be > 0")
+    low, high = SUMMARY_RANGES.get(key, (-math.inf, math.inf))
+    out = [s for s in ("mean", "q50") if not low <= v[s] <= high]  # the tails of a small V may cross 0
+    if out:
+        raise FrictionUQError(f"{p}: key '{key}': {out[0]} is {v[out[0]]!r}, outside [{low:g}, {high:g}], where a "
+                              f"run's {key} lies")
 
 
 def load_result(path: str | os.PathLike[str]) -> TestResult:
@@ -155,6 +165,10 @@ def compare(paths: list[str | os.PathLike[str]]) -> Comparison:
     results = sorted((load_result(p) for p in paths), key=lambda r: (r.campaign, r.test_id))
     if not results:
         raise FrictionUQError("no result files given")
+    for a, b in zip(results, results[1:]):  # one test counted twice would weigh twice in the trends
+        if (a.campaign, a.test_id) == (b.campaign, b.test_id):
+            raise FrictionUQError(f"{b.path}: test {a.campaign} {a.test_id} is also given as {a.path}; a test "
+                                  "counts once in a comparison")
     fits: dict[str, TrendFit] = {}
     for name, regs in (("V", ("V",)), ("p_mean", ("p_mean",)), ("V+p_mean", ("V", "p_mean"))):
         X = np.column_stack([np.ones(len(results))] + [[getattr(r, x)["mean"] for r in results] for x in regs])
