@@ -250,6 +250,9 @@ CASES = [
     Case("sample-missing", delete(f"{A}/sample"), f"{A}/sample", "required group is missing"),
     Case("sample-is-a-dataset", replace_by(f"{A}/sample", lambda g, n: g.create_dataset(n, data=[0.01])),
          f"{A}/sample", "must be a group"),
+    Case("provenance-is-a-dataset", h5edit(lambda fh: (fh.__delitem__("provenance") if "provenance" in fh else None,
+                                                      fh.create_dataset("provenance", data=[1.0]))), "/provenance",
+         "must be a group"),
     Case("plug-is-a-dataset", h5edit(lambda fh: fh[A].create_dataset("plug", data=[0.01])), f"{A}/plug",
          "must be a group"),
     # ---- /signals attributes ----

@@ -296,9 +296,13 @@ def _read_channel(ds: Any, name: str, where: str, r: Reader, read: dict[str, Cha
 
 def _read_provenance(fh: Any, r: Reader) -> dict[str, Any]:
     """/provenance's attributes (optional, free-form), each bounded like every attribute."""
+    import h5py
+
     prov = r.member(fh, "provenance", "/provenance")
     if prov is None:
         return {}
+    if not isinstance(prov, h5py.Group):
+        raise r.fail("/provenance", "must be a group")
     provenance = {}
     for k in prov.attrs:
         try:  # an attribute HDF5 cannot size or read (a null dataspace, a type it lacks): named, not "damaged"
