@@ -471,3 +471,115 @@ def test_channels_already_in_strain_and_microstrain(tmp_path):
     doc["channels"]["tube_hoop"]["strain_per_volt"] = 1e-4
     with pytest.raises(SetupError, match=r"\[channels.tube_hoop\] strain_per_volt: applies to channels in V or mV"):
         parse_setup(doc, path=tmp_path / "SETUP.toml")
+
+
+# ---- TDMS channels and properties, rows of another length, the time base's source -------------------
+
+
+def _tdms(path: Path, *, data: dict | None = None, props: dict | None = None) -> Path:
+    """A TDMS file of A-03's gauges in volts, group 'scope', channels CH1..CH4 with their time base; ``data`` and
+    ``props`` replace a channel's samples or properties."""
+    nptdms = pytest.importorskip("nptdms")
+    strains, rate, t0 = gauge_signals(RECORD)
+    chans = []
+    for g, eps in strains.items():
+        c = COLUMNS[g]
+        p = {"wf_increment": 1.0 / rate, "wf_start_offset": t0, **(props or {}).get(c, {})}
+        chans.append(nptdms.ChannelObject("scope", c, (data or {}).get(c, eps / SPV[g]), properties=p))
+    with nptdms.TdmsWriter(str(path)) as w:
+        w.write_segment([nptdms.RootObject(), nptdms.GroupObject("scope"), *chans])
+    return path
+
+
+def _tdms_doc() -> dict:
+    doc = setup_doc()
+    del doc["time"]  # TDMS carries its time base
+    for g, c in COLUMNS.items():
+        doc["channels"][g]["column"] = f"scope/{c}"
+    return doc
+
+
+@pytest.mark.parametrize("values, what", [
+    (lambda v: np.resize(np.array(["a", "b"]), v.size), "text"),
+    (lambda v: v > 0, "booleans"),  # would import as 0 and 1 V
+    (lambda v: v.astype(np.complex128), "complex numbers"),  # would import with a ComplexWarning
+])
+def test_a_tdms_channel_of_other_than_real_numbers_is_refused(tmp_path, capsys, values, what):
+    strains, _, _ = gauge_signals(RECORD)
+    path = _tdms(tmp_path / "shot.tdms",
+                 data={"CH2": values(strains["internal_output_bar"] / SPV["internal_output_bar"])})
+    err = _refused(tmp_path, [path], _tdms_doc(), capsys)
+    assert f"shot.tdms: channel 'scope/CH2' holds {what}, not numeric samples" in err, err
+
+
+@pytest.mark.parametrize("prop, value, words", [
+    ("wf_increment", "abc", "must be a number (seconds), got 'abc'"),
+    ("wf_increment", "2e-7", "must be a number (seconds), got '2e-7'"),  # was read as 2e-7
+    ("wf_start_offset", "abc", "must be a number (seconds), got 'abc'"),
+    ("wf_increment", float("nan"), "must be a finite number (seconds), got nan"),  # was accepted
+    ("wf_increment", -2e-7, "must be positive (the time between two samples, s), got -2e-07"),
+    ("wf_increment", 2e-16, "2e-16 s between samples is a sample rate that is 5000000000000000.0 Hz, outside"),
+    ("wf_start_offset", 5.0, "the start is 5.0 s, outside the plausible range [-1, 1] s"),
+])
+def test_a_tdms_time_property_is_checked_and_named(tmp_path, capsys, prop, value, words):
+    path = _tdms(tmp_path / "shot.tdms", props={"CH2": {prop: value}})
+    err = _refused(tmp_path, [path], _tdms_doc(), capsys)
+    assert f"shot.tdms: channel 'scope/CH2' property {prop}: {words}" in err, err
+
+
+def test_show_names_a_tdms_time_property_that_is_not_a_number(tmp_path, capsys):
+    path = _tdms(tmp_path / "shot.tdms", props={"CH3": {"wf_increment": "abc"}})
+    assert main(["import", str(path), "--show"]) == 2
+    err = capsys.readouterr().err
+    assert "shot.tdms: channel 'scope/CH3' property wf_increment: must be a number (seconds), got 'abc'" in err
+    assert err.count("\n") == 1
+
+
+def test_tdms_lengths_are_checked_from_the_metadata_before_any_sample_is_read(tmp_path, capsys, monkeypatch):
+    nptdms = pytest.importorskip("nptdms")
+    path = _tdms(tmp_path / "shot.tdms", data={"CH1": np.zeros(1_000_001)})
+
+    def no_data(*args, **kwargs):
+        raise AssertionError("samples were read before the lengths were checked")
+
+    monkeypatch.setattr(nptdms.TdmsFile, "read", no_data)
+    monkeypatch.setattr(nptdms.tdms.TdmsChannel, "__getitem__", no_data)
+    monkeypatch.setattr(nptdms.tdms.TdmsChannel, "read_data", no_data)
+    err = _refused(tmp_path, [path], _tdms_doc(), capsys)
+    assert "shot.tdms: channel 'scope/CH1' declares 1000001 samples, more than the 1000000 a record may hold" in err
+    assert main(["import", str(path), "--show"]) == 0  # --show reads the metadata alone
+    assert '"scope/CH1"  1000001 samples, every 2e-07 s' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("edit, fields, drop_hoop", [
+    (lambda c: c[:2] + ["0.0"] + c[2:], 6, False),  # a field inserted: CH2 would read 0, CH3 CH2's value
+    (lambda c: c + ["0.0"], 6, False),  # a field too many at the end
+    (lambda c: c[:2] + c[3:], 4, True),  # a field lost in the middle, the last column unused: CH3 would read CH4
+])
+def test_a_row_with_another_number_of_fields_is_refused(tmp_path, scope_csv, capsys, edit, fields, drop_hoop):
+    lines = scope_csv.read_text().splitlines()
+    lines[3506] = ",".join(edit(lines[3506].split(",")))
+    scope_csv.write_text("\n".join(lines) + "\n")
+    doc = setup_doc()
+    if drop_hoop:
+        del doc["channels"]["tube_hoop"]
+    err = _refused(tmp_path, [scope_csv], doc, capsys)
+    assert f"scope.csv: line 3507 has {fields} fields where the data rows have 5" in err, err
+
+
+def test_a_non_finite_time_is_named_by_its_line(tmp_path, scope_csv, capsys):
+    lines = scope_csv.read_text().splitlines()
+    lines[3000] = "nan" + lines[3000][lines[3000].index(","):]
+    scope_csv.write_text("\n".join(lines) + "\n")
+    err = _refused(tmp_path, [scope_csv], setup_doc(), capsys)
+    assert "scope.csv: line 3001: the time column 'Time' holds nan, not a finite time" in err, err
+
+
+@pytest.mark.parametrize("time, words", [
+    ({"sample_rate": 1e300, "t0": -8e-5}, "SETUP.toml: [time] sample_rate: is 1e+300 Hz, outside the plausible"),
+    ({"sample_rate": 5e6, "t0": 5.0}, "SETUP.toml: [time] t0: is 5.0 s, outside the plausible range"),
+    ({"column": "Time", "units": "ns"}, "SETUP.toml: [time] units: the sample rate from the time column 'Time' of "),
+])
+def test_an_implausible_time_base_names_the_setup_key(tmp_path, scope_csv, capsys, time, words):
+    err = _refused(tmp_path, [scope_csv], setup_doc(time=time), capsys)
+    assert words in err, err

@@ -26,10 +26,9 @@ from ..plausible import not_regular
 from ..record.contract import FORMAT, FORMAT_VERSION
 from .binary import BINARY_SUFFIXES, Trace, read_binary
 from .delimited import read_delimited
-from .setup_file import TIME_UNITS, ChannelSetup, Setup, load_setup
+from .setup_file import ChannelSetup, Setup, load_setup
+from .timebase import time_base
 
-#: Largest departure of a time column from even spacing, in sample intervals.
-TIME_JITTER = 0.25
 #: Largest relative difference of two channels' sample intervals.
 RATE_TOL = 1e-6
 
@@ -71,44 +70,6 @@ def _file_of(setup: Setup, ch: ChannelSetup, files: Sequence[Path]) -> Path:
     return hits[0]
 
 
-def _time_base(setup: Setup, file: Path, table_time: np.ndarray | None, trace: Trace,
-               first_line: int) -> tuple[float, float]:
-    """(t0, dt) of a channel: from the time column, from [time] sample_rate, or from the file's own time base."""
-    ts = setup.time
-    if ts is not None and ts.sample_rate is not None:
-        return ts.t0, 1.0 / ts.sample_rate
-    if table_time is not None:
-        assert ts is not None
-        t = table_time * TIME_UNITS[ts.units]
-        n = len(t)
-        if n < 2:
-            raise ScopeFileError(f"{file}: the time column has {n} value(s); a record needs many samples")
-        step = np.diff(t)
-        dt = float(np.median(step))
-        if not dt > 0:
-            raise ScopeFileError(f"{file}: the time column {ts.column!r} does not increase "
-                                 f"(from {t[0]:g} to {t[-1]:g} s)")
-        bad = np.flatnonzero(np.abs(step - dt) > TIME_JITTER * dt)  # a jump between two rows
-        if bad.size:
-            i = int(bad[0]) + 1
-            raise ScopeFileError(f"{file}: line {first_line + i}: the time column {ts.column!r} is not evenly spaced "
-                                 f"(it reads {t[i]:.9g} s where a step of {dt:.6g} s from the row before gives "
-                                 f"{t[i - 1] + dt:.9g} s): a gap, a second segment or a time column in another unit "
-                                 "(see [time] units)")
-        dt = (t[-1] - t[0]) / (n - 1)  # the mean step: the printed times' rounding averages out
-        bad = np.flatnonzero(np.abs(t - (t[0] + np.arange(n) * dt)) > TIME_JITTER * dt)  # or a slow drift
-        if bad.size:
-            i = int(bad[0])
-            raise ScopeFileError(f"{file}: line {first_line + i}: the time column {ts.column!r} drifts from an even "
-                                 f"step of {dt:.6g} s (it reads {t[i]:.9g} s, the step gives {t[0] + i * dt:.9g} s)")
-        rate = float(f"{1.0 / dt:.9g}")  # the rate to 9 digits: the printed times' rounding is not a rate
-        return float(t[0]), 1.0 / rate
-    if trace.dt is None:
-        raise SetupError(f"{setup.path}: [time]: {file} holds no time base; give [time] column = the time column's "
-                         "name or number, or sample_rate (Hz) and t0 (s)")
-    return float(trace.t0 or 0.0), trace.dt
-
-
 def _read_file(setup: Setup, file: Path, chans: list[ChannelSetup]) -> list[Channel]:
     cols: list[str | int] = list(dict.fromkeys(c.column for c in chans))
     ts = setup.time
@@ -117,7 +78,7 @@ def _read_file(setup: Setup, file: Path, chans: list[ChannelSetup]) -> list[Chan
         wanted = cols + ([time_col] if time_col is not None and time_col not in cols else [])
         traces = read_binary(file, wanted)
         time = traces[time_col].values if time_col is not None else None
-        first = 1
+        first = None  # a binary file's time channel is named by sample, not by line
     else:
         if time_col is None and (ts is None or ts.sample_rate is None):
             raise SetupError(f"{setup.path}: [time]: a text export has no time base of its own; give [time] column "
@@ -130,7 +91,7 @@ def _read_file(setup: Setup, file: Path, chans: list[ChannelSetup]) -> list[Chan
     out = []
     for c in chans:
         tr = traces[c.column]
-        t0, dt = _time_base(setup, file, time, tr, first)
+        t0, dt = time_base(setup, file, time, tr, first)
         out.append(Channel(c, file, tr.label, tr.values, t0, dt))
     return out
 

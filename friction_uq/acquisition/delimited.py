@@ -21,15 +21,18 @@ import numpy as np
 
 from ..errors import ScopeFileError
 from ..plausible import MAX_SAMPLES
+from .text_layout import (
+    DIALECT_NAMES,
+    HEAD_LINES,
+    data_start,
+    find_dialect,
+    fields,
+    is_number,
+    tail_lines,
+)
 
 #: Largest text export read (bytes): 1 M samples x 8 columns of 16-character numbers is 140 MB.
 MAX_TEXT_BYTES = 2_000_000_000
-#: (delimiter, decimal mark) candidates in order of preference; None splits on whitespace.
-DIALECTS = (("\t", "."), ("\t", ","), (";", "."), (";", ","), (",", "."), (None, "."), (None, ","))
-_NAMES = {"\t": "tab", ";": "semicolon", ",": "comma", None: "whitespace"}
-_HEAD_LINES = 400
-_TAIL_LINES = 20
-_CONFIRM_ROWS = 3
 
 
 @dataclass(frozen=True)
@@ -46,131 +49,30 @@ class TextTable:
 
     @property
     def dialect(self) -> str:
-        return f"{_NAMES[self.delimiter]}-separated, decimal mark {self.decimal!r}"
-
-
-def _fields(line: str, delim: str | None) -> list[str]:
-    parts = line.split(delim) if delim is not None else line.split()
-    parts = [p.strip().strip('"').strip() for p in parts]
-    while parts and parts[-1] == "":
-        parts.pop()
-    return parts
-
-
-def _number(cell: str, decimal: str) -> bool:
-    if decimal == ",":
-        cell = cell.replace(",", ".")
-    try:
-        float(cell)
-    except ValueError:
-        return False
-    return True
-
-
-def _numeric_row(line: str, delim: str | None, decimal: str) -> int:
-    """Number of fields if every field of ``line`` is a number, else 0."""
-    f = _fields(line, delim)
-    return len(f) if f and all(_number(c, decimal) for c in f) else 0
-
-
-def _tail(text: str, head: list[str]) -> list[tuple[int, str]]:
-    """The last :data:`_TAIL_LINES` lines that are not blank, each with its offset in ``text`` (a short file's
-    from its head): the lines the layout is read from."""
-    chunk = text[-(1 << 15):]
-    base, out, at = len(text) - len(chunk), [], 0
-    for k, line in enumerate(chunk.split("\n")):
-        if k and line.strip():  # the chunk's first line may be cut
-            out.append((base + at, line))
-        at += len(line) + 1
-    if not out:  # a short file: its tail is its head
-        at = 0
-        for line in head:
-            if line.strip():
-                out.append((at, line))
-            at += len(line) + 1
-    return out[-_TAIL_LINES:]
-
-
-def _dialect(path: Path, tail: list[tuple[int, str]], text: str) -> tuple[str | None, str, int]:
-    """(delimiter, decimal mark, fields per row) under which every line of ``tail`` (offset, line) is a row of
-    numbers; else one sentence naming the line that breaks the layout the others share, or saying there is none."""
-    lines = [ln for _, ln in tail]
-    best: tuple[str | None, str, int] | None = None
-    for delim, dec in DIALECTS:
-        counts = {_numeric_row(line, delim, dec) for line in lines}
-        if len(counts) == 1 and (n := counts.pop()) > 0 and (best is None or n > best[2]):
-            best = (delim, dec, n)
-    if best is None:
-        odd = _odd_line(tail, text)
-        if odd is not None:
-            raise ScopeFileError(f"{path}: {odd[0]}, where the rows around it are {odd[1]} numbers each (a truncated "
-                                 "or damaged row near the end of the export)")
-        raise ScopeFileError(f"{path}: its last lines are not rows of numbers in any of the usual layouts (comma, "
-                             "semicolon, tab or space separated; decimal point or comma): is it an oscilloscope "
-                             "export?")
-    return best
-
-
-def _odd_line(tail: list[tuple[int, str]], text: str) -> tuple[str, int] | None:
-    """The first line of ``tail`` (offset, line) that breaks the layout more than half of them share (of such
-    layouts, the one with the most numbers per row): a row of numbers with another count of them, or a line
-    between rows of the layout that is not a row of numbers ('line N has k fields'), and the rows' count of
-    numbers; None when there is no such layout or no such line (a footer after the data, a header above it)."""
-    lines = [ln for _, ln in tail]
-    shared: tuple[int, int, str | None, str] | None = None  # (rows, fields, delimiter, decimal mark)
-    for delim, dec in DIALECTS:
-        counts = [_numeric_row(line, delim, dec) for line in lines]
-        top = max(set(counts) - {0}, key=lambda n: (counts.count(n), n), default=0)
-        if top and 2 * counts.count(top) > len(lines) and (shared is None or (counts.count(top), top) > shared[:2]):
-            shared = (counts.count(top), top, delim, dec)
-    if shared is None:
-        return None
-    _, ncols, delim, dec = shared
-    fits = [_numeric_row(line, delim, dec) == ncols for line in lines]
-    for k, (pos, line) in enumerate(tail):
-        if fits[k]:
-            continue
-        if _numeric_row(line, delim, dec):
-            n = len(_fields(line, delim))
-            what = f"has {n} field{'s' if n != 1 else ''}"
-        elif any(fits[:k]) and any(fits[k + 1:]):
-            what = f"is not a row of numbers ({line.strip()[:40]!r})"
-        else:
-            continue
-        return f"line {text.count(chr(10), 0, pos) + 1} {what}", ncols
-    return None
-
-
-def _data_start(path: Path, head: list[str], delim: str | None, dec: str, ncols: int) -> int:
-    ok = [_numeric_row(line, delim, dec) == ncols for line in head]
-    for i in range(len(head)):
-        if ok[i] and all(ok[i:i + _CONFIRM_ROWS]):
-            return i
-    raise ScopeFileError(f"{path}: no run of {_CONFIRM_ROWS} rows of {ncols} numbers in its first {len(head)} lines: "
-                         "more metadata lines than an oscilloscope writes, or a column that is not numeric")
+        return f"{DIALECT_NAMES[self.delimiter]}-separated, decimal mark {self.decimal!r}"
 
 
 def _header(path: Path, head: list[str], start: int, delim: str | None,
             wanted: list[str]) -> tuple[int | None, list[str]]:
     """(index, fields) of the nearest line above the data naming every wanted column (case-insensitively)."""
     for i in range(start - 1, max(-1, start - 60), -1):
-        f = _fields(head[i], delim)
+        f = fields(head[i], delim)
         low = [c.lower() for c in f]
         if f and all(w in f or w.lower() in low for w in wanted):
             return i, f
     if wanted:  # name the first missing column against the line that names most of them
-        lines = [(sum(w.lower() in [c.lower() for c in _fields(head[i], delim)] for w in wanted), i)
+        lines = [(sum(w.lower() in [c.lower() for c in fields(head[i], delim)] for w in wanted), i)
                  for i in range(start - 1, max(-1, start - 60), -1) if head[i].strip()]
         if not lines:
             raise ScopeFileError(f"{path}: no header line above the data (line {start + 1}); name the columns by "
                                  "number (column = 2)")
         _, best = max(lines, key=lambda x: x[0])
-        f = _fields(head[best], delim)
+        f = fields(head[best], delim)
         miss = next(w for w in wanted if w.lower() not in [c.lower() for c in f])
         raise ScopeFileError(f"{path}: column {miss!r} not found; the header line {best + 1} has: {', '.join(f)}")
     for i in range(start - 1, max(-1, start - 60), -1):  # for messages only: the nearest non-numeric line
         if head[i].strip():
-            return i, _fields(head[i], delim)
+            return i, fields(head[i], delim)
     return None, []
 
 
@@ -192,12 +94,12 @@ def _locate_bad_cell(path: Path, lines: list[str], start: int, delim: str | None
     for n, line in enumerate(lines[start:], start=start + 1):
         if not line.strip():
             continue
-        f = _fields(line, delim)
+        f = fields(line, delim)
         if len(f) <= max(idx):
             return ScopeFileError(f"{path}: line {n} has {len(f)} fields where the data rows have {ncols} "
                                   "(a truncated or damaged row)")
         for i, label in zip(idx, labels):
-            if not _number(f[i], dec):
+            if not is_number(f[i], dec):
                 return ScopeFileError(f"{path}: line {n}, column {label}: {f[i]!r} is not a number")
     return None
 
@@ -231,6 +133,31 @@ def _rows_over(body: str, limit: int) -> bool:
     return False
 
 
+def _row_of_another_length(body: str, delim: str | None, ncols: int) -> tuple[int, int] | None:
+    """(index among ``body``'s lines, fields) of the first line that is not blank and has other than ``ncols``
+    fields, else None: with a field too many or too few, numbers would land in the wrong columns (a row's
+    columns are taken by their place). Read a megabyte at a time, the delimiters counted in C."""
+    want, trail = ncols - 1, f' \t\r"{delim or ""}'
+    drop = None if delim is None else bytes(range(256)).translate(None, (delim + "\n").encode())
+    pos = first = 0
+    while pos < len(body):
+        end = body.find("\n", pos + (1 << 20))
+        end = len(body) if end < 0 else end + 1
+        lines = body[pos:end].split("\n")
+        if delim is None:
+            odd = [k for k, line in enumerate(lines) if len(line.split()) != ncols]
+        else:  # each line's delimiters; a trailing delimiter (an empty last field) is looked at again
+            sig = body[pos:end].encode().translate(None, drop).split(b"\n")
+            odd = [k for k, d in enumerate(sig) if len(d) != want and lines[k].rstrip(trail).count(delim) != want]
+        for k in odd:
+            n = len(fields(lines[k], delim))
+            if n != ncols and lines[k].strip():
+                return first + k, n
+        first += len(lines) - 1
+        pos = end
+    return None
+
+
 def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
     """The columns ``wanted`` (header names or 1-based numbers) of a delimited text export, as float64.
 
@@ -238,18 +165,18 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
     ------
     ScopeFileError
         Naming the file and the line or column: no data, a missing column, a cell that is not a
-        number, a short row.
+        number, a row with fields too few or too many.
     """
     p = Path(path)
     text = _text(p)
     if "\n" not in text[: 1 << 16] and "\r" in text[: 1 << 16]:
         text = text.replace("\r", "\n")  # old Macintosh line ends
-    head = text[: 1 << 18].split("\n")[:_HEAD_LINES]
-    tail = _tail(text, head)
+    head = text[: 1 << 18].split("\n")[:HEAD_LINES]
+    tail = tail_lines(text, head)
     if not tail:
         raise ScopeFileError(f"{p}: is empty")
-    delim, dec, ncols = _dialect(p, tail, text)
-    start = _data_start(p, head, delim, dec, ncols)
+    delim, dec, ncols = find_dialect(p, tail, text)
+    start = data_start(p, head, delim, dec, ncols)
     names = [w for w in wanted if isinstance(w, str)]
     hline, header = _header(p, head, start, delim, names)
     idx = [_index(p, w, header, None if hline is None else hline + 1, ncols) for w in wanted]
@@ -263,6 +190,11 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
     if body.count("\n") + 1 > MAX_SAMPLES and _rows_over(body, MAX_SAMPLES):  # before parsing
         raise ScopeFileError(f"{p}: more than {MAX_SAMPLES} data rows from line {start + 1}, more samples than a "
                              "record may hold (docs/limits.md); export a shorter or decimated record")
+    odd = _row_of_another_length(body, delim, ncols)
+    if odd is not None:
+        why = "a truncated or damaged row" if odd[1] < ncols else "a damaged row: its numbers would shift columns"
+        raise ScopeFileError(f"{p}: line {start + 1 + odd[0]} has {odd[1]} fields where the data rows have {ncols} "
+                             f"({why})")
     if dec == ",":
         body = body.replace(",", ".")
     uniq = sorted(set(idx))
@@ -282,21 +214,21 @@ def describe_text(path: str | Path) -> list[str]:
     text = _text(p)
     if "\n" not in text[: 1 << 16] and "\r" in text[: 1 << 16]:
         text = text.replace("\r", "\n")
-    head = text[: 1 << 18].split("\n")[:_HEAD_LINES]
-    tail = _tail(text, head)
+    head = text[: 1 << 18].split("\n")[:HEAD_LINES]
+    tail = tail_lines(text, head)
     if not tail:
         raise ScopeFileError(f"{p}: is empty")
-    delim, dec, ncols = _dialect(p, tail, text)
-    start = _data_start(p, head, delim, dec, ncols)
+    delim, dec, ncols = find_dialect(p, tail, text)
+    start = data_start(p, head, delim, dec, ncols)
     above = [i for i in range(start - 1, max(-1, start - 60), -1) if head[i].strip()][:3]
-    named = [i for i in above if len(f := _fields(head[i], delim)) >= ncols and len(set(f)) == len(f)]
+    named = [i for i in above if len(f := fields(head[i], delim)) >= ncols and len(set(f)) == len(f)]
     hline = named[0] if named else None
-    header = _fields(head[hline], delim) if hline is not None else []
+    header = fields(head[hline], delim) if hline is not None else []
     table = read_delimited(p, list(range(1, ncols + 1)))
     n = len(table.columns[1])
     first = [table.columns[i][0] for i in range(1, ncols + 1)]
     out = [f"{p}: {table.dialect}; {start} line(s) before the data, data from line {start + 1}, {n} rows"]
-    out += [f"  line {i + 1}: {', '.join(_fields(head[i], delim))}" for i in reversed(above)]
+    out += [f"  line {i + 1}: {', '.join(fields(head[i], delim))}" for i in reversed(above)]
     out.append(f"  column names from line {hline + 1}" if hline is not None
                else "  no header line: name columns by number")
     for i in range(ncols):
