@@ -1,4 +1,4 @@
-"""The expected information of one more test on which law holds (friction_uq.campaigns.next_test)."""
+"""The expected information of one more test on which law holds (friction_uq.campaigns.next_test_choice)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from friction_uq.campaigns.next_test import Candidate, advice, information
+from friction_uq.campaigns.next_test_choice import Candidate, advice, information
 
 
 def test_laws_that_predict_alike_gain_nothing_and_laws_far_apart_gain_the_weights_entropy():
@@ -48,7 +48,7 @@ def test_the_advice_names_the_best_candidate():
 def test_the_laws_the_verdict_names_are_asked_about_equally_whatever_stacking_says():
     """Stacking may give 0.99 to one of two laws whose ELPDs are not decisively apart; the verdict names both, and
     the advice must be about both (equal weights), not about nothing."""
-    from friction_uq.campaigns.next_test import _in_play
+    from friction_uq.campaigns.next_test_choice import _in_play
 
     weights = {"velocity": 0.99, "pressure": 0.001, "pressure+velocity": 0.009, "constant": 0.0}
     assert _in_play(weights, None) == ["velocity"]

@@ -24,7 +24,7 @@ from .job import RecordResult
 from .law_comparison import (WEIGHT_RULE, LawComparison, draw_summary, fits_with_loo, offset_sentence,
                              simplest_supported, supported_laws, verdict)
 from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model, law_mean
-from .next_test import advice, rank_next_tests
+from .next_test_choice import advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
 from .pooling import implied_kappa_log_prior, strata
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from .draws import RecordPosterior
 from .laws import Fit, LawData, law_mean
-from .next_test import Candidate
+from .next_test_choice import Candidate
 from .pooling import Pooled
 
 
@@ -31,7 +31,7 @@ class CampaignAnalysis:
     sentences: list[str] = field(default_factory=list)
     #: each law's stacking weight (friction_uq.stats.stacking_weights)
     weights: dict[str, float] = field(default_factory=dict)
-    #: candidate next tests, the most informative first (.next_test), when the laws are not separated
+    #: candidate next tests, the most informative first (.next_test_choice), when the laws are not separated
     next_tests: list[Candidate] = field(default_factory=list)
     #: law -> the name of its model in ``fits`` that the weights are of (the law, or with set-ups left out)
     law_models: dict[str, str] = field(default_factory=dict)

@@ -18,7 +18,7 @@ of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and
 ``posterior`` of the best (else heaviest) law's parameters in f units; ``models``: the same for every
 model; ``meanings``: each parameter in words with its unit; ``next_tests``: when the laws are not separated,
 each candidate test (set-up, V, p) with the expected information it brings on which law holds, most
-informative first (:mod:`.next_test`); ``pressure_or_setup``: with two set-ups, when a law with a pressure term
+informative first (:mod:`.next_test_choice`); ``pressure_or_setup``: with two set-ups, when a law with a pressure term
 is named or the second set-up is flagged by the laws with and without its offset, the best law with a free offset
 on that set-up against the best without (dELPD, SE, ``d_elpd_rest`` with the test that favours it most left out, the
 weight the laws with the offset carry among all the models, ``without_ruled_out``: the laws without it ruled out by

@@ -9,7 +9,8 @@ import arviz_base  # noqa: F401, I001
 
 from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
 from .outputs import netcdf_bytes, safe_stem, summary_table
-from .pipeline import JSON_VARIABLES, RunResult, run_file
+from .pipeline import RunResult, run_file
+from .run_document import JSON_VARIABLES
 
 __all__ = ["JSON_VARIABLES", "RunResult", "alternative_nu_priors", "hoop_unusable", "netcdf_bytes", "run_file",
            "safe_stem", "sliding_velocity_summary", "summary_table"]
