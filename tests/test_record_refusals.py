@@ -644,9 +644,9 @@ def test_unknown_additions_are_ignored(good_record: Path, record_copy: Callable[
 def test_a_channel_in_too_many_chunks_is_refused_before_it_is_read(record_copy, monkeypatch) -> None:
     """A chunk a sample made a million-sample record take 4 GB to read; the chunk count is checked from the
     dataset's layout first (here against a limit lowered to 100, so that a short record shows it)."""
-    from friction_uq.record import reader
+    from friction_uq.record import _checks
 
-    monkeypatch.setattr(reader, "MAX_CHUNKS", 100)
+    monkeypatch.setattr(_checks, "MAX_CHUNKS", 100)
     path = record_copy()
     with h5py.File(path, "r+") as fh:
         attrs, data = dict(fh["signals/tube_hoop"].attrs), fh["signals/tube_hoop"][()]
@@ -657,7 +657,7 @@ def test_a_channel_in_too_many_chunks_is_refused_before_it_is_read(record_copy, 
     with pytest.raises(RecordError, match=rf"^{re.escape(str(path))}: /signals/tube_hoop: is stored in {n} chunks "
                                           r"of 10 samples, more than the 100 a channel may have"):
         read_record(path)
-    monkeypatch.setattr(reader, "MAX_CHUNKS", n)
+    monkeypatch.setattr(_checks, "MAX_CHUNKS", n)
     read_record(path)
 
 

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import RecordError
-from ..plausible import MAX_ATTRIBUTE_BYTES, text_bytes
+from ..plausible import MAX_ATTRIBUTE_BYTES, MAX_CHUNKS, MAX_SAMPLES, text_bytes
 from .contract import CLIP_RUN
 
 
@@ -180,3 +180,40 @@ def check_distinct(strain: np.ndarray, earlier: dict[str, Any], where: str, r: R
         den = float(np.sqrt(np.dot(a, a) * np.dot(b, b)))
         if den > 0 and abs(float(np.dot(a, b))) / den > 1.0 - 1e-12:
             raise r.fail(where, f"is /signals/{name} multiplied by a constant: a channel copied twice?")
+
+
+def check_dataset(ds: Any, where: str, r: Reader) -> None:
+    """A channel's dataset: 1-D floats, no more samples than a channel may have (checked before it is read)."""
+    import h5py
+
+    if not isinstance(ds, h5py.Dataset):
+        raise r.fail(where, "must be a dataset")
+    if ds.ndim != 1:
+        raise r.fail(where, f"must be 1-D, got shape {ds.shape}")
+    if ds.dtype.kind != "f" or ds.dtype.itemsize not in (4, 8):
+        raise r.fail(where, f"must be float32 or float64, got {ds.dtype}")
+    if ds.shape[0] > MAX_SAMPLES:
+        raise r.fail(where, f"declares {ds.shape[0]} samples, more than the {MAX_SAMPLES} a channel may have "
+                     "(docs/limits.md)")
+    _check_storage(ds, where, r)
+
+
+def _check_storage(ds: Any, where: str, r: Reader) -> None:
+    """A channel's storage, before it is read: no more chunks than :data:`MAX_CHUNKS` (a chunk a sample holds
+    a 4-channel record of a million samples in 4 GB of HDF5's index), and every filter it was written through
+    available here (else HDF5 reports the whole file as damaged)."""
+    import h5py
+
+    if ds.chunks is not None:
+        n_chunks = -(-ds.shape[0] // ds.chunks[0]) if ds.shape[0] else 0
+        if n_chunks > MAX_CHUNKS:
+            raise r.fail(where, f"is stored in {n_chunks} chunks of {ds.chunks[0]} samples, more than the "
+                         f"{MAX_CHUNKS} a channel may have (docs/limits.md): write it contiguous or in larger chunks "
+                         "(h5repack -l CONTI)")
+    plist = ds.id.get_create_plist()
+    for i in range(plist.get_nfilters()):
+        code, _, _, name = plist.get_filter(i)
+        if not h5py.h5z.filter_avail(code):
+            label = name.decode(errors="replace") if isinstance(name, bytes) else str(name)
+            raise r.fail(where, f"is compressed with HDF5 filter {code} ({label or 'unnamed'}), which this "
+                         "installation cannot read: write it uncompressed or with gzip")
