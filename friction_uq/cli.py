@@ -16,16 +16,13 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__, import_command, priors_command
-from .errors import ConfigError, FrictionUQError, OutputError, os_error_text
+from .errors import FrictionUQError, OutputError, os_error_text
+from .cli_arguments import (FIGURE_SUFFIXES, RECORD_SUFFIXES, config_file, nu_argument, output_file, result_files,
+                            seed_argument, striker_velocity_argument, window_argument, workers_argument)
 
 EXIT_BAD_INPUT = 2
 #: Exit status of an unexpected error (a bug), said in one line; FRICTION_UQ_TRACEBACK=1 shows its traceback.
 EXIT_INTERNAL = 3
-#: Figure formats of ``design -o`` and ``compare -o`` (matplotlib writes them without extra packages).
-FIGURE_SUFFIXES = (".pdf", ".png", ".svg", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp")
-#: Record file names ``simulate -o`` writes.
-RECORD_SUFFIXES = (".h5", ".hdf5")
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 #: Environment variables that set BLAS's threads (OpenBLAS, as numpy's wheels ship it; MKL).
 BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -35,138 +32,6 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(EXIT_BAD_INPUT, f"friction-uq: error: {message} (see {self.prog} --help)\n")
-
-
-def _seed(text: str) -> int:
-    """A seed in decimal ("010" is 10; "0x10" is refused, not read in another base)."""
-    try:
-        v = int(text, 10)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"seed {text!r} is not a decimal integer") from None
-    if not 0 <= v < 2**64:
-        raise argparse.ArgumentTypeError(f"seed must be an integer in [0, 2**64), got {text}")
-    return v
-
-
-def _output_file(path: Path, suffixes: Sequence[str], what: str) -> None:
-    """Refuse an output name that is a directory, has a parent that is a file, or an unknown suffix."""
-    if path.is_dir():
-        raise OutputError(f"{path}: is a directory; give a {what} file name ending in {' or '.join(suffixes)}")
-    if path.suffix.lower() not in suffixes:
-        raise OutputError(f"{path}: unknown {what} format {path.suffix or '(no suffix)'!r}; "
-                          f"give a name ending in {', '.join(suffixes)}")
-    for parent in path.parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise OutputError(f"{path}: {parent} is a file, not a folder")
-            break
-
-
-def _check_text_file(path: Path, what: str, error: type[FrictionUQError]) -> str:
-    """The UTF-8 text of an input file, or one sentence saying why it is not one."""
-    from .plausible import MAX_TEXT_BYTES, not_regular
-
-    try:
-        path.stat()  # a missing file: said below, as for any file that cannot be read
-        if odd := not_regular(path):
-            raise error(f"{path}: {odd}, not a {what}")
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_TEXT_BYTES + 1)
-    except OSError as exc:
-        raise error(f"{path}: cannot read the {what} ({os_error_text(exc)})") from None
-    if len(raw) > MAX_TEXT_BYTES:
-        raise error(f"{path}: is larger than {MAX_TEXT_BYTES} bytes, too large for a {what} (docs/limits.md)")
-    if raw.startswith(HDF5_SIGNATURE):
-        raise error(f"{path}: is an HDF5 file (a test record?), not a {what}")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise error(f"{path}: the {what} is not UTF-8 text (byte {exc.start}); save it as UTF-8") from None
-    if "\x00" in text:
-        raise error(f"{path}: the {what} contains NUL characters (a binary file?)")
-    return text
-
-
-def _check_config(path: Path) -> None:
-    """Refuse a configuration that is not UTF-8 TOML, or is nested too deeply to parse."""
-    import tomllib
-
-    from .plausible import toml_shape_problem
-
-    text = _check_text_file(path, "simulation configuration (TOML)", ConfigError)
-    problem = toml_shape_problem(text)
-    if problem:
-        raise ConfigError(f"{path}: {problem}, too deep for a simulation configuration (docs/limits.md)")
-    try:
-        tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
-    except RecursionError:
-        raise ConfigError(f"{path}: nested too deeply to be a simulation configuration") from None
-
-
-def _check_results(paths: Sequence[Path]) -> None:
-    """Refuse a ``compare`` input that is not a JSON result (an HDF5 record, a binary, bad JSON)."""
-    for path in paths:
-        text = _check_text_file(path, "result file (JSON written by run)", FrictionUQError)
-        try:
-            json.loads(text)
-        except (ValueError, RecursionError) as exc:  # JSONDecodeError, or an integer of more than 4300 digits
-            raise FrictionUQError(f"{path}: not a friction-uq result file (not JSON: {exc})") from None
-
-
-_TIME_UNITS = {"s": "1", "ms": "1e-3", "us": "1e-6", "\u00b5s": "1e-6"}  # exact decimal scales
-
-
-def _window(text: str) -> tuple[float, float]:
-    """T0:T1 in seconds, or with a unit (s, ms, us) on either bound or on the second for both: 400us:600us,
-    400:600us, 0.4ms:0.6ms, 4e-4:6e-4."""
-    import re
-    from decimal import Decimal, InvalidOperation
-
-    bad = (f"window {text!r} is not T0:T1 on the record's time base, in seconds or with a unit: "
-           "400us:600us, 0.4ms:0.6ms or 4e-4:6e-4")
-    parts = text.split(":")
-    m = [re.fullmatch(r"\s*([-+0-9.eE]+)\s*(s|ms|us|\u00b5s)?\s*", p) for p in parts]
-    if len(parts) != 2 or not all(m):
-        raise argparse.ArgumentTypeError(bad)
-    unit_b = m[1].group(2)
-    try:
-        vals = [float(Decimal(x.group(1)) * Decimal(_TIME_UNITS[x.group(2) or unit_b or "s"])) for x in m]
-    except (ValueError, InvalidOperation):
-        raise argparse.ArgumentTypeError(bad) from None
-    if not (m[0].group(2) or unit_b) and max(abs(v) for v in vals) > 1.0:
-        raise argparse.ArgumentTypeError(f"window {text!r}: {vals[0]:g} to {vals[1]:g} s is longer than any record; "
-                                         f"for microseconds write {parts[0]}us:{parts[1]}us")
-    if not vals[1] > vals[0]:
-        raise argparse.ArgumentTypeError(f"window {text!r}: T1 must be after T0")
-    return vals[0], vals[1]
-
-
-def _striker_velocity(text: str) -> float:
-    from .plausible import out_of_range
-
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"striker velocity {text!r} is not a number") from None
-    problem = out_of_range("striker_velocity", v)
-    if problem:
-        raise argparse.ArgumentTypeError(f"striker velocity {problem}")
-    return v
-
-
-def _nu(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"nu {text!r} is not a number") from None
-    from .plausible import out_of_range
-
-    problem = out_of_range("sample.poisson_ratio", v)
-    if problem:
-        raise argparse.ArgumentTypeError(f"nu {problem}")
-    return v
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -185,8 +50,8 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("analyze", help="the lab's deterministic analysis (eq. 17) for a given nu",
                        description="Deterministic identification of f from eq. 17 over the stationary window.")
     s.add_argument("file", type=Path, help="test record (test.h5)")
-    s.add_argument("--nu", type=_nu, default=0.4, help="sample Poisson ratio (default 0.4)")
-    s.add_argument("--window", type=_window, help="stationary window T0:T1 on the record's time base, in seconds or with a unit: 400us:600us, "
+    s.add_argument("--nu", type=nu_argument, default=0.4, help="sample Poisson ratio (default 0.4)")
+    s.add_argument("--window", type=window_argument, help="stationary window T0:T1 on the record's time base, in seconds or with a unit: 400us:600us, "
                        "0.4ms:0.6ms, 4e-4:6e-4 (default: automatic); write --window=T0:T1 when T0 is negative")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of a table")
@@ -195,15 +60,15 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Design relations eq. 15-16 for a record's apparatus and striker speed.")
     s.add_argument("file", type=Path, help="test record (test.h5)")
     s.add_argument("-o", "--output", type=Path, required=True, help="figure file (PDF or PNG)")
-    s.add_argument("--nu", type=_nu, default=0.4, help="sample Poisson ratio (default 0.4)")
-    s.add_argument("--striker-velocity", type=_striker_velocity,
+    s.add_argument("--nu", type=nu_argument, default=0.4, help="sample Poisson ratio (default 0.4)")
+    s.add_argument("--striker-velocity", type=striker_velocity_argument,
                    help="m/s (default: the record's, else from the incident wave)")
 
     s = sub.add_parser("simulate", help="simulate a whole test into a record",
                        description="Simulate a confined friction test from a TOML configuration.")
     s.add_argument("config", type=Path, help="simulation configuration (TOML)")
     s.add_argument("-o", "--output", type=Path, help="record to write (test.h5); required unless --compare")
-    s.add_argument("--seed", type=_seed, help="noise seed, 0 <= seed < 2**64 (default: the config's)")
+    s.add_argument("--seed", type=seed_argument, help="noise seed, 0 <= seed < 2**64 (default: the config's)")
     s.add_argument("--compare", type=Path, metavar="PDF", help="also run the 1-D and the axisymmetric model on "
                    "the configuration and draw them side by side per phase into this PDF (table on stdout)")
 
@@ -229,8 +94,8 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("file", type=Path, help="test record (test.h5)")
         s.add_argument("--priors", type=Path, help="prior file (TOML; default: the package's <material>.toml)")
         s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
-        s.add_argument("--seed", type=_seed, default=20161, help="random seed, 0 <= seed < 2**64 (default 20161)")
-        s.add_argument("--window", type=_window, help="stationary window T0:T1 on the record's time base, in seconds or with a unit: 400us:600us, "
+        s.add_argument("--seed", type=seed_argument, default=20161, help="random seed, 0 <= seed < 2**64 (default 20161)")
+        s.add_argument("--window", type=window_argument, help="stationary window T0:T1 on the record's time base, in seconds or with a unit: 400us:600us, "
                        "0.4ms:0.6ms, 4e-4:6e-4 (default: automatic); write --window=T0:T1 when T0 is negative")
         s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
         s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
@@ -311,7 +176,7 @@ def _analyze(args: argparse.Namespace) -> int:
 
 
 def _design(args: argparse.Namespace) -> int:
-    _output_file(args.output, FIGURE_SUFFIXES, "figure")
+    output_file(args.output, FIGURE_SUFFIXES, "figure")
     from .record import read_record
     from .report.design_figure import design_figure
 
@@ -325,10 +190,10 @@ def _simulate(args: argparse.Namespace) -> int:
     if args.output is None and args.compare is None:
         raise OutputError("simulate: give -o RECORD.h5, --compare PAGES.pdf, or both")
     if args.output is not None:
-        _output_file(args.output, RECORD_SUFFIXES, "record")
+        output_file(args.output, RECORD_SUFFIXES, "record")
     if args.compare is not None:
-        _output_file(args.compare, (".pdf",), "comparison")
-    _check_config(args.config)
+        output_file(args.compare, (".pdf",), "comparison")
+    config_file(args.config)
     from .simulate import load_config, simulate_to_file
 
     cfg = load_config(args.config)
@@ -343,8 +208,8 @@ def _simulate(args: argparse.Namespace) -> int:
 
 def _compare(args: argparse.Namespace) -> int:
     if args.output:
-        _output_file(args.output, FIGURE_SUFFIXES, "figure")
-    _check_results(args.results)
+        output_file(args.output, FIGURE_SUFFIXES, "figure")
+    result_files(args.results)
     from .campaigns import compare, comparison_table
 
     comp = compare(args.results)
@@ -379,19 +244,9 @@ def _dispatch(args: argparse.Namespace) -> int:
     """The subcommand's function (argparse restricts the choices)."""
     commands = {"inspect": _inspect, "analyze": _analyze, "design": _design, "simulate": _simulate,
                 "compare": _compare, "campaign": _campaign, "run": _run, "diagnose": _run,
-                "import": lambda a: import_command.run(a, build_parser(), _output_file),
+                "import": lambda a: import_command.run(a, build_parser(), output_file),
                 "priors": priors_command.run}
     return commands[args.command](args)
-
-
-def _workers(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"workers {text!r} is not a whole number") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"workers must be at least 1, got {v}")
-    return v
 
 
 def _add_campaign_parser(sub) -> None:
@@ -403,10 +258,10 @@ def _add_campaign_parser(sub) -> None:
                        "summary says why), 2 on bad input.")
     s.add_argument("records", type=Path, nargs="*", help="record files (test.h5) or folders of them")
     s.add_argument("--out", type=Path, required=True, help="campaign output directory")
-    s.add_argument("--workers", type=_workers, default=2, help="local worker processes (default 2)")
+    s.add_argument("--workers", type=workers_argument, default=2, help="local worker processes (default 2)")
     s.add_argument("--scheduler", help="address of a running Dask scheduler (e.g. tcp://10.0.0.5:8786) "
                    "instead of a local cluster")
-    s.add_argument("--seed", type=_seed, default=20161, help="campaign seed, 0 <= seed < 2**64 (default 20161)")
+    s.add_argument("--seed", type=seed_argument, default=20161, help="campaign seed, 0 <= seed < 2**64 (default 20161)")
     s.add_argument("--priors", type=Path, help="prior file for every record (default: priors/<material>.toml)")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
