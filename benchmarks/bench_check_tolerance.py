@@ -45,7 +45,7 @@ from friction_uq.discrepancy import run_stage  # noqa: E402
 from friction_uq.discrepancy.misfit import cell_test, cell_threshold, phase_spans  # noqa: E402
 from friction_uq.discrepancy.whole_record import TIMING_TOLERANCE, TOLERANCE  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
-from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+from friction_uq.prior_loader import default_prior_path, load_priors  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
 from friction_uq.record_run.alongside import whole_record_start  # noqa: E402
 

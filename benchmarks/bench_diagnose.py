@@ -42,7 +42,7 @@ from friction_uq.discrepancy.diagnose import diagnose  # noqa: E402
 from friction_uq.discrepancy.diagnosed_f import quoted_of  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.likelihood import Likelihood  # noqa: E402
-from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+from friction_uq.prior_loader import default_prior_path, load_priors  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
 from friction_uq.sampler import LogPosterior, start_ball  # noqa: E402
 from friction_uq.simulate import simulate_to_file  # noqa: E402

@@ -47,7 +47,7 @@ from friction_uq.discrepancy.run_stage import f_nu_log_prior  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.models.parameters import F  # noqa: E402
 from friction_uq.models.simulator import NU  # noqa: E402
-from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+from friction_uq.prior_loader import default_prior_path, load_priors  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
 from friction_uq.record_run.alongside import whole_record_start  # noqa: E402
 

@@ -31,7 +31,7 @@ from friction_uq.discrepancy.check import check_whole_record
 from friction_uq.discrepancy.diagnosis_words import HOOP_GAIN_FINDING
 from friction_uq.errors import FrictionUQError
 from friction_uq.likelihood import Likelihood
-from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.prior_loader import default_prior_path, load_priors
 from friction_uq.record import read_record
 from friction_uq.sampler import LogPosterior, start_ball
 from friction_uq.simulate import load_config, simulate_to_file

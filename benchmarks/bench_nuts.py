@@ -98,7 +98,7 @@ def main(argv: list[str]) -> int:
 
     from friction_uq.analysis import prepare
     from friction_uq.likelihood import Likelihood
-    from friction_uq.priors import default_prior_path, load_priors
+    from friction_uq.prior_loader import default_prior_path, load_priors
     from friction_uq.record import read_record
     from friction_uq.sampler import LogPosterior, sample_posterior, start_ball
 

@@ -45,7 +45,7 @@ from friction_uq.discrepancy.diagnose import MAX_CAUSES  # noqa: E402
 from friction_uq.discrepancy.diagnosed_f import quoted_of  # noqa: E402
 from friction_uq.discrepancy.diagnosis_words import sentence  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
-from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+from friction_uq.prior_loader import default_prior_path, load_priors  # noqa: E402
 
 #: Pairs on the 1-D simulation: the issue's two (a clearance with a velocity law; plug friction with a gauge's
 #: gain), others of the cell with each other, and faults of the chain with effects of the cell.

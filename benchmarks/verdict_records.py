@@ -56,7 +56,7 @@ from bench_misfit import clean_config  # noqa: E402
 from bench_trust import write_strains  # noqa: E402
 
 from friction_uq.errors import FrictionUQError  # noqa: E402
-from friction_uq.priors import default_prior_path, load_priors  # noqa: E402
+from friction_uq.prior_loader import default_prior_path, load_priors  # noqa: E402
 from friction_uq.simulate import simulate  # noqa: E402
 
 #: The mechanisms the axisymmetric simulation also has.

@@ -226,7 +226,7 @@ def _run(args: argparse.Namespace) -> int:
     from .record import read_record
 
     rec = read_record(args.file)
-    from .priors import load_priors, record_prior_path
+    from .prior_loader import load_priors, record_prior_path
 
     load_priors(args.priors or record_prior_path(rec.path, rec.apparatus.sample.material))
     from .record_run import run_file

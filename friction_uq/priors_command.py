@@ -39,7 +39,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def _listing(folder: Path) -> str:
-    from .priors import PRIORS_DIR, prior_files
+    from .prior_loader import PRIORS_DIR, prior_files
 
     folders = [(PRIORS_DIR, "come with friction-uq")]
     if folder.resolve() != PRIORS_DIR.resolve() and prior_files(folder):
@@ -57,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     from ._atomic import write_bytes
     from .errors import FrictionUQError, OutputError
     from .prior_template import prior_texts
-    from .priors import parse_priors
+    from .prior_loader import parse_priors
 
     if args.material is None:
         print(_listing(args.out))

@@ -14,7 +14,7 @@ from friction_uq.campaigns.law_comparison import SLIP_CAVEAT
 from friction_uq.campaigns.flags import causes_sentence, setup_flags, tally_causes
 from friction_uq.campaigns.laws import Elpd, Model
 from friction_uq.campaigns.outputs import campaign_doc, summary_text, write_netcdf
-from friction_uq.priors import PRIORS_DIR
+from friction_uq.prior_loader import PRIORS_DIR
 from friction_uq.report.campaign_pages import write_campaign_report
 
 PRIOR = str(PRIORS_DIR / "I1.toml")

@@ -15,7 +15,7 @@ from friction_uq.campaigns.analysis import RecordPosterior, analyse_tests, read_
 from friction_uq.campaigns.flags import tally_causes
 from friction_uq.campaigns.outputs import SCHEMA_VERSION, campaign_doc, summary_text, write_netcdf
 from friction_uq.campaigns.pooling import StoredDraws, pool
-from friction_uq.priors import PRIORS_DIR, load_priors
+from friction_uq.prior_loader import PRIORS_DIR, load_priors
 from friction_uq.report.campaign_pages import write_campaign_report
 
 PRIOR = str(PRIORS_DIR / "I1.toml")

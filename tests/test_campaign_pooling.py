@@ -8,7 +8,7 @@ import pytest
 from scipy import stats
 
 from friction_uq.campaigns.pooling import StoredDraws, implied_kappa_log_prior, pool
-from friction_uq.priors import PRIORS_DIR, load_priors
+from friction_uq.prior_loader import PRIORS_DIR, load_priors
 
 
 def _normal_tests(rng, means, sd, n):

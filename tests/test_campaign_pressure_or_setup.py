@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from friction_uq.campaigns.analysis import RecordPosterior, analyse_tests, supported_laws
-from friction_uq.priors import PRIORS_DIR
+from friction_uq.prior_loader import PRIORS_DIR
 
 PRIOR = str(PRIORS_DIR / "I1.toml")
 NU = 0.4

@@ -15,7 +15,7 @@ from friction_uq.campaigns.analysis import RecordPosterior, analyse_tests, suppo
 from friction_uq.campaigns.flags import tally_causes
 from friction_uq.campaigns.law_comparison import SLIP_CAVEAT
 from friction_uq.campaigns.laws import LAWS, TREND_FLOOR
-from friction_uq.priors import PRIORS_DIR
+from friction_uq.prior_loader import PRIORS_DIR
 from friction_uq.window_halves import WindowHalves
 
 PRIOR = str(PRIORS_DIR / "I1.toml")

@@ -13,7 +13,7 @@ import pytest
 from friction_uq.campaigns import run_campaign
 from friction_uq.campaigns.analysis import RecordPosterior, analyse_tests, supported_laws
 from friction_uq.campaigns.flags import tally_causes
-from friction_uq.priors import PRIORS_DIR
+from friction_uq.prior_loader import PRIORS_DIR
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 PRIOR = str(PRIORS_DIR / "I1.toml")

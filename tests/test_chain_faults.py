@@ -16,7 +16,7 @@ import pytest
 from friction_uq.analysis import identify, prepare
 from friction_uq.discrepancy import outcome
 from friction_uq.discrepancy.diagnose import diagnose
-from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.prior_loader import default_prior_path, load_priors
 from friction_uq.record import read_record
 from friction_uq.simulate import simulate
 from simulated import noisy_config

@@ -19,7 +19,7 @@ from friction_uq.discrepancy import diagnosed_f, diagnosis_words, outcome, round
 from friction_uq.discrepancy.diagnose import candidates, diagnose
 from friction_uq.discrepancy.mechanisms import MECHANISMS, Mechanism, register
 from friction_uq.models.parameters import F, HOOP_GAIN, NU
-from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.prior_loader import default_prior_path, load_priors
 from friction_uq.record import read_record
 from friction_uq.simulate import simulate_to_file
 from friction_uq.simulate.config import ChannelSpec

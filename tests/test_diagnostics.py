@@ -13,7 +13,7 @@ import pytest
 from friction_uq import diagnostics as dg
 from friction_uq.likelihood import Likelihood
 from friction_uq.physics import cell
-from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.prior_loader import default_prior_path, load_priors
 from friction_uq.sampler import PosteriorSamples, sample_posterior
 from test_sbc import closed_form_data
 

@@ -13,7 +13,7 @@ from friction_uq.discrepancy import outcome
 from friction_uq.discrepancy.effective_prior import EXACT_NOTE, PUSHED_NOTE, log_prior_f_effective
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS, Context
-from friction_uq.priors import PRIORS_DIR, load_priors
+from friction_uq.prior_loader import PRIORS_DIR, load_priors
 
 F_PRIOR = load_priors(PRIORS_DIR / "I1.toml")["f"]  # half-normal(0.3), as the run passes it
 F_SCIPY = F_PRIOR.frozen()  # the same law, for the quadratures

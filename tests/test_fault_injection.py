@@ -27,7 +27,7 @@ from friction_uq import _atomic, plausible
 from friction_uq.campaigns import job, runner
 from friction_uq.cli import main
 from friction_uq.errors import PriorError, RecordError
-from friction_uq.priors import PRIORS_DIR, check_material_name, default_prior_path, load_priors
+from friction_uq.prior_loader import PRIORS_DIR, check_material_name, default_prior_path, load_priors
 from friction_uq.record import read_record
 
 REPO = Path(__file__).resolve().parents[1]

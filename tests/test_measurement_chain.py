@@ -180,7 +180,7 @@ def _fits(path, names):
     from friction_uq.discrepancy.block_loo import elpd_difference
     from friction_uq.discrepancy.extended import Diagnoser, Variant
     from friction_uq.discrepancy.mechanisms import MECHANISMS
-    from friction_uq.priors import default_prior_path, load_priors
+    from friction_uq.prior_loader import default_prior_path, load_priors
     from friction_uq.record import read_record
 
     priors = load_priors(default_prior_path("I1"))

@@ -13,7 +13,7 @@ from friction_uq.discrepancy.mechanisms import MECHANISMS
 from friction_uq.discrepancy.nu_cut import CutFit, NuCut, conditional_fit, cut_draws, window_nu
 from friction_uq.discrepancy.fit import WholeRecordFit
 from friction_uq.models.parameters import F, NU
-from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.prior_loader import default_prior_path, load_priors
 from friction_uq.record import read_record
 from friction_uq.simulate import simulate_to_file
 from simulated import noisy_config

@@ -33,7 +33,7 @@ from friction_uq.discrepancy.block_loo import elpd_difference
 from friction_uq.stats import RULE
 from friction_uq.stats.trimmed import points_to_drop
 from friction_uq.discrepancy.diagnose import MAX_CAUSES
-from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.prior_loader import default_prior_path, load_priors
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "benchmarks"))
 from bench_diagnose import analyse  # noqa: E402

@@ -163,7 +163,7 @@ def test_the_campaign_law_comparison_is_the_same_on_one_or_two_processes(monkeyp
 def _campaign_tests():
     """Six tests of a velocity-weakening wall on one set-up, drawn once."""
     from friction_uq.campaigns.analysis import RecordPosterior
-    from friction_uq.priors import PRIORS_DIR
+    from friction_uq.prior_loader import PRIORS_DIR
 
     rng = np.random.default_rng(2)
     out = []

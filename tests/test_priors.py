@@ -10,7 +10,8 @@ import pytest
 from scipy import stats
 
 from friction_uq.errors import PriorError
-from friction_uq.priors import PRIORS_DIR, ParameterPrior, default_prior_path, load_priors
+from friction_uq.priors import ParameterPrior
+from friction_uq.prior_loader import PRIORS_DIR, default_prior_path, load_priors
 
 GOOD = """
 material = "X"

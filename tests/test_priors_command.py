@@ -9,7 +9,7 @@ from scipy import stats
 
 from friction_uq.cli import main
 from friction_uq.errors import PriorError
-from friction_uq.priors import PRIORS_DIR, default_prior_path, load_priors, prior_files
+from friction_uq.prior_loader import PRIORS_DIR, default_prior_path, load_priors, prior_files
 from friction_uq.record_run.inputs import alternative_nu_priors
 
 

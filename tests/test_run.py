@@ -212,7 +212,7 @@ def test_a_prior_that_overwhelms_the_data_is_said_everywhere(paper_run, tmp_path
     import matplotlib.pyplot as plt
 
     import friction_uq.report.pdf as report
-    from friction_uq.priors import default_prior_path
+    from friction_uq.prior_loader import default_prior_path
 
     _, _, rec = paper_run
     original = default_prior_path("I1").read_text()
@@ -246,7 +246,7 @@ def test_a_uniform_prior_is_run_and_its_power_scaling_is_zero(paper_run, tmp_pat
     """The shipped sensitivity file puts a uniform prior on nu: a power of a flat prior is the same prior, so the
     posterior cannot move with it (prior sensitivity 0); before, the power-scaling check ended the run with an
     internal error after sampling, and left a checkpoint behind."""
-    from friction_uq.priors import PRIORS_DIR
+    from friction_uq.prior_loader import PRIORS_DIR
 
     _, _, rec = paper_run
     out = tmp_path / "wide"

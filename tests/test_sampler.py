@@ -12,7 +12,7 @@ import pytest
 from friction_uq.errors import PriorError, SamplingError
 from friction_uq.likelihood import Likelihood
 from friction_uq.physics import cell
-from friction_uq.priors import default_prior_path, load_priors, parse_priors
+from friction_uq.prior_loader import default_prior_path, load_priors, parse_priors
 from friction_uq.sampler import (
     ConvergenceWarning,
     LogPosterior,

@@ -38,7 +38,7 @@ from scipy import stats
 
 from friction_uq.likelihood import RATIO_MODEL_FORM, Likelihood, offset_sd
 from friction_uq.physics import cell, design
-from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.prior_loader import default_prior_path, load_priors
 from friction_uq.record import paper_apparatus
 from friction_uq.sampler import sample_posterior
 from friction_uq.window import StationaryData

@@ -15,7 +15,7 @@ from friction_uq.discrepancy.check import check_whole_record
 from friction_uq.discrepancy.misfit import misfit_detected, predictive_quadratic, tolerated
 from friction_uq.discrepancy.whole_record import longest_sign_run, whiten
 from friction_uq.likelihood import ar1_noise
-from friction_uq.priors import default_prior_path, load_priors
+from friction_uq.prior_loader import default_prior_path, load_priors
 from friction_uq.record import read_record
 from friction_uq.simulate import simulate_to_file
 from simulated import noisy_config

@@ -25,7 +25,7 @@ from typing import Any
 
 from .._atomic import check_unlocked, output_folder, output_lock
 from ..errors import FrictionUQError, check_seed
-from ..priors import load_priors
+from ..prior_loader import load_priors
 from .analysis import CampaignAnalysis, analyse
 from .compare import Comparison, TestResult, TrendFit, compare, comparison_table, fit_trend, load_result
 from .job import RecordResult, RecordTask, read_result, run_record

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..priors import load_priors
+from ..prior_loader import load_priors
 from .flags import outlier_tests, setup_entry, setup_flags, tally_causes
 from .conclusions import CampaignAnalysis
 from .job import RecordResult

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionUQError
-from ..priors import load_priors
+from ..prior_loader import load_priors
 from ..window_halves import WindowHalves
 from .job import RecordResult
 from .pooling import Pooled, StoredDraws, implied_kappa_log_prior, pool, thin

@@ -208,7 +208,7 @@ def _peak_rss_mb() -> float:
 
 def run_record(task: RecordTask) -> RecordResult:
     """Analyse one record (or find it up to date); never prints, never raises for a bad record."""
-    from ..priors import record_prior_path
+    from ..prior_loader import record_prior_path
     from ..record import read_record
     from ..record_run import run_file, safe_stem
 

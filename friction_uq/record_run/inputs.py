@@ -13,7 +13,8 @@ from scipy import stats
 from ..analysis import Prepared
 from ..diagnostics import VariableSummary
 from ..gauge_check import hoop_findings
-from ..priors import PRIORS_DIR, Priors, load_priors
+from ..priors import Priors
+from ..prior_loader import PRIORS_DIR, load_priors
 
 
 def sliding_velocity_summary(p: Prepared) -> VariableSummary:

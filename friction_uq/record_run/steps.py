@@ -33,7 +33,8 @@ from ..diagnostics import (
 from ..errors import OutputError, SamplingError
 from ..likelihood import Likelihood
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
-from ..priors import Priors, load_priors, record_prior_path
+from ..priors import Priors
+from ..prior_loader import load_priors, record_prior_path
 from ..quoted import quoted_summary
 from ..record import Record, read_record
 from ..sampler import PosteriorSamples, likelihood_priors, sample_posterior, stderr_progress
