@@ -108,9 +108,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
+    try:  # an argument type's unexpected error too is one line, not a traceback (SystemExit passes through)
+        args = build_parser().parse_args(argv)
         out = getattr(args, "out", None)
         if args.command in ("run", "diagnose", "campaign") and out is not None:
             from ._logfile import libraries_to_log

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -102,7 +103,7 @@ def window_argument(text: str) -> tuple[float, float]:
     """T0:T1 in seconds, or with a unit (s, ms, us) on either bound or on the second for both: 400us:600us,
     400:600us, 0.4ms:0.6ms, 4e-4:6e-4."""
     import re
-    from decimal import Decimal, InvalidOperation
+    from decimal import Decimal
 
     bad = (f"window {text!r} is not T0:T1 on the record's time base, in seconds or with a unit: "
            "400us:600us, 0.4ms:0.6ms or 4e-4:6e-4")
@@ -113,8 +114,10 @@ def window_argument(text: str) -> tuple[float, float]:
     unit_b = m[1].group(2)
     try:
         vals = [float(Decimal(x.group(1)) * Decimal(_TIME_UNITS[x.group(2) or unit_b or "s"])) for x in m]
-    except (ValueError, InvalidOperation):
+    except (ValueError, ArithmeticError):  # not a number; or one past Decimal's exponent range (Overflow)
         raise argparse.ArgumentTypeError(bad) from None
+    if not all(math.isfinite(v) for v in vals):
+        raise argparse.ArgumentTypeError(f"window {text!r}: its times must be finite")
     if not (m[0].group(2) or unit_b) and max(abs(v) for v in vals) > 1.0:
         raise argparse.ArgumentTypeError(f"window {text!r}: {vals[0]:g} to {vals[1]:g} s is longer than any record; "
                                          f"for microseconds write {parts[0]}us:{parts[1]}us")

@@ -59,6 +59,11 @@ def test_bad_window_is_a_usage_error(record, capsys):
         main(["analyze", str(record), "--window", "abc"])
     assert e.value.code == 2
     assert "T0:T1" in capsys.readouterr().err
+    for text in ("1e1000000:2e1000000", "1e999999999us:2e999999999us", "1e400us:2e400us"):  # overflowed: traceback
+        with pytest.raises(SystemExit) as e:
+            main(["analyze", str(record), "--window", text])
+        assert e.value.code == 2
+        assert "argument --window: window" in capsys.readouterr().err
     with pytest.raises(SystemExit) as e:
         main(["analyze", str(record), "--window", "600us:400us"])
     assert e.value.code == 2
