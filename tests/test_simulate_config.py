@@ -128,6 +128,8 @@ def test_the_written_record_follows_the_contract(tmp_path: Path) -> None:
         ("[friction]\nlaw = \"coulomb\"\nf = 0.1\nf_s = 0.2\n", "unknown key 'friction.f_s'; allowed keys in "
                                                                "[friction]: law, f"),
         ("[friction]\nf = -0.1\n", "key 'friction.f' must lie in [0, 5], got -0.1"),
+        ("[friction]\nlaw = [\"velocity\"]\n", "key 'friction.law' must be a string, got ['velocity']"),
+        ("[friction]\nlaw = {name = \"velocity\"}\n", "key 'friction.law' must be a string"),
         ("[channels.input_bar]\nunits = \"V\"\n", "key 'channels.input_bar.strain_per_volt' is missing; "
                                                  "units 'V' need it"),
         ("[channels.input_bar]\nunits = \"volt\"\n", "key 'channels.input_bar.units' is 'volt', allowed values: "

@@ -185,6 +185,8 @@ def load_config(path: str | Path) -> SimulationConfig:
 
 def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> SimulationConfig:
     """Build a :class:`SimulationConfig` from the parsed TOML tables (checks as :func:`load_config`)."""
+    if not isinstance(data, Mapping):
+        raise ConfigError(f"{source}: a simulation configuration is a table of sections, got {type(data).__name__}")
     for name in data:
         if name not in SECTIONS:
             raise ConfigError(f"{source}: unknown section [{name}]; allowed sections: {', '.join(SECTIONS)}.")
@@ -266,6 +268,8 @@ def _friction(source: str, table: Any) -> tuple[str, Mapping[str, float]]:
     if not isinstance(table, Mapping):
         raise ConfigError(f"{source}: [friction] must be a table, got {table!r}.")
     law_name = table.get("law", "coulomb")
+    if not isinstance(law_name, str):  # a list or a table is not a name (and not hashable)
+        raise ConfigError(f"{source}: key 'friction.law' must be a string, got {law_name!r}.")
     if law_name not in LAWS:
         raise ConfigError(f"{source}: key 'friction.law' is {law_name!r}, allowed values: {', '.join(LAWS)}.")
     law = LAWS[law_name]
