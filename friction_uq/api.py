@@ -83,9 +83,10 @@ def read_result(path: str | os.PathLike[str]) -> Result:
     FrictionUQError
         The file is missing, not JSON, or not a run result (another schema).
     """
+    from .api_arguments import path_argument
     from .errors import FrictionUQError
 
-    p = Path(path)
+    p = path_argument("path", path)
     js = p.with_suffix(".json") if p.suffix in (".nc", ".pdf", "") else p
     try:
         doc = json.loads(js.read_text(encoding="utf-8"))
@@ -95,6 +96,11 @@ def read_result(path: str | os.PathLike[str]) -> Result:
         raise FrictionUQError(f"{js}: not a friction-uq result file (not JSON: {exc})") from None
     if not isinstance(doc, dict) or doc.get("schema") != RUN_SCHEMA:
         raise FrictionUQError(f"{js}: not a run result (key 'schema' is not {RUN_SCHEMA!r})")
+    if not isinstance(doc.get("f"), dict):
+        raise FrictionUQError(f"{js}: not a run result: key 'f' (the f to quote) is missing or not an object")
+    warns = doc.get("warnings", [])
+    if not isinstance(warns, list) or not all(isinstance(w, str) for w in warns):
+        raise FrictionUQError(f"{js}: key 'warnings' must be a list of sentences, got {warns!r:.60}")
     nc, pdf = js.with_suffix(".nc"), js.with_suffix(".pdf")
     return Result(doc, js, nc if nc.is_file() else None, pdf if pdf.is_file() else None)
 
@@ -129,8 +135,13 @@ def run(path: str | os.PathLike[str], *, priors: str | os.PathLike[str] | None =
     Result
         The JSON document and the files; ``details`` holds the in-process run.
     """
+    from .api_arguments import flag_argument, path_argument, window_argument
     from .record_run import run_file
 
+    path, priors = path_argument("path", path), path_argument("priors", priors, optional=True)
+    out_dir, window = path_argument("out_dir", out_dir), window_argument(window)
+    dispersion, hoop, pdf, progress, diagnose = (flag_argument(k, v) for k, v in (
+        ("dispersion", dispersion), ("hoop", hoop), ("pdf", pdf), ("progress", progress), ("diagnose", diagnose)))
     rr = run_file(path, priors_path=priors, out_dir=out_dir, seed=seed, window=window, dispersion=dispersion,
                   hoop=hoop, pdf=pdf, progress=progress, table=progress, notes=progress, diagnose=diagnose)
     res = read_result(rr.outputs["json"])
@@ -143,6 +154,9 @@ def diagnose(path: str | os.PathLike[str], **options: Any) -> Result:
     Takes the options of :func:`run`; the JSON then holds a ``discrepancy`` block and ``f`` is the f
     under the named causes (docs/outputs.md).
     """
+    unknown = sorted(set(options) - {"priors", "out_dir", "seed", "window", "dispersion", "hoop", "pdf", "progress"})
+    if unknown:
+        raise TypeError(f"diagnose() got unexpected keyword argument(s): {', '.join(unknown)}")
     return run(path, **{**options, "diagnose": True})
 
 
@@ -155,7 +169,7 @@ def campaign(records: Sequence[str | os.PathLike[str]], out_dir: str | os.PathLi
     Parameters
     ----------
     records
-        Record files or folders of them.
+        Record files or folders of them (one path, or a list).
     out_dir
         Receives ``campaign.json``, ``campaign.nc``, ``campaign.pdf`` and ``records/`` (one run each).
     workers, scheduler
@@ -167,8 +181,14 @@ def campaign(records: Sequence[str | os.PathLike[str]], out_dir: str | os.PathLi
         ``.doc`` is the campaign's JSON document, ``.outputs`` the files written; each record's
         result reads back with :func:`read_result` from ``out_dir/records``.
     """
+    from .api_arguments import flag_argument, path_argument, paths_argument, scheduler_argument, workers_argument
     from .campaigns import run_campaign
 
+    records, out_dir = paths_argument("records", records), path_argument("out_dir", out_dir)
+    priors, workers = path_argument("priors", priors, optional=True), workers_argument(workers)
+    scheduler = scheduler_argument(scheduler)
+    dispersion, hoop, pdf, diagnose, progress = (flag_argument(k, v) for k, v in (
+        ("dispersion", dispersion), ("hoop", hoop), ("pdf", pdf), ("diagnose", diagnose), ("progress", progress)))
     return run_campaign(records, out_dir, workers=workers, scheduler=scheduler, seed=seed, priors_path=priors,
                         dispersion=dispersion, hoop=hoop, pdf=pdf, diagnose=diagnose, progress=progress)
 
@@ -180,5 +200,7 @@ def import_scope_files(files: Sequence[str | os.PathLike[str]], setup: str | os.
     Returns the :class:`friction_uq.acquisition.ImportOutcome` (path written, samples, warnings).
     """
     from .acquisition import import_scope_files as _import
+    from .api_arguments import flag_argument, path_argument, paths_argument
 
-    return _import(files, setup, output, check=check)
+    return _import(paths_argument("files", files), path_argument("setup", setup), path_argument("output", output),
+                   check=flag_argument("check", check))

@@ -67,3 +67,50 @@ def test_example_imports_a_csv_runs_and_draws_a_figure(tmp_path):
     res = fu.read_result(tmp_path / "A_A-03.json")
     assert res.datatree()["posterior"]["f"].shape[0] >= 1
     assert "f = " in r.stdout and "eti90" in r.stdout
+
+
+R = ROOT / "data" / "A" / "A-01.h5"
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda o: fu.run(5, out_dir=o), "path: must be a path (text or os.PathLike), got int 5"),
+    (lambda o: fu.run(str(R).encode(), out_dir=o), "path: must be a path"),
+    (lambda o: fu.run([R], out_dir=o), "path: must be a path"),
+    (lambda o: fu.run(R, out_dir=5), "out_dir: must be a path"),
+    (lambda o: fu.run(R, out_dir=""), "write '.' for the current folder"),
+    (lambda o: fu.run(R, out_dir=o, priors=""), "priors: must be a path"),
+    (lambda o: fu.run(R, out_dir=o, window="400us:600us"), "window: must be (t0, t1)"),
+    (lambda o: fu.run(R, out_dir=o, window=(4e-4, 5e-4, 6e-4)), "window: must be (t0, t1)"),
+    (lambda o: fu.run(R, out_dir=o, window=("4e-4", "6e-4")), "window: must be (t0, t1)"),
+    (lambda o: fu.run(R, out_dir=o, window=(4e-4, float("nan"))), "window: must be (t0, t1)"),
+    (lambda o: fu.run(R, out_dir=o, hoop="no"), "hoop: must be True or False, got str 'no'"),
+    (lambda o: fu.diagnose(R, out_dir=o, pdf=None), "pdf: must be True or False"),
+    (lambda o: fu.campaign(str(R), o, workers="2"), "workers: must be a whole number of at least 1, got str"),
+    (lambda o: fu.campaign([R], o, workers=1.5), "workers: must be a whole number"),
+    (lambda o: fu.campaign([R], o, scheduler=5), "scheduler: must be a Dask scheduler's address"),
+    (lambda o: fu.campaign(5, o), "records: must be a path or a list of paths"),
+    (lambda o: fu.campaign([R, None], o), "records[1]: must be a path"),
+    (lambda o: fu.campaign([R], o, diagnose="no"), "diagnose: must be True or False"),
+    (lambda o: fu.import_scope_files("x.csv", "SETUP.toml", o / "x.h5", check="no"), "check: must be True or False"),
+    (lambda o: fu.read_result(5), "path: must be a path"),
+    (lambda o: fu.read_result(""), "path: must be a path"),
+])
+def test_arguments_of_the_wrong_type_are_refused_in_one_sentence_before_any_work(tmp_path, call, words):
+    """Not a TypeError from deep inside, and not read as something else: the string 'no' is true, and one path
+    given to campaign was walked character by character (from '/', the whole file system)."""
+    out = tmp_path / "out"
+    with pytest.raises(FrictionUQError) as info:
+        call(out)
+    assert words in str(info.value) and "\n" not in str(info.value)
+    assert not out.exists()
+
+
+def test_read_result_refuses_a_json_without_what_it_exposes(tmp_path):
+    (tmp_path / "a.json").write_text(json.dumps({"schema": "friction-uq/run-result"}))
+    with pytest.raises(FrictionUQError, match=r"a.json: not a run result: key 'f'"):
+        fu.read_result(tmp_path / "a.json")
+    (tmp_path / "b.json").write_text(json.dumps({"schema": "friction-uq/run-result", "f": {}, "warnings": "abc"}))
+    with pytest.raises(FrictionUQError, match=r"b.json: key 'warnings' must be a list of sentences"):
+        fu.read_result(tmp_path / "b.json")
+    with pytest.raises(TypeError, match=r"diagnose\(\) got unexpected keyword argument\(s\): bogus"):
+        fu.diagnose(R, bogus=1)
