@@ -57,24 +57,35 @@ def test_up_to_date_needs_same_record_settings_prior_version_and_outputs(tmp_pat
     (tmp_path / "A_A-01.nc").write_bytes(b"draws")  # the run JSON names the .nc's checksum
     from friction_uq.record_run.outputs import RUN_SCHEMA_VERSION
 
-    run_json = {"schema_version": RUN_SCHEMA_VERSION, "outputs": {"netcdf": {
-        "file": "A_A-01.nc", "sha256": hashlib.sha256(b"draws").hexdigest()}, "pdf": None}}
+    run_json = {"schema_version": RUN_SCHEMA_VERSION, "record_sha256": "ab" * 32, "campaign": "A", "test_id": "A-01",
+                "outputs": {"netcdf": {"file": "A_A-01.nc", "sha256": hashlib.sha256(b"draws").hexdigest()},
+                            "pdf": None}}
     (tmp_path / "A_A-01.json").write_text(json.dumps(run_json | {"schema_version": RUN_SCHEMA_VERSION - 1}))
     old = _result(outputs={"json": "A_A-01.json", "netcdf": "A_A-01.nc"})
-    assert not _up_to_date(old, _result(status="failed"), tmp_path)  # an older run's JSON: its keys meant other things
+    stem = "A_A-01"
+    assert not _up_to_date(old, _result(status="failed"), tmp_path, stem)  # an older run's JSON: other meanings
     (tmp_path / "A_A-01.json").write_text(json.dumps(run_json))
-    assert _up_to_date(old, _result(status="failed"), tmp_path)
+    assert _up_to_date(old, _result(status="failed"), tmp_path, stem) == run_json  # its run's document
     for change in ({"record_sha256": "ff" * 32}, {"prior_sha256": "ee" * 32}, {"friction_uq_version": "0.0.1"},
                    {"settings": old.settings | {"seed": 6}}, {"settings": old.settings | {"dispersion": True}}):
-        assert not _up_to_date(old, dataclasses.replace(old, **change), tmp_path), change
-    assert not _up_to_date(dataclasses.replace(old, status="failed"), old, tmp_path)
+        assert _up_to_date(old, dataclasses.replace(old, **change), tmp_path, stem) is None, change
+    assert _up_to_date(dataclasses.replace(old, status="failed"), old, tmp_path, stem) is None
     with_pdf = dataclasses.replace(old, settings=old.settings | {"pdf": True})
-    assert _up_to_date(with_pdf, old, tmp_path)  # a run with the report serves one without
-    assert not _up_to_date(old, with_pdf, tmp_path)
+    assert _up_to_date(with_pdf, old, tmp_path, stem) is not None  # a run with the report serves one without
+    assert _up_to_date(old, with_pdf, tmp_path, stem) is None
+    # a stored result edited to another test's id or to another record's outputs is not this record's: redone
+    assert _up_to_date(dataclasses.replace(old, test_id="Z-99"), old, tmp_path, stem) is None
+    (tmp_path / "A_A-02.json").write_text(json.dumps(run_json | {"test_id": "A-02"}))
+    (tmp_path / "A_A-02.nc").write_bytes(b"draws")
+    other = dataclasses.replace(old, outputs={"json": "A_A-02.json", "netcdf": "A_A-02.nc"})
+    assert _up_to_date(other, old, tmp_path, stem) is None
+    (tmp_path / "A_A-01.json").write_text(json.dumps(run_json | {"record_sha256": "ff" * 32}))  # another record's run
+    assert _up_to_date(old, old, tmp_path, stem) is None
+    (tmp_path / "A_A-01.json").write_text(json.dumps(run_json))
     (tmp_path / "A_A-01.nc").write_bytes(b"drawz")  # changed since its run: redone
-    assert not _up_to_date(old, old, tmp_path)
+    assert _up_to_date(old, old, tmp_path, stem) is None
     (tmp_path / "A_A-01.json").unlink()
-    assert not _up_to_date(old, old, tmp_path)
+    assert _up_to_date(old, old, tmp_path, stem) is None
 
 
 @pytest.fixture(scope="module")
@@ -145,3 +156,24 @@ def test_a_rerun_skips_what_is_up_to_date(scheduler_campaign, capsys):
     assert doc["counts"] == {"done": 0, "skipped": 2, "failed": 1}
     err = capsys.readouterr().err
     assert "campaign: 2 done (2 up to date), 1 failed, 0 left" in err
+
+
+def test_a_stored_result_edited_is_read_from_its_run_or_redone(scheduler_campaign, capsys):
+    """A stored result's summary is its run JSON's, not its own copy's: emptied or made text, the skip reads the
+    run back (these were an internal error and a half-written campaign); its test id changed, the record is
+    analysed again."""
+    _, d, out, address, _ = scheduler_campaign
+    stored = out / "records" / "S_S-01.result.json"
+    before = read_result(stored).summary
+    doc = json.loads(stored.read_text())
+    doc["summary"] = {"V": {"mean": "abc"}}
+    stored.write_text(json.dumps(doc))
+    assert main(["campaign", str(d), "--out", str(out), "--scheduler", address, "--no-pdf", "--quiet"]) == 1
+    counts = json.loads((out / "campaign.json").read_text())["counts"]
+    assert counts == {"done": 0, "skipped": 2, "failed": 1} and read_result(stored).summary == before
+    doc = json.loads(stored.read_text())
+    doc["test_id"] = "Z-99"
+    stored.write_text(json.dumps(doc))
+    assert main(["campaign", str(d), "--out", str(out), "--scheduler", address, "--no-pdf", "--quiet"]) == 1
+    counts = json.loads((out / "campaign.json").read_text())["counts"]
+    assert counts == {"done": 1, "skipped": 1, "failed": 1} and read_result(stored).test_id == "S-01"

@@ -159,38 +159,57 @@ def write_result(result: RecordResult, path: str | os.PathLike[str]) -> Path:
     return Path(path)
 
 
-def _up_to_date(old: RecordResult, new: RecordResult, out_dir: Path) -> bool:
+def _up_to_date(old: RecordResult, new: RecordResult, out_dir: Path, stem: str) -> dict[str, Any] | None:
+    """The stored run's JSON document when the stored result is of this record (its bytes, campaign and test id),
+    its analysis settings, prior and friction-uq version, and its outputs are this record's and intact
+    (:func:`_outputs_intact`); else None (the record is analysed again)."""
     # a run with the PDF report also serves a campaign without one (not the other way round)
     analysis = {k: v for k, v in old.settings.items() if k != "pdf"} == {k: v for k, v in new.settings.items()
                                                                         if k != "pdf"}
     pdf_ok = old.settings.get("pdf", False) or not new.settings.get("pdf", False)
     same = (old.ok and old.record_sha256 == new.record_sha256 and analysis and pdf_ok
-            and old.prior_sha256 == new.prior_sha256 and old.friction_uq_version == new.friction_uq_version)
-    return same and _outputs_intact(old, out_dir)
+            and old.prior_sha256 == new.prior_sha256 and old.friction_uq_version == new.friction_uq_version
+            and (old.campaign, old.test_id) == (new.campaign, new.test_id))
+    named = {"json": f"{stem}.json", "netcdf": f"{stem}.nc", "pdf": f"{stem}.pdf"}
+    if not same or any(name != named.get(kind) for kind, name in old.outputs.items()):
+        return None  # another record's outputs named in an edited result, or a stale one
+    doc = _outputs_intact(old, out_dir)
+    if doc is None or (doc.get("record_sha256"), doc.get("campaign"), doc.get("test_id")) != (
+            new.record_sha256, new.campaign, new.test_id):
+        return None
+    return doc
 
 
-def _outputs_intact(old: RecordResult, out_dir: Path) -> bool:
-    """The stored outputs are there, are the bytes their run wrote (the run JSON names the sha256 of the ``.nc``
-    and the ``.pdf``) and the run JSON is of this package's schema version. Anything missing, unreadable, changed
-    or older: False (the record is analysed again)."""
+def _outputs_intact(old: RecordResult, out_dir: Path) -> dict[str, Any] | None:
+    """The stored run's JSON document when the stored outputs are there, are the bytes their run wrote (the run
+    JSON names the sha256 of the ``.nc`` and the ``.pdf``) and the run JSON is of this package's schema version.
+    Anything missing, unreadable, changed or older: None."""
     try:
         if not all((out_dir / name).is_file() for name in old.outputs.values()):
-            return False
+            return None
         doc = json.loads((out_dir / old.outputs["json"]).read_text())
         from ..record_run.outputs import RUN_SCHEMA_VERSION
 
         if doc.get("schema_version") != RUN_SCHEMA_VERSION:  # written by an older run: its keys meant other things
-            return False
+            return None
         for kind in ("netcdf", "pdf"):
             if kind not in old.outputs:
                 continue
             named = doc["outputs"][kind]
             if named is None or named["file"] != old.outputs[kind] or \
                     file_sha256(out_dir / named["file"]) != named["sha256"]:
-                return False
-        return "netcdf" in old.outputs
+                return None
+        return doc if "netcdf" in old.outputs else None
     except (OSError, KeyError, TypeError, ValueError):
-        return False
+        return None
+
+
+def _from_run_json(doc: dict[str, Any]) -> dict[str, Any]:
+    """What a record result takes from its run's JSON: the summaries, convergence, causes and window halves (a
+    stored result is read back from the run it names, not from its own copy, which an edit could change)."""
+    return {"summary": _summary(doc), "converged": bool(doc.get("converged")),
+            "causes": [c["name"] for c in doc["discrepancy"]["causes"]] if "discrepancy" in doc else None,
+            "window_halves": doc.get("window_halves")}
 
 
 def _summary(doc: dict[str, Any]) -> dict[str, dict[str, float]]:
@@ -233,11 +252,14 @@ def run_record(task: RecordTask) -> RecordResult:
         if stored.exists():
             try:  # a stored result that cannot be read, or holds values of the wrong kind, is redone
                 old = read_result(stored)
-                fresh = _up_to_date(old, base, out)
+                run_doc = _up_to_date(old, base, out, stem)
+                if run_doc is not None:
+                    kept = dataclasses.replace(old, **_from_run_json(run_doc))
+                    if kept != old:  # the stored copy was edited: restored from its run
+                        write_result(kept, stored)
+                    return dataclasses.replace(kept, status="skipped", path=str(task.path))
             except (FrictionUQError, TypeError, ValueError, AttributeError, KeyError):
-                fresh = False
-            if fresh:
-                return dataclasses.replace(old, status="skipped", path=str(task.path))
+                pass
         buf_out, buf_err = io.StringIO(), io.StringIO()
         for attempt in range(LOCK_WAIT_S + 1):
             try:
@@ -253,11 +275,9 @@ def run_record(task: RecordTask) -> RecordResult:
         doc = json.loads(run.outputs["json"].read_text())
         notes = [line.removeprefix("friction-uq: note: ") for line in buf_err.getvalue().splitlines() if line.strip()]
         result = dataclasses.replace(
-            base, status="done", outputs={k: p.name for k, p in run.outputs.items()}, summary=_summary(doc),
-            converged=bool(doc.get("converged")), notes=notes, seconds=time.perf_counter() - t0,
-            cpu_seconds=time.process_time() - c0, peak_rss_mb=_peak_rss_mb(),
-            causes=[c["name"] for c in doc["discrepancy"]["causes"]] if "discrepancy" in doc else None,
-            window_halves=doc.get("window_halves"))
+            base, status="done", outputs={k: p.name for k, p in run.outputs.items()}, notes=notes,
+            seconds=time.perf_counter() - t0, cpu_seconds=time.process_time() - c0, peak_rss_mb=_peak_rss_mb(),
+            **_from_run_json(doc))
         write_result(result, stored)
         return result
     except FrictionUQError as exc:
