@@ -190,6 +190,8 @@ def _simulate(args: argparse.Namespace) -> int:
         raise OutputError("simulate: give -o RECORD.h5, --compare PAGES.pdf, or both")
     if args.output is not None:
         output_file(args.output, RECORD_SUFFIXES, "record")
+        if args.config.exists() and args.output.exists() and args.output.resolve() == args.config.resolve():
+            raise OutputError(f"{args.output}: is the configuration being read; write the record to another file")
     if args.compare is not None:
         output_file(args.compare, (".pdf",), "comparison")
     config_file(args.config)

@@ -19,11 +19,12 @@ HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 def seed_argument(text: str) -> int:
-    """A seed in decimal ("010" is 10; "0x10" is refused, not read in another base)."""
-    try:
-        v = int(text, 10)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"seed {text!r} is not a decimal integer") from None
+    """A seed in decimal ASCII digits ("010" is 10; "0x10", "5_000" and other scripts' digits are refused, not read
+    another way)."""
+    digits = text.strip()
+    if not (digits.isascii() and digits.lstrip("+-").isdigit() and len(digits) - len(digits.lstrip("+-")) <= 1):
+        raise argparse.ArgumentTypeError(f"seed {text!r} is not a decimal integer (digits 0-9 only)")
+    v = int(digits, 10)
     if not 0 <= v < 2**64:
         raise argparse.ArgumentTypeError(f"seed must be an integer in [0, 2**64), got {text}")
     return v

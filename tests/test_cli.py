@@ -118,3 +118,22 @@ def test_simulate_refuses_a_config_with_a_typo(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "bad.toml" in err[0] and "colomb" in err[0] and "coulomb" in err[0]
     assert not out.exists()
+
+
+def test_simulate_does_not_write_over_its_own_configuration(tmp_path, capsys):
+    """A configuration named .h5 given as its own output was overwritten by the record."""
+    cfg = tmp_path / "t.h5"
+    text = '[record]\ntest_id = "T-1"\ncampaign = "T"\nseed = 5\n'
+    cfg.write_text(text)
+    assert main(["simulate", str(cfg), "-o", str(cfg)]) == 2
+    assert "is the configuration being read" in capsys.readouterr().err
+    assert cfg.read_text() == text
+
+
+def test_the_simulation_seed_is_checked_as_every_seed():
+    from friction_uq.errors import SeedError
+    from friction_uq.simulate import SimulationConfig, simulate
+
+    for bad in (-1, 1.5, True, 2**64, "5"):
+        with pytest.raises(SeedError, match="seed: must be an integer in"):
+            simulate(SimulationConfig(), seed=bad)

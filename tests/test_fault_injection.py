@@ -464,6 +464,9 @@ def test_compare_of_tests_at_one_speed_fits_no_trend_it_cannot(tmp_path, capsys)
 def test_seed_out_of_range_is_a_usage_error(good_record, tmp_path, capsys):
     assert _code(["campaign", good_record, "--out", tmp_path / "c", "--seed", "-1"]) == 2
     assert "seed must be an integer in [0, 2**64), got -1" in _one_sentence(capsys)
+    for text in ("5_000", "\u0665", "0x10", "1e3", "+-1"):  # read another way by int(): refused
+        assert _code(["campaign", good_record, "--out", tmp_path / "c", "--seed", text]) == 2
+        assert f"seed {text!r} is not a decimal integer" in _one_sentence(capsys)
 
 
 def test_an_unexpected_error_is_one_line(monkeypatch, good_record, capsys):

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..physics.cell import beta as janssen_beta
+from ..errors import check_seed
 from ..record import write_record
 from .config import SimulationConfig
 from .measurement import measure
@@ -56,9 +57,7 @@ class Simulation:
 def resolve_seed(seed: int | None, config: SimulationConfig) -> int:
     """The seed to use: the argument, else the configuration's, else fresh entropy (a 63-bit int)."""
     if seed is not None:
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
-        return int(seed)
+        return check_seed(seed, what="seed")  # one sentence (SeedError), the range numpy's SeedSequence takes
     if config.seed is not None:
         return config.seed
     return int(np.random.SeedSequence().entropy % (2**63))
