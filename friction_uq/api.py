@@ -61,13 +61,16 @@ class Result:
 
     def datatree(self) -> Any:
         """The posterior, prior, log-likelihood and observed data as an ``xarray.DataTree`` (ArviZ reads it)."""
-        if self.netcdf_path is None or not self.netcdf_path.is_file():
-            from .errors import FrictionUQError
+        from .errors import FrictionUQError
 
+        if self.netcdf_path is None or not self.netcdf_path.is_file():
             raise FrictionUQError(f"{self.json_path}: its netCDF file ({self.netcdf_path}) is missing")
         import xarray as xr
 
-        return xr.open_datatree(self.netcdf_path, engine="h5netcdf")
+        try:
+            return xr.open_datatree(self.netcdf_path, engine="h5netcdf")
+        except (OSError, ValueError) as exc:  # not HDF5, truncated, or not a netCDF of groups
+            raise FrictionUQError(f"{self.netcdf_path}: not a readable netCDF file ({exc})") from None
 
 
 def read_result(path: str | os.PathLike[str]) -> Result:

@@ -47,6 +47,9 @@ def test_read_result_reads_the_json_and_refuses_others(tmp_path):
     assert res.f["q50"] == 0.05 and res.warnings == ["w"] and res.test_id == "A-03"
     with pytest.raises(FrictionUQError, match=r"A_A-03.json: its netCDF file .* is missing"):
         res.datatree()
+    (tmp_path / "A_A-03.nc").write_bytes(b"not a netCDF file")
+    with pytest.raises(FrictionUQError, match=r"A_A-03.nc: not a readable netCDF file"):
+        fu.read_result(tmp_path / "A_A-03.json").datatree()
     (tmp_path / "x.json").write_text(json.dumps({"schema": "friction-uq/campaign"}))
     with pytest.raises(FrictionUQError, match=r"x.json: not a run result"):
         fu.read_result(tmp_path / "x.json")
