@@ -127,30 +127,26 @@ def window_argument(text: str) -> tuple[float, float]:
     return vals[0], vals[1]
 
 
-def striker_velocity_argument(text: str) -> float:
+def _plausible_number(text: str, label: str, key: str) -> float:
+    """``text`` as a number inside its plausible range (:data:`friction_uq.plausible.RANGES` ``key``)."""
     from .plausible import out_of_range
 
     try:
         v = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"striker velocity {text!r} is not a number") from None
-    problem = out_of_range("striker_velocity", v)
+        raise argparse.ArgumentTypeError(f"{label} {text!r} is not a number") from None
+    problem = out_of_range(key, v)
     if problem:
-        raise argparse.ArgumentTypeError(f"striker velocity {problem}")
+        raise argparse.ArgumentTypeError(f"{label} {problem}")
     return v
+
+
+def striker_velocity_argument(text: str) -> float:
+    return _plausible_number(text, "striker velocity", "striker_velocity")
 
 
 def nu_argument(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"nu {text!r} is not a number") from None
-    from .plausible import out_of_range
-
-    problem = out_of_range("sample.poisson_ratio", v)
-    if problem:
-        raise argparse.ArgumentTypeError(f"nu {problem}")
-    return v
+    return _plausible_number(text, "nu", "sample.poisson_ratio")
 
 
 def workers_argument(text: str) -> int:
