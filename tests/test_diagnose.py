@@ -813,6 +813,8 @@ class _RoundsDiagnoser:
     model's blocks are the reference's plus what its last mechanism adds (``gain``: per block), its f the reference's
     times ``shift`` (the fits are what they are resolved to)."""
 
+    gauges = ("input_bar", "internal_output_bar", "external_output_bar", "tube_hoop")
+
     def __init__(self, gain, shift):
         self.gain, self.shift = gain, shift
 
@@ -866,7 +868,7 @@ def test_a_later_round_within_the_checks_tolerance_names_a_chain_entry_only_if_i
     flags = iter([True, False, False])
     monkeypatch.setattr(dmod, "compare_whole_record", lambda prep, predicted: None)
     monkeypatch.setattr(dmod, "decide", lambda comparison: SimpleNamespace(detected=next(flags)))
-    monkeypatch.setattr(dmod, "candidates", lambda exclude=(): [
+    monkeypatch.setattr(dmod, "candidates", lambda exclude=(), gauges=None: [
         variant(m) for m in ("clearance", later, "dispersion") if m.partition("[")[0] not in exclude])
     mech = later.partition("[")[0]
     dg = _RoundsDiagnoser({"clearance": 2.0, mech: 1.0}, {"clearance": 0.95, mech: shift})

@@ -240,6 +240,43 @@ def test_a_chain_fault_fitted_on_every_gauge_says_which_gauge():
     assert MECHANISMS["clearance"].departing_gauge({"gap": 1e-6}) is None
 
 
+def test_the_chain_faults_are_fitted_on_the_gauges_a_record_has():
+    from friction_uq.discrepancy.extended import candidates
+    from friction_uq.discrepancy.mechanisms import MECHANISMS
+
+    bars = ("input_bar", "internal_output_bar", "external_output_bar")
+    drift = MECHANISMS["zero_drift"].on_gauges(bars)
+    assert drift.per_gauge == bars and [p.name for p in drift.parameters] == [f"drift_{g}" for g in bars]
+    assert set(drift.priors) == set(drift.start) == {f"drift_{g}" for g in bars}
+    assert MECHANISMS["bandwidth"].on_gauges(("input_bar",)) is None  # read against the input bar: nothing left
+    assert MECHANISMS["clearance"].on_gauges(("input_bar",)) is MECHANISMS["clearance"]  # the cell's own: whole
+    assert MECHANISMS["gauge_gain"].on_gauges(bars[:2]).channels == bars[:2]
+    every = {p.name for v in candidates() for p in v.mechanism.parameters}
+    without = {p.name for v in candidates(gauges=bars) for p in v.mechanism.parameters}
+    assert every - without == {"drift_tube_hoop", "delay_tube_hoop", "time_constant_tube_hoop"}
+    assert [v.label for v in candidates()] == [v.label for v in candidates(gauges=bars)]
+
+
+def test_a_record_read_without_its_hoop_gauge_gets_no_hoop_parameter(chain_records):
+    from friction_uq.analysis import prepare
+    from friction_uq.discrepancy.extended import Diagnoser, candidates
+    from friction_uq.prior_loader import default_prior_path, load_priors
+    from friction_uq.record import read_record
+
+    priors = load_priors(default_prior_path("I1"))
+
+    def log_prior(v):
+        return float(priors["f"].logpdf(np.array(v["f"])) + priors["nu"].logpdf(np.array(v["nu"])))
+
+    dg = Diagnoser(prepare(read_record(chain_records["late"])), log_prior, hoop=False, seed=5, n_draws=60)
+    assert "tube_hoop" not in dg.gauges
+    timing = next(v for v in candidates(gauges=dg.gauges) if v.mechanism.name == "channel_timing")
+    mf = dg.fit((timing,), {"f": 0.05, "nu": 0.4}, "channel_timing")
+    assert "delay_tube_hoop" not in mf.fit.draws and "delay_internal_output_bar" in mf.fit.draws
+    d = mf.fit.draws["delay_external_output_bar"]
+    assert np.quantile(d, 0.005) <= 4e-6 <= np.quantile(d, 0.995)
+
+
 def test_an_output_bar_stiffer_than_its_header_is_measured(chain_records):
     mf, delpd, se = _fits(chain_records["stiff"], ("bar_modulus",))["bar_modulus"]
     k = mf.fit.draws["modulus_factor_external_output_bar"]

@@ -44,8 +44,9 @@ def _chain_fault(name: str, field: str, gauges: tuple[str, ...], *, unit: str, l
     gauge (the :class:`~friction_uq.models.measurement_chain.Reading` field it sets; ``what``: its meaning, with
     ``{gauge}`` for the gauge), the same prior and start for each."""
     def apply(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
-        for gauge in gauges:
-            setattr(g[gauge], field, float(v[f"{field}_{gauge}"]))
+        for gauge in gauges:  # the gauges the record has (:meth:`Mechanism.on_gauges` drops the others' parameters)
+            if f"{field}_{gauge}" in v:
+                setattr(g[gauge], field, float(v[f"{field}_{gauge}"]))
 
     return Mechanism(
         name=name, meaning=meaning, signature=signature,
@@ -61,6 +62,8 @@ OUTPUT_BARS = ("internal_output_bar", "external_output_bar")
 def _bar_modulus(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
     app = s["apparatus"]
     for name in OUTPUT_BARS:
+        if f"modulus_factor_{name}" not in v:  # a bar whose gauge the record does not read
+            continue
         k = float(v[f"modulus_factor_{name}"])
         bar = getattr(app, name)
         app = replace(app, **{name: replace(bar, young_modulus=bar.young_modulus * k,

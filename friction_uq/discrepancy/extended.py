@@ -36,6 +36,7 @@ from .block_loo import Elpd, calibration_loo, takeuchi_block_loo, with_calibrati
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
 from .mechanisms import MECHANISMS, Context, Mechanism
 from .nu_cut import CutFit, conditional_fit, window_nu
+from .whole_record import CHANNEL_LABELS
 
 #: Block of the leave-one-block-out ELPD (s).
 BLOCK = 10e-6
@@ -101,6 +102,8 @@ class Diagnoser:
         self.loading = measured_loading(rec, prep.forces)
         self.dispersive_loading = measured_loading(rec, prep.forces, dispersion=True)  # for ``dispersion``
         self.hoop = hoop and rec.has_hoop
+        #: the gauges the record is read by: the measurement chain's entries are fitted on these
+        self.gauges = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or self.hoop))
         self.log_prior_f_nu = log_prior_f_nu
         self.seed = seed
         self.n_draws = n_draws
@@ -290,13 +293,16 @@ class Diagnoser:
         return float(f)
 
 
-def candidates(exclude: tuple[str, ...] = ()) -> list[Variant]:
+def candidates(exclude: tuple[str, ...] = (), gauges: tuple[str, ...] | None = None) -> list[Variant]:
     """Every mechanism of the catalogue as fitted (gauge_gain once per gauge), minus ``exclude`` and
-    the other members of an excluded mechanism's group (one friction law at a time)."""
+    the other members of an excluded mechanism's group (one friction law at a time). ``gauges``: the gauges
+    the record is read by (:attr:`Diagnoser.gauges`): the measurement chain's entries on those only (None: all)."""
     out: list[Variant] = []
     groups = {MECHANISMS[n].group for n in exclude if MECHANISMS[n].group}
-    for m in MECHANISMS.values():
-        if m.name in exclude or (m.group is not None and m.group in groups):
+    for entry in MECHANISMS.values():
+        if entry.name in exclude or (entry.group is not None and entry.group in groups):
             continue
-        out += [Variant(m, ch) for ch in m.channels] if m.channels else [Variant(m)]
+        m = entry if gauges is None else entry.on_gauges(gauges)
+        if m is not None:
+            out += [Variant(m, ch) for ch in m.channels] if m.channels else [Variant(m)]
     return out

@@ -7,7 +7,7 @@ window's means it states its effective f at (:class:`Context`), and :func:`regis
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from scipy import stats
@@ -63,6 +63,24 @@ class Mechanism:
 
     def log_prior(self, values: Mapping[str, float]) -> float:
         return float(sum(self.priors[p.name].logpdf(values[p.name]) for p in self.parameters))
+
+    def on_gauges(self, gauges: tuple[str, ...]) -> Mechanism | None:
+        """This entry as fitted on a record read by ``gauges`` only (a record without a hoop gauge, or analysed
+        without it): a chain fault keeps the parameters of the gauges there (with none left, None), a gain the
+        channels there; an entry of the cell is itself. A parameter of a gauge that is not read has no data: its
+        posterior would be its prior, reported as if the gauge had been fitted."""
+        if not (self.per_gauge or self.channels):
+            return self
+        channels = tuple(c for c in self.channels if c in gauges)
+        kept = tuple((g, p) for g, p in zip(self.per_gauge, self.parameters) if g in gauges)
+        if not (channels or kept):
+            return None
+        if not self.per_gauge:
+            return replace(self, channels=channels)
+        names = {p.name for _, p in kept}
+        return replace(self, per_gauge=tuple(g for g, _ in kept), parameters=tuple(p for _, p in kept),
+                       priors={k: v for k, v in self.priors.items() if k in names},
+                       start={k: v for k, v in self.start.items() if k in names})
 
     def departing_gauge(self, values: Mapping[str, float]) -> tuple[str, Parameter] | None:
         """For a fault fitted on every gauge at once (``per_gauge``): the gauge whose parameter lies furthest
