@@ -9,13 +9,12 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from .errors import ConfigError, FrictionUQError, OutputError, os_error_text
+from .errors import ConfigError, FrictionUQError, OutputError
 
 #: Figure formats of ``design -o`` and ``compare -o`` (matplotlib writes them without extra packages).
 FIGURE_SUFFIXES = (".pdf", ".png", ".svg", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp")
 #: Record file names ``simulate -o`` writes.
 RECORD_SUFFIXES = (".h5", ".hdf5")
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 def seed_argument(text: str) -> int:
@@ -46,27 +45,12 @@ def output_file(path: Path, suffixes: Sequence[str], what: str) -> None:
 
 def text_file(path: Path, what: str, error: type[FrictionUQError]) -> str:
     """The UTF-8 text of an input file, or one sentence saying why it is not one."""
-    from .plausible import MAX_TEXT_BYTES, not_regular
+    from .plausible import MAX_TEXT_BYTES, NotText, text_of
 
     try:
-        path.stat()  # a missing file: said below, as for any file that cannot be read
-        if odd := not_regular(path):
-            raise error(f"{path}: {odd}, not a {what}")
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_TEXT_BYTES + 1)
-    except OSError as exc:
-        raise error(f"{path}: cannot read the {what} ({os_error_text(exc)})") from None
-    if len(raw) > MAX_TEXT_BYTES:
-        raise error(f"{path}: is larger than {MAX_TEXT_BYTES} bytes, too large for a {what} (docs/limits.md)")
-    if raw.startswith(HDF5_SIGNATURE):
-        raise error(f"{path}: is an HDF5 file (a test record?), not a {what}")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise error(f"{path}: the {what} is not UTF-8 text (byte {exc.start}); save it as UTF-8") from None
-    if "\x00" in text:
-        raise error(f"{path}: the {what} contains NUL characters (a binary file?)")
-    return text
+        return text_of(path, what, MAX_TEXT_BYTES)
+    except NotText as why:
+        raise error(f"{path}: {why}") from None
 
 
 def config_file(path: Path) -> None:

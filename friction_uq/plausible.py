@@ -18,6 +18,8 @@ import stat
 import unicodedata
 from pathlib import Path
 
+from .errors import os_error_text
+
 #: (low, high, unit, what spans it) per quantity; bounds are inclusive.
 RANGES: dict[str, tuple[float, float, str, str]] = {
     "bar.young_modulus": (1e9, 1e12, "Pa", "polymer (PMMA 3 GPa) to tungsten carbide (700 GPa) bars"),
@@ -93,6 +95,38 @@ def not_regular(path: Path) -> str | None:
     if stat.S_ISREG(mode):
         return None
     return "is a folder" if stat.S_ISDIR(mode) else "is not a regular file (a device or a pipe)"
+
+
+#: The first bytes of every HDF5 file (a test record given where a text file was asked for)
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+class NotText(ValueError):
+    """Why a file is not the text input it was given as: the words that follow its name (and its field)."""
+
+
+def text_of(path: Path, what: str, limit: int, *, encoding: str = "utf-8") -> str:
+    """The text of an input file (a prior file, a set-up, a configuration, a result) read up to ``limit`` bytes and
+    decoded with ``encoding``; else :class:`NotText` in a few words naming ``what`` it was given as: not a regular
+    file, unreadable, too large (from at most ``limit`` + 1 bytes read), a record, not UTF-8, NUL characters."""
+    if odd := not_regular(path):
+        raise NotText(f"{odd}, not a {what}")
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(limit + 1)
+    except OSError as exc:
+        raise NotText(f"cannot be read ({os_error_text(exc)})") from None
+    if len(raw) > limit:
+        raise NotText(f"is larger than {limit} bytes, too large for a {what} (docs/limits.md)")
+    if raw.startswith(HDF5_SIGNATURE):
+        raise NotText(f"is an HDF5 file (a test record?), not a {what}")
+    try:
+        text = raw.decode(encoding)
+    except UnicodeDecodeError as exc:
+        raise NotText(f"is not UTF-8 text (byte {exc.start}); save the {what} as UTF-8") from None
+    if "\x00" in text:
+        raise NotText(f"contains NUL characters (a binary file?), not a {what}")
+    return text
 
 
 def unprintable(text: str) -> str | None:

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from .errors import PriorError
-from .plausible import MAX_TEXT_BYTES, is_name, not_regular, toml_shape_problem
+from .plausible import MAX_TEXT_BYTES, NotText, is_name, text_of, toml_shape_problem
 from .priors import (DISTRIBUTIONS, MIN_MASS, MIN_PLAUSIBLE_MASS, PARAMETERS, PLAUSIBLE, REQUIRED_PARAMETERS,
                      TOP_LEVEL_KEYS, ParameterPrior, Priors, log_normal_mass)
 
@@ -126,23 +126,10 @@ def load_priors(path: str | Path) -> Priors:
         names the file, the key and the problem.
     """
     path = Path(path)
-    odd = not_regular(path)
-    if odd:
-        raise _fail(path, "file", f"{odd}, not a prior file")
     try:
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_PRIOR_BYTES + 1)
-    except OSError as exc:
-        raise _fail(path, "file", f"cannot be read ({exc.strerror or exc})") from None
-    if len(raw) > MAX_PRIOR_BYTES:
-        raise _fail(path, "file", f"is larger than {MAX_PRIOR_BYTES} bytes, not a prior file")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise _fail(path, "file", f"is not UTF-8 text (byte {exc.start}: {raw[exc.start:exc.start + 1]!r}); "
-                    "save it as UTF-8 TOML") from None
-    if "\x00" in text:
-        raise _fail(path, "file", "contains NUL characters: a binary file, not TOML")
+        text = text_of(path, "prior file", MAX_PRIOR_BYTES)
+    except NotText as why:
+        raise _fail(path, "file", str(why)) from None
     shape = toml_shape_problem(text)
     if shape:
         raise _fail(path, "file", f"{shape}, too deep for a prior file")

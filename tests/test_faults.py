@@ -225,6 +225,8 @@ def test_a_real_full_disk_is_one_sentence_and_leaves_nothing(record, tmp_path):
     (["run", "{rec}", "--priors", "{binary}"], "is not UTF-8 text"),
     (["run", "{rec}", "--priors", "{deep}"], "nested too deeply"),
     (["run", "{rec}", "--priors", "{tmp}"], "is a folder, not a prior file"),
+    (["run", "{rec}", "--priors", "{rec}"], "is an HDF5 file (a test record?), not a prior file"),
+    (["simulate", "{rec}", "-o", "{tmp}/x.h5"], "is an HDF5 file (a test record?), not a simulation configuration"),
     (["inspect", "{u16}"], "is not an HDF5 file"),
     (["analyze", "{tmp}"], "is a directory"),
 ])

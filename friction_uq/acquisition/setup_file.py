@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SetupError
-from ..plausible import not_regular
+from ..plausible import NotText, text_of
 from ..record.contract import CHANNELS, REQUIRED_CHANNELS
 
 #: Largest set-up file read (bytes).
@@ -305,20 +305,10 @@ def parse_setup(doc: dict, *, path: str | Path = "<setup>") -> Setup:
 def load_setup(path: str | Path) -> Setup:
     """Read and check a SETUP.toml; :class:`SetupError` names the file, the key and the problem."""
     p = Path(path)
-    odd = not_regular(p)
-    if odd:
-        raise _fail(p, "file", f"{odd}, not a set-up file")
     try:
-        with open(p, "rb") as fh:
-            raw = fh.read(MAX_SETUP_BYTES + 1)
-    except OSError as exc:
-        raise _fail(p, "file", f"cannot be read ({exc.strerror or exc})") from None
-    if len(raw) > MAX_SETUP_BYTES:
-        raise _fail(p, "file", f"is larger than {MAX_SETUP_BYTES} bytes, not a set-up file")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise _fail(p, "file", f"is not UTF-8 text (byte {exc.start}); save it as UTF-8") from None
+        text = text_of(p, "set-up file", MAX_SETUP_BYTES, encoding="utf-8-sig")  # a BOM: Windows' editors
+    except NotText as why:
+        raise _fail(p, "file", str(why)) from None
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
