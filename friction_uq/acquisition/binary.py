@@ -15,16 +15,25 @@ Siglent, Yokogawa
 npTDMS is a dependency of friction-uq (:mod:`.tdms` reads TDMS files); lecroyparser and RigolWFM come
 with the ``scopes`` extra (``pip install 'friction-uq[scopes]'``). Each trace carries its own time
 base (start and sample interval), so ``[time]`` may be left out of SETUP.toml for these files.
+
+The number of samples is checked against the sample limit of a record (docs/limits.md) before the
+samples are decoded, from what the file's header declares (:mod:`.declared`): a LeCroy trace's
+WAVEDESC descriptor, a Tektronix ISF header and curve block, a Tektronix WFM header. The other
+formats RigolWFM reads are checked as soon as RigolWFM has parsed them, before their samples are
+copied.
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..errors import ScopeFileError
+from ..plausible import MAX_SAMPLES
+from .declared import lecroy_declared, over_limit, rigolwfm_declared
 from .tdms import describe_tdms, read_tdms
 from .trace import MAX_BINARY_BYTES, Trace, check_size, need
 
@@ -50,6 +59,7 @@ def read_lecroy(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
     for col in columns:
         if col not in (1, "1"):
             raise ScopeFileError(f"{path}: a LeCroy .trc file holds one trace: give column = 1, not {col!r}")
+    lecroy_declared(path)  # the descriptor's counts, before lecroyparser decodes the samples
     try:
         d = lecroyparser.ScopeData(str(path))  # type: ignore[attr-defined]
     except Exception as exc:
@@ -60,25 +70,43 @@ def read_lecroy(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
     return {col: tr for col in columns}
 
 
-def read_rigolwfm(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
-    """Channels of a Tektronix, Rigol, Keysight, Siglent or Yokogawa waveform file (RigolWFM), in volts."""
+def _open_rigolwfm(path: Path) -> Any:
+    """The waveform file as RigolWFM parses it, once the counts its header declares are checked."""
     check_size(path)
     need("RigolWFM", path)
     import RigolWFM.wfm as wfm  # type: ignore[import-not-found]
 
+    rigolwfm_declared(path)
     try:
-        w = wfm.Wfm.from_file(str(path), "auto")
+        return wfm.Wfm.from_file(str(path), "auto")
     except Exception as exc:
         raise ScopeFileError(f"{path}: not a waveform file RigolWFM can read ({type(exc).__name__}: {exc})") from None
+
+
+def _pick_channel(path: Path, chans: list[Any], col: str | int) -> Any:
+    """The channel ``col`` names (its number or name), its length checked against the sample limit."""
+    key = str(col).upper().replace(" ", "")
+    hits = [c for c in chans if key in (str(c.channel_number), c.name.upper().replace(" ", ""))]
+    if not hits:
+        have = ", ".join(f"{c.channel_number} ({c.name})" for c in chans) or "none"
+        raise ScopeFileError(f"{path}: no channel {col!r} with data; the file has {have}")
+    c = hits[0]
+    if len(c.volts) > MAX_SAMPLES:
+        raise over_limit(path, f"channel {c.channel_number} ({c.name}), by the header's record length,",
+                         len(c.volts), "holds", MAX_SAMPLES)
+    return c
+
+
+def read_rigolwfm(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
+    """Channels of a Tektronix, Rigol, Keysight, Siglent or Yokogawa waveform file (RigolWFM), in volts.
+
+    Every channel asked for is picked and its length checked before any of them is copied.
+    """
+    w = _open_rigolwfm(path)
     chans = [c for c in w.channels if getattr(c, "volts", None) is not None and len(c.volts)]
+    picked = {col: _pick_channel(path, chans, col) for col in columns}
     out: dict[str | int, Trace] = {}
-    for col in columns:
-        key = str(col).upper().replace(" ", "")
-        hits = [c for c in chans if key in (str(c.channel_number), c.name.upper().replace(" ", ""))]
-        if not hits:
-            have = ", ".join(f"{c.channel_number} ({c.name})" for c in chans) or "none"
-            raise ScopeFileError(f"{path}: no channel {col!r} with data; the file has {have}")
-        c = hits[0]
+    for col, c in picked.items():
         t = np.asarray(c.times, dtype=np.float64)
         dt = _rate_digits((t[-1] - t[0]) / (len(t) - 1), 9) if len(t) > 1 else None
         out[col] = Trace(np.asarray(c.volts, dtype=np.float64), c.name, float(t[0]), dt)
@@ -105,13 +133,7 @@ def describe_binary(path: Path) -> list[str]:
         t = traces[1]
         return [f"{path}: LeCroy trace, column = 1",
                 f"  {t.label}: {len(t.values)} samples every {t.dt:.6g} s from {t.t0:.6g} s"]
-    need("RigolWFM", path)
-    import RigolWFM.wfm as wfm  # type: ignore[import-not-found]
-
-    try:
-        w = wfm.Wfm.from_file(str(path), "auto")
-    except Exception as exc:
-        raise ScopeFileError(f"{path}: not a waveform file RigolWFM can read ({type(exc).__name__}: {exc})") from None
+    w = _open_rigolwfm(path)
     out = [f"{path}: {w.header_name} waveform; column = the channel number"]
     for c in w.channels:
         if getattr(c, "volts", None) is not None and len(c.volts):
