@@ -17,8 +17,8 @@ from pathlib import Path
 
 from . import __version__, import_command, priors_command
 from .errors import FrictionUQError, OutputError, os_error_text
-from .cli_arguments import (FIGURE_SUFFIXES, RECORD_SUFFIXES, config_file, nu_argument, output_file, result_files,
-                            seed_argument, striker_velocity_argument, window_argument, workers_argument)
+from .cli_arguments import (FIGURE_SUFFIXES, RECORD_SUFFIXES, config_file, nu_argument, output_file, path_argument,
+                            result_files, seed_argument, striker_velocity_argument, window_argument, workers_argument)
 
 EXIT_BAD_INPUT = 2
 #: Exit status of an unexpected error (a bug), said in one line; FRICTION_UQ_TRACEBACK=1 shows its traceback.
@@ -45,11 +45,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("inspect", help="summarise a test record: ids, channels, apparatus, arrivals, noise",
                        description="Print a readable summary of a test record.")
-    s.add_argument("file", type=Path, help="test record (test.h5)")
+    s.add_argument("file", type=path_argument, help="test record (test.h5)")
 
     s = sub.add_parser("analyze", help="the lab's deterministic analysis (eq. 17) for a given nu",
                        description="Deterministic identification of f from eq. 17 over the stationary window.")
-    s.add_argument("file", type=Path, help="test record (test.h5)")
+    s.add_argument("file", type=path_argument, help="test record (test.h5)")
     s.add_argument("--nu", type=nu_argument, default=0.4, help="sample Poisson ratio (default 0.4)")
     s.add_argument("--window", type=window_argument, help="stationary window T0:T1 on the record's time base, in seconds or with a unit: 400us:600us, "
                        "0.4ms:0.6ms, 4e-4:6e-4 (default: automatic); write --window=T0:T1 when T0 is negative")
@@ -58,25 +58,26 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("design", help="draw the paper's figure 4 (p_mean and V against f) for a record",
                        description="Design relations eq. 15-16 for a record's apparatus and striker speed.")
-    s.add_argument("file", type=Path, help="test record (test.h5)")
-    s.add_argument("-o", "--output", type=Path, required=True, help="figure file (PDF or PNG)")
+    s.add_argument("file", type=path_argument, help="test record (test.h5)")
+    s.add_argument("-o", "--output", type=path_argument, required=True, help="figure file (PDF or PNG)")
     s.add_argument("--nu", type=nu_argument, default=0.4, help="sample Poisson ratio (default 0.4)")
     s.add_argument("--striker-velocity", type=striker_velocity_argument,
                    help="m/s (default: the record's, else from the incident wave)")
 
     s = sub.add_parser("simulate", help="simulate a whole test into a record",
                        description="Simulate a confined friction test from a TOML configuration.")
-    s.add_argument("config", type=Path, help="simulation configuration (TOML)")
-    s.add_argument("-o", "--output", type=Path, help="record to write (test.h5); required unless --compare")
+    s.add_argument("config", type=path_argument, help="simulation configuration (TOML)")
+    s.add_argument("-o", "--output", type=path_argument, help="record to write (test.h5); required unless --compare")
     s.add_argument("--seed", type=seed_argument, help="noise seed, 0 <= seed < 2**64 (default: the config's)")
-    s.add_argument("--compare", type=Path, metavar="PDF", help="also run the 1-D and the axisymmetric model on "
-                   "the configuration and draw them side by side per phase into this PDF (table on stdout)")
+    s.add_argument("--compare", type=path_argument, metavar="PDF",
+                   help="also run the 1-D and the axisymmetric model on the configuration and draw them side by side "
+                        "per phase into this PDF (table on stdout)")
 
     s = sub.add_parser("compare", help="compare tests across campaigns from run results (JSON)",
                        description="Table and figure of kappa and f against sliding velocity and wall "
                        "pressure for several tests, with weighted trend fits.")
-    s.add_argument("results", type=Path, nargs="+", help="<campaign>_<test_id>.json files written by run")
-    s.add_argument("-o", "--output", type=Path, help="figure file (PDF or PNG)")
+    s.add_argument("results", type=path_argument, nargs="+", help="<campaign>_<test_id>.json files written by run")
+    s.add_argument("-o", "--output", type=path_argument, help="figure file (PDF or PNG)")
 
     _add_campaign_parser(sub)
     import_command.add_parser(sub)
@@ -91,9 +92,10 @@ def build_parser() -> argparse.ArgumentParser:
                      "decisive. Same outputs as run, with a 'discrepancy' block.")
     for name, short, long in (run_help, diagnose_help):  # one job, one set of options
         s = sub.add_parser(name, help=short, description=long)
-        s.add_argument("file", type=Path, help="test record (test.h5)")
-        s.add_argument("--priors", type=Path, help="prior file (TOML; default: the package's <material>.toml)")
-        s.add_argument("--out", type=Path, default=Path("reports"), help="output directory (default reports/)")
+        s.add_argument("file", type=path_argument, help="test record (test.h5)")
+        s.add_argument("--priors", type=path_argument, help="prior file (TOML; default: the package's <material>.toml)")
+        s.add_argument("--out", type=path_argument, default=Path("reports"),
+                       help="output directory (default reports/)")
         s.add_argument("--seed", type=seed_argument, default=20161, help="random seed, 0 <= seed < 2**64 (default 20161)")
         s.add_argument("--window", type=window_argument, help="stationary window T0:T1 on the record's time base, in seconds or with a unit: 400us:600us, "
                        "0.4ms:0.6ms, 4e-4:6e-4 (default: automatic); write --window=T0:T1 when T0 is negative")
@@ -257,13 +259,13 @@ def _add_campaign_parser(sub) -> None:
                        "ELPD and flag set-ups off the shared law. Writes DIR/campaign.json, .nc, .pdf and "
                        "DIR/records/. Exit 0 when every record was analysed, 1 when some were refused (the "
                        "summary says why), 2 on bad input.")
-    s.add_argument("records", type=Path, nargs="*", help="record files (test.h5) or folders of them")
-    s.add_argument("--out", type=Path, required=True, help="campaign output directory")
+    s.add_argument("records", type=path_argument, nargs="*", help="record files (test.h5) or folders of them")
+    s.add_argument("--out", type=path_argument, required=True, help="campaign output directory")
     s.add_argument("--workers", type=workers_argument, default=2, help="local worker processes (default 2)")
     s.add_argument("--scheduler", help="address of a running Dask scheduler (e.g. tcp://10.0.0.5:8786) "
                    "instead of a local cluster")
     s.add_argument("--seed", type=seed_argument, default=20161, help="campaign seed, 0 <= seed < 2**64 (default 20161)")
-    s.add_argument("--priors", type=Path, help="prior file for every record (default: priors/<material>.toml)")
+    s.add_argument("--priors", type=path_argument, help="prior file for every record (default: priors/<material>.toml)")
     s.add_argument("--dispersion", action="store_true", help="apply the Pochhammer-Chree correction")
     s.add_argument("--no-hoop", action="store_true", help="leave the tube hoop gauge out of the likelihood")
     s.add_argument("--no-pdf", action="store_true", help="no per-record PDF reports (campaign.pdf is always written)")

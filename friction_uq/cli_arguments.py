@@ -43,6 +43,14 @@ def output_file(path: Path, suffixes: Sequence[str], what: str) -> None:
             break
 
 
+def path_argument(text: str) -> Path:
+    """A path given on the command line; an empty one is refused (``Path('')`` is the current folder: ``--out ''``
+    wrote there, ``run ''`` read it as a folder)."""
+    if not text:
+        raise argparse.ArgumentTypeError("an empty path: give a file or folder name")
+    return Path(text)
+
+
 def text_file(path: Path, what: str, error: type[FrictionUQError]) -> str:
     """The UTF-8 text of an input file, or one sentence saying why it is not one."""
     from .plausible import MAX_TEXT_BYTES, NotText, text_of

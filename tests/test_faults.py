@@ -228,6 +228,9 @@ def test_a_real_full_disk_is_one_sentence_and_leaves_nothing(record, tmp_path):
     (["run", "{rec}", "--priors", "{rec}"], "is an HDF5 file (a test record?), not a prior file"),
     (["simulate", "{rec}", "-o", "{tmp}/x.h5"], "is an HDF5 file (a test record?), not a simulation configuration"),
     (["inspect", "{u16}"], "is not an HDF5 file"),
+    (["run", "{rec}", "--out", ""], "argument --out: an empty path"),
+    (["campaign", "{rec}", "--out", ""], "argument --out: an empty path"),
+    (["analyze", ""], "argument file: an empty path"),
     (["analyze", "{tmp}"], "is a directory"),
 ])
 def test_bad_input_is_one_sentence_before_any_work(record, tmp_path, capsys, argv, words):
