@@ -814,6 +814,7 @@ class _RoundsDiagnoser:
     times ``shift`` (the fits are what they are resolved to)."""
 
     gauges = ("input_bar", "internal_output_bar", "external_output_bar", "tube_hoop")
+    in_baseline = ()
 
     def __init__(self, gain, shift):
         self.gain, self.shift = gain, shift
@@ -925,3 +926,28 @@ def test_a_final_median_of_zero_is_moved_by_any_other_f():
     assert moves_f(np.zeros(5), np.full(5, 0.01)) and not moves_f(np.zeros(5), np.zeros(5))
     assert moves_f(np.full(5, 0.05), np.full(5, 0.05 * (1 + 1.01 * FORM_SHIFT)))
     assert not moves_f(np.full(5, 0.05), np.full(5, 0.05 * (1 - 0.99 * FORM_SHIFT)))
+
+
+def test_a_dispersion_corrected_diagnosis_starts_from_the_checks_dispersive_bars(tmp_path):
+    """--dispersion: the diagnosis's reference model is the whole-record check's (bars that disperse, the incident
+    wave carried to the cell with dispersion), and the dispersion entry, which would be that model again, is no
+    candidate; without the flag the baseline's bars do not disperse and the entry is one. (Before, the flag did
+    not reach the diagnosis: its baseline missed what the check's model held, and ``dispersion`` was named.)"""
+    from friction_uq.discrepancy.extended import Diagnoser
+    from friction_uq.models import SimulatorModel, measured_loading
+
+    path = tmp_path / "d.h5"
+    simulate_to_file(noisy_config(dispersion=True), path, seed=3)
+    rec = read_record(path)
+    values = {"f": 0.05, "nu": 0.4, "sample_modulus": rec.apparatus.sample.young_modulus}
+    diagnosers = {flag: Diagnoser(prepare(rec, dispersion=flag), lambda v: 0.0, hoop=True, seed=1)
+                  for flag in (False, True)}
+    for flag, dg in diagnosers.items():
+        assert dg._model(()).config(values)[0].dispersion is flag
+        assert ("dispersion" in {v.mechanism.name for v in candidates(exclude=dg.in_baseline)}) is not flag
+    prep = diagnosers[True].prep
+    check = SimulatorModel(rec.apparatus, measured_loading(rec, prep.forces), dispersion=True,
+                           dispersive_loading=measured_loading(rec, prep.forces, dispersion=True))
+    ours, theirs = diagnosers[True]._model(()).predict(values).strains, check.predict(values).strains
+    for c in theirs:
+        np.testing.assert_array_equal(ours[c], theirs[c])

@@ -143,7 +143,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     say = progress or (lambda msg: None)
     dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales,
                    nominal=start, nu_cut=nu_cut)
-    say(f"baseline (up to {max_causes} rounds of up to {len(candidates(gauges=dg.gauges))} extended models follow)")
+    say(f"baseline (up to {max_causes} rounds of up to {len(candidates(dg.in_baseline, dg.gauges))} extended models follow)")
     base = dg.fit((), start, "baseline")
     st = _search(dg, prep, _Search(base, base), max_causes=max_causes, workers=workers, seed=seed, say=say, t0=t0)
     final, causes, rounds, verdicts = st.reference, st.causes, st.rounds, st.verdicts
@@ -214,7 +214,7 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
         if k == 0:
             st.base = st.reference
         st.misfits.append(decide(compare_whole_record(prep, st.reference.predicted)))
-        used = tuple(v.mechanism.name for v in st.causes)
+        used = dg.in_baseline + tuple(v.mechanism.name for v in st.causes)
         jobs = [(tuple(st.causes) + (cand,), dict(st.reference.fit.mode),
                  "+".join([v.label for v in st.causes] + [cand.label]))
                 for cand in candidates(exclude=used, gauges=dg.gauges)]

@@ -101,6 +101,12 @@ class Diagnoser:
         rec = prep.record
         self.loading = measured_loading(rec, prep.forces)
         self.dispersive_loading = measured_loading(rec, prep.forces, dispersion=True)  # for ``dispersion``
+        #: an analysis with the dispersion correction (``--dispersion``): every model's bars disperse, as the
+        #: whole-record check's (:mod:`.check`) and the forces' do; the ``dispersion`` entry, that model again, is then
+        #: no candidate (:attr:`in_baseline`)
+        self.dispersion = prep.forces.dispersion
+        #: the catalogue's entries the baseline already holds
+        self.in_baseline: tuple[str, ...] = ("dispersion",) if self.dispersion else ()
         self.hoop = hoop and rec.has_hoop
         #: the gauges the record is read by: the measurement chain's entries are fitted on these
         self.gauges = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or self.hoop))
@@ -131,7 +137,7 @@ class Diagnoser:
                 v.mechanism.apply(values, settings, readings, v.channel)
 
         return SimulatorModel(self.prep.record.apparatus, self.loading, hoop=self.hoop, extra=tuple(extra),
-                              apply=apply, dispersive_loading=self.dispersive_loading)
+                              apply=apply, dispersion=self.dispersion, dispersive_loading=self.dispersive_loading)
 
     def fit(self, variants: tuple[Variant, ...], start: Mapping[str, float], label: str, *,
             cut: bool = True) -> ModelFit:

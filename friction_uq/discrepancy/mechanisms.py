@@ -24,7 +24,8 @@ Priors (why these ranges):
 * ``clearance``: gap ~ half-normal(20 um): the paper quotes ~10 um of radial clearance.
 * ``plug_friction``: force ~ half-normal(500 N), coefficient ~ half-normal(0.03) of F_i.
 * ``gauge_gain``: gain ~ lognormal(0, 0.1): a bar gauge's calibration is rarely 10 % off.
-* ``dispersion``: no parameter (the bars' geometry gives it).
+* ``dispersion``: no parameter (the bars' geometry gives it); no candidate of an analysis with the dispersion
+  correction (``--dispersion``), whose every model's bars already disperse.
 * ``end_friction``: f_e ~ half-normal(0.25): PTFE on steel is 0.02-0.1, bare faces (a sheet torn or
   missing: explosive on steel) 0.3-0.5.
 
