@@ -168,6 +168,21 @@ def test_a_dead_hoop_gauge_is_left_out_with_a_note(tmp_path, capsys):
     assert "tube_hoop" not in channels and "external_output_bar" in channels
 
 
+def test_a_record_without_a_hoop_gauge_says_why_the_term_is_off(tmp_path, capsys):
+    """The JSON said "hoop_term": false with no reason while its settings asked for the hoop."""
+    import h5py
+
+    rec = write_closed_form_record(tmp_path / "bare.h5", ClosedFormTest(f=0.05, nu=0.4), seed=8, test_id="N-01",
+                                   campaign="bare")
+    with h5py.File(rec, "r+") as fh:
+        del fh["signals/tube_hoop"]
+    out = tmp_path / "out"
+    assert main(["run", str(rec), "--out", str(out), "--quiet", "--no-pdf"]) == 0
+    assert "hoop gauge is left out of the likelihood: the record has no hoop gauge" in capsys.readouterr().err
+    doc = json.loads((out / "bare_N-01.json").read_text())
+    assert doc["hoop_term"] is False and "no hoop gauge (/signals/tube_hoop)" in doc["hoop_left_out"]
+
+
 def test_a_reversed_hoop_gauge_is_said_as_reversed(tmp_path, capsys):
     test = ClosedFormTest(f=0.05, nu=0.4)
     rec = write_closed_form_record(tmp_path / "rev.h5", test, seed=8, test_id="R-01", campaign="rev")

@@ -78,7 +78,8 @@ def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | N
     prep = prepare(record, window=window, dispersion=dispersion)
     settings = AnalysisSettings(window=window, dispersion=dispersion, hoop=hoop)
     alternatives = alternative_nu_priors(p_path, priors)
-    left_out = hoop_unusable(prep) if settings.hoop and prep.data.hoop is not None else None
+    left_out = None if not settings.hoop else (
+        hoop_unusable(prep) if prep.data.hoop is not None else "the record has no hoop gauge (/signals/tube_hoop)")
     use_hoop = bool(settings.hoop and prep.data.hoop is not None and left_out is None)
     likelihood = Likelihood(prep.data, hoop=use_hoop, axial_poisson=settings.axial_poisson,
                             hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy,
