@@ -951,3 +951,29 @@ def test_a_dispersion_corrected_diagnosis_starts_from_the_checks_dispersive_bars
     ours, theirs = diagnosers[True]._model(()).predict(values).strains, check.predict(values).strains
     for c in theirs:
         np.testing.assert_array_equal(ours[c], theirs[c])
+
+
+@pytest.mark.slow  # a whole diagnose through the command line, PDF included, 40-90 s
+def test_a_record_without_a_hoop_gauge_is_diagnosed_without_words_of_one(tmp_path):
+    """The models of a record without a hoop gauge read none; the JSON and the PDF said a hoop gauge's factor (1.000
+    under a 5 % prior), a stationary f "eq. 17 + hoop" and an ELPD with the hoop's calibration data."""
+    import json
+
+    import h5py
+    from pypdf import PdfReader
+
+    from friction_uq.cli import main
+
+    path = tmp_path / "bare.h5"
+    simulate_to_file(noisy_config(striker_velocity=10.0, friction_params=MappingProxyType({"f": 0.05})), path, seed=5)
+    with h5py.File(path, "r+") as fh:
+        del fh["signals/tube_hoop"]
+    assert main(["diagnose", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    [js] = (tmp_path / "out").glob("*.json")
+    doc = json.loads(js.read_text())
+    dd = doc["discrepancy"]
+    assert dd["hoop_gain"] is None and "hoop" not in dd["elpd"] and doc["misfit"]["fit"]["hoop_gain"] is None
+    assert all(set(r["calibration_elpd"]) == {"sample_modulus"} for r in dd["ranking"])
+    text = "\n".join(page.extract_text() for page in PdfReader(js.with_suffix(".pdf")).pages)
+    assert "eq. 17 + hoop" not in text and "hoop gauge gain" not in text
+    assert "the hoop gauge left out" in text

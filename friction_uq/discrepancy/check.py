@@ -30,7 +30,7 @@ class WholeRecordCheck:
     """The fitted baseline over the whole record, its comparison with every gauge and the decision."""
 
     fit: WholeRecordFit
-    hoop_gain: float
+    hoop_gain: float | None  # None: no hoop gauge read (none recorded, or left out)
     comparison: WholeRecord
     decision: MisfitDecision
     seconds: float
@@ -70,5 +70,6 @@ def check_whole_record(prep: Prepared, log_prior: Callable[[Mapping[str, float]]
     draws["hoop_gain"] = np.full(len(draws["f"]), gain)
     predicted = model.predict_draws(draws)
     comparison = compare_whole_record(prep, predicted)
-    return WholeRecordCheck(fit=fit, hoop_gain=gain, comparison=comparison, decision=decide(comparison),
+    return WholeRecordCheck(fit=fit, hoop_gain=gain if "tube_hoop" in lik.channels else None,
+                            comparison=comparison, decision=decide(comparison),
                             seconds=time.perf_counter() - t0)

@@ -74,10 +74,12 @@ RULE_TEXT = ("a cause is named only of a misfit the whole-record check found, wh
              "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
              f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
              "the entry stays in the model within the check's tolerance (within_tolerance), not named")
-#: How the ELPD is computed, in words (the JSON's ``elpd``).
-ELPD_TEXT = ("exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "
-             "plus the calibration data (hoop gauge factor 1 +- 5 %, the header's sample modulus +- 10 %) each left "
-             "out in turn (calibration_elpd per model)")
+def elpd_text(hoop: bool) -> str:
+    """How the ELPD is computed, in words (the JSON's ``elpd``); ``hoop``: the models read the hoop gauge."""
+    data = "hoop gauge factor 1 +- 5 %, the header's sample modulus +- 10 %" if hoop else \
+        "the header's sample modulus +- 10 %"
+    return ("exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "
+            f"plus the calibration data ({data}) each left out in turn (calibration_elpd per model)")
 
 
 def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[str, float] | None = None
@@ -90,7 +92,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "rule": RULE_TEXT,
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
-        "elpd": ELPD_TEXT,
+        "elpd": elpd_text("tube_hoop" in dg.final.predicted),
         "seconds": dg.seconds,
         "sentence": sentence(dg, f_without if f_without_quoted is None else f_without_quoted),
     }
@@ -161,9 +163,10 @@ def _posterior_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, obj
         "nu_whole_record": dg.final.fit.mode["nu"],
         "kappa_extended": summarize_draws(kappa_draws(dg.final)),
         "kappa_baseline_whole_record": summarize_draws(kappa_draws(dg.baseline)),
-        "hoop_gain": {"value": hoop, "without_causes": baseline_hoop_gain(dg), "finding": hoop_gain_off(dg),
-                      "meaning": "calibration factor of the tube hoop gauge (recorded / true) at the final model's "
-                                 "whole-record fit: its most probable value under a 5 % prior"},
+        "hoop_gain": None if "tube_hoop" not in dg.final.predicted else {  # no hoop gauge read: nothing to say
+            "value": hoop, "without_causes": baseline_hoop_gain(dg), "finding": hoop_gain_off(dg),
+            "meaning": "calibration factor of the tube hoop gauge (recorded / true) at the final model's whole-record "
+                       "fit: its most probable value under a 5 % prior"},
         "residual_rms": {ch: {ph: {"before": b, "after": a} for ph, (b, a) in phases.items()}
                          for ch, phases in dg.rms.items()},
     }

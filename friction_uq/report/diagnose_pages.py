@@ -74,7 +74,9 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
     ax.set_title("rounds 1, 2, ...: each mechanism added to the model of the round before", fontsize=9)
 
 
-def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, test: str) -> Figure:
+def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, test: str, hoop: bool) -> Figure:
+    """The ranking of the first round and, beside it, the verdict and the posteriors; ``hoop``: the stationary
+    analysis used the hoop gauge."""
     fig, axes = figure(f"{test}: what the baseline misses, mechanism by mechanism", nrows=1, ncols=2,
                        gridspec_kw={"width_ratios": [3, 2]})
     _ranking_axes(axes[0], dg)
@@ -85,13 +87,15 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     lines = [sentence, "",
              "The posteriors below are given the output bars' header values; the f to quote (the sentence's, and the "
              "first line of page 1) also carries the bars' calibration.",
-             f"f, stationary phase (eq. 17 + hoop): {f_without['q50']:.4f} [{f_without['q05']:.4f}, {f_without['q95']:.4f}]",
+             f"f, stationary phase (eq. 17{' + hoop' if hoop else '; the hoop gauge left out'}): "
+             f"{f_without['q50']:.4f} [{f_without['q05']:.4f}, {f_without['q95']:.4f}]",
              f"f, baseline over the whole record: {fb['q50']:.4f} [{fb['q05']:.4f}, {fb['q95']:.4f}] "
              f"(nu {np.median(dg.baseline.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.baseline)):.4f})",
              f"f, model '{dg.final.label}': {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] "
              f"(nu {np.median(dg.final.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.final)):.4f})",
              *_nu_source_line(dg),
-             f"hoop gauge gain (final model, most probable under its 5 % prior): {dg.final.hoop_gain:.3f}", ""]
+             *([f"hoop gauge gain (final model, most probable under its 5 % prior): {dg.final.hoop_gain:.3f}"]
+               if "tube_hoop" in dg.final.predicted else []), ""]
     for v in dg.causes:
         turn = "" if v in dg.named_causes else (" (in the model within the check's tolerance, not named)"
                                                 if v.label in dg.within_tolerance else

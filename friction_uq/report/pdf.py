@@ -292,9 +292,8 @@ def diagnosis_pages(r: ReportInputs) -> list[Figure]:
 
     test = f"{r.prepared.record.campaign} {r.prepared.record.test_id}"
     n = whole_record_page(r) + 2
-    return [page_ranking(r.diagnosis, f_without=r.summary["f"].to_json(), sentence=sentence(r.diagnosis,
-                                                                                         stationary_quoted(r)),
-                         test=f"{n}. {test}"),
+    return [page_ranking(r.diagnosis, f_without=r.summary["f"].to_json(),
+                         sentence=sentence(r.diagnosis, stationary_quoted(r)), test=f"{n}. {test}", hoop=r.samples.hoop),
             page_extended_fit(r.diagnosis, test=f"{n + 1}. {test}")]
 
 
