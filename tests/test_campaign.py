@@ -63,6 +63,22 @@ def test_compare_cli_prints_table_and_writes_figure(two_campaigns, tmp_path, cap
     assert "one campaign" not in comparison_table(compare(two_campaigns))
 
 
+def test_tests_analysed_otherwise_are_said_apart(two_campaigns):
+    """A test analysed with the dispersion correction beside tests without it (or with another prior file) was
+    compared silently: its kappa moves by a few per cent with the correction alone."""
+    assert "analysed differently" not in comparison_table(compare(two_campaigns))  # the files say nothing: alike
+    for k, path in enumerate(two_campaigns):
+        doc = json.loads(path.read_text())
+        doc |= {"dispersion_correction": k == 2, "hoop_term": True, "prior_file": "/x/priors/I1.toml"}
+        path.write_text(json.dumps(doc))
+    text = comparison_table(compare(two_campaigns))
+    assert "analysed differently, the dispersion correction: A-01: off; A-02: off; A-03: on; A-04: off" in text
+    assert "hoop term" not in text and "prior file" not in text
+    doc = json.loads(two_campaigns[0].read_text()) | {"prior_file": "/lab/I1-mine.toml"}
+    two_campaigns[0].write_text(json.dumps(doc))
+    assert "the prior file: A-01: I1-mine.toml; A-02: I1.toml" in comparison_table(compare(two_campaigns))
+
+
 def test_a_file_that_is_not_a_result_is_refused(tmp_path, capsys):
     bad = tmp_path / "x.json"
     bad.write_text('{"f": 1}')

@@ -24,6 +24,9 @@ from ..errors import FrictionUQError
 REQUIRED = ("f", "kappa", "nu", "V", "p_mean", "test_id", "campaign")
 SUMMARIES = ("f", "kappa", "nu", "V", "p_mean")
 STATISTICS = ("mean", "sd", "q05", "q50", "q95")
+#: A run's settings that change its summaries, as its JSON names them, and in words
+SETTINGS = {"dispersion_correction": "the dispersion correction", "hoop_term": "the hoop term",
+            "prior_file": "the prior file"}
 
 
 @dataclass(frozen=True)
@@ -38,6 +41,9 @@ class TestResult:
     V: dict[str, float]
     p_mean: dict[str, float]
     path: str
+    #: how the run analysed it (the JSON's ``dispersion_correction``, ``hoop_term``, ``prior_file``; None where the
+    #: file does not say): tests analysed otherwise are said apart in the table
+    settings: tuple[tuple[str, object], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -127,8 +133,9 @@ def load_result(path: str | os.PathLike[str]) -> TestResult:
             raise FrictionUQError(f"{p}: key {key!r} is {shown!r}, not an id (non-empty text, no control characters)")
     for key in SUMMARIES:
         _check_summary(p, field.get(key, key), doc[key], positive_sd=key == "kappa")
+    settings = tuple((k, doc.get(k) if isinstance(doc.get(k), (bool, str)) else None) for k in SETTINGS)
     return TestResult(doc["campaign"], doc["test_id"], doc["f"], doc["kappa"], doc["nu"], doc["V"], doc["p_mean"],
-                      str(p))
+                      str(p), settings)
 
 
 def fit_trend(results: list[TestResult], regressors: tuple[str, ...]) -> TrendFit:
@@ -193,8 +200,30 @@ def comparison_table(c: Comparison) -> str:
             parts.append(f"d kappa/d {reg} = {fit.coef[j] * s:+.2e} +- {fit.se[j] * s:.1e} {u} "
                          f"({fit.slope_z(reg):+.1f} se)")
         lines.append(f"fit kappa ~ {name}: " + "; ".join(parts) + f"; chi2/dof {fit.chi2_dof:.2f} ({fit.n} tests)")
+    lines += settings_differences(c.results)
     if len(c.campaigns) < 2 and "V" in c.fits:
         lines.append("one campaign: V and p_mean rise together with the striker speed, so a trend cannot be "
                      "assigned to one of them (docs/physics.md section 5)")
     return "\n".join(lines)
 
+
+
+def settings_differences(results: list[TestResult]) -> list[str]:
+    """One line per setting the tests were analysed with that differs among them (the trends then mix analyses:
+    a dispersion correction moves kappa by a few per cent), naming each test's value."""
+    out = []
+    for key, words in SETTINGS.items():
+        values = {r.test_id if len({q.test_id for q in results}) == len(results) else f"{r.campaign} {r.test_id}":
+                  dict(r.settings).get(key) for r in results}
+        if len(set(values.values())) > 1:
+            said = "; ".join(f"{t}: {_setting_text(v)}" for t, v in values.items())
+            out.append(f"analysed differently, {words}: {said} (the trends above mix them)")
+    return out
+
+
+def _setting_text(value: object) -> str:
+    if value is None:
+        return "not recorded"
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    return Path(str(value)).name
