@@ -162,3 +162,19 @@ def test_a_short_exact_posterior_is_a_warning_that_names_its_effective_size():
     assert exact_posterior_warning(SimpleNamespace(causes=("clearance",), posterior_converged=True)) is None
     assert exact_posterior_warning(SimpleNamespace(causes=(), posterior_converged=False)) is None
     assert exact_posterior_warning(None) is None
+
+
+def test_exact_draws_go_on_where_one_draw_carries_every_weight():
+    """A normal approximation a thousand times too wide: one draw of the first proposal carries all the weight (the
+    others' underflow to 0), its weighted covariance was nan and the second proposal an internal error; now the
+    second proposal is the robust covariance around that draw, and the draws end as the exact posterior's."""
+    from friction_uq.stats.exact import exact_draws
+
+    def log_post(z):
+        return float(-0.5 * np.sum((np.asarray(z) / 1e-3) ** 2))
+
+    ex = exact_draws(log_post, np.zeros(2), np.eye(2), np.eye(2), rng=np.random.default_rng(1))
+    assert ex.converged
+    n = len(ex.z)
+    np.testing.assert_allclose(np.std(ex.z, axis=0), 1e-3, rtol=5 * 1.0 / np.sqrt(2 * ex.ess) + 0.05)
+    assert np.all(np.abs(np.mean(ex.z, axis=0)) < 5e-3 / np.sqrt(ex.ess)) and n > 0

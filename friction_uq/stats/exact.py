@@ -171,6 +171,21 @@ def _emcee(log_post_rows: Callable[[np.ndarray], np.ndarray], z: np.ndarray, log
     return flat[rng.choice(len(flat), size=n, replace=len(flat) < n)], float(ess), nwalkers * total, converged
 
 
+def _second_proposal(first: _Stage, cov_robust: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Centre and scale of the second proposal: the first's weighted draws' mean and covariance (x 1.5), or, where
+    fewer draws than dimensions carry the weight (their covariance is singular: one draw carrying it all gave nan),
+    the heaviest draw with the robust covariance x 1.5."""
+    ndim = first.z.shape[1]
+    top = float(np.max(first.log_weights))
+    w = np.exp(first.log_weights - top) if math.isfinite(top) else np.zeros(len(first.z))
+    if not w.sum() > 0.0 or float(w.sum()) ** 2 / float(w @ w) < ndim + 1:
+        best = int(np.argmax(w)) if w.sum() > 0.0 else int(np.argmax(first.log_target))
+        return first.z[best], 1.5 * np.atleast_2d(cov_robust) + 1e-12 * np.eye(ndim)
+    w /= w.sum()
+    cov = np.atleast_2d(np.cov(first.z, rowvar=False, aweights=w)) * 1.5 + 1e-12 * np.eye(ndim)
+    return w @ first.z, cov
+
+
 def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_laplace: np.ndarray,
                 cov_robust: np.ndarray, *, rng: np.random.Generator, n_importance: int = 200, n_out: int = 1000,
                 emcee_steps: int = 150, emcee_burn: int = 50,
@@ -194,10 +209,7 @@ def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_l
     calls, st, method = len(first.z), first, "importance"
     omega = sandwich_map(mode, cov_laplace, cov_robust)
     if not first.kept(floor):
-        w = np.exp(first.log_weights - np.max(first.log_weights))
-        w /= w.sum()
-        mean = w @ first.z
-        cov = np.atleast_2d(np.cov(first.z, rowvar=False, aweights=w)) * 1.5 + 1e-12 * np.eye(len(mode))
+        mean, cov = _second_proposal(first, cov_robust)
         st = _importance(log_post_rows, stats.multivariate_t(mean, cov, df=5, allow_singular=True),
                          n_importance, rng, floor)
         calls += len(st.z)
