@@ -259,4 +259,39 @@ def test_the_whole_record_check_fits_with_the_channels_own_tolerance(clean_recor
     monkeypatch.setattr(check, "WholeRecordLikelihood", recording)
     with pytest.raises(Stop):
         check.check_whole_record(prep, lambda v: 0.0, {"f": 0.06, "nu": 0.4}, hoop=True, seed=1)
-    assert made == [{"phase_tolerance": {}, "shape_sd": {}}]
+    assert made == [{"phase_tolerance": {}, "shape_sd": {}, "hoop_calibration": (1.0, HOOP_GAIN_SD)}]
+
+
+def test_the_hoop_calibration_a_prior_file_states_is_its_median_and_at_least_the_calibrated_sd():
+    from friction_uq.discrepancy.record_likelihood import hoop_calibration
+
+    assert hoop_calibration(stats.lognorm(s=0.05, scale=1.0)) == (pytest.approx(1.0), HOOP_GAIN_SD)  # the package's
+    median, sd = hoop_calibration(stats.lognorm(s=0.01, scale=0.85))  # tighter than the check was calibrated with
+    assert median == pytest.approx(0.85) and sd == HOOP_GAIN_SD
+    assert hoop_calibration(stats.lognorm(s=0.2, scale=0.85))[1] == pytest.approx(0.2)  # a lab that does not know
+
+
+def test_a_hoop_gauge_known_to_read_low_is_read_with_its_known_factor(tmp_path):
+    """A prior file's hoop_gain (a hoop gauge known to read 0.85 of the strain) reached the stationary analysis but not
+    the whole-record models: diagnose's baseline (the sample's modulus free) shrank the factor toward 1 and bent nu
+    and f to make up the hoop's level, and called the known factor a finding."""
+    from friction_uq.discrepancy.check import check_whole_record
+
+    hoop = {"tube_hoop": ChannelSpec(white=2e-6, ar1=1e-6, ar1_coef=0.3, gain=0.85)}
+    path = tmp_path / "low.h5"
+    simulate_to_file(noisy_config(channels=hoop, friction_params=MappingProxyType({"f": 0.05}), poisson_ratio=0.4),
+                     path, seed=4)
+    prep = prepare(read_record(path))
+    check = check_whole_record(prep, lambda v: 0.0, {"f": 0.05, "nu": 0.4}, hoop=True, seed=1,
+                               hoop_calibration=(0.85, HOOP_GAIN_SD))
+    assert check.hoop_gain == pytest.approx(0.85, abs=0.02)
+
+    def baseline(calibration):
+        dg = Diagnoser(prep, lambda v: 0.0, hoop=True, seed=1, hoop_calibration=calibration)
+        b = dg.fit((), {"f": 0.05, "nu": 0.4}, "baseline", cut=False)
+        return b, np.quantile(b.fit.draws["nu"], [0.05, 0.95]), np.quantile(b.f_effective, [0.05, 0.95])
+
+    known, nu, f = baseline((0.85, HOOP_GAIN_SD))
+    assert known.hoop_gain == pytest.approx(0.85, abs=0.02) and nu[0] <= 0.4 <= nu[1] and f[0] <= 0.05 <= f[1]
+    unknown, nu, f = baseline((1.0, HOOP_GAIN_SD))  # what it read before: the factor pulled toward 1, nu and f off
+    assert unknown.hoop_gain > 0.9 and nu[1] < 0.4 and f[0] > 0.05

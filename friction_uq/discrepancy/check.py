@@ -21,6 +21,7 @@ from ..models import SimulatorModel, measured_loading
 from ..stats.streams import stream
 from .extended import NU_STARTS
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
+from .record_likelihood import HOOP_GAIN_SD
 from .misfit import MisfitDecision, decide
 from .whole_record import WholeRecord, compare_whole_record
 
@@ -46,10 +47,12 @@ class WholeRecordCheck:
 
 
 def check_whole_record(prep: Prepared, log_prior: Callable[[Mapping[str, float]], float], start: Mapping[str, float],
-                       *, hoop: bool, seed: int, n_draws: int = 30) -> WholeRecordCheck:
+                       *, hoop: bool, seed: int, n_draws: int = 30,
+                       hoop_calibration: tuple[float, float] = (1.0, HOOP_GAIN_SD)) -> WholeRecordCheck:
     """Fit, simulate the posterior draws, compare and decide (module docstring).
 
-    ``log_prior`` takes ``{"f": ..., "nu": ...}``; ``start`` where the mode search starts (f, nu).
+    ``log_prior`` takes ``{"f": ..., "nu": ...}``; ``start`` where the mode search starts (f, nu);
+    ``hoop_calibration`` the hoop gauge's known factor (:func:`.record_likelihood.hoop_calibration`).
     """
     t0 = time.perf_counter()
     rec = prep.record
@@ -61,7 +64,7 @@ def check_whole_record(prep: Prepared, log_prior: Callable[[Mapping[str, float]]
     # the check's fit keeps the channels' own tolerance, with which its decision's tolerance table and thresholds were
     # calibrated, whatever LIKELIHOOD_TOLERANCE and SHAPE_SD hold: with 10 % on the hoop in its fit it flagged 11 of
     # 80 clean axisymmetric records (4 before; docs/trust.md)
-    lik = WholeRecordLikelihood(prep, model, phase_tolerance={}, shape_sd={})
+    lik = WholeRecordLikelihood(prep, model, phase_tolerance={}, shape_sd={}, hoop_calibration=hoop_calibration)
     rng = stream(seed, "whole-record check")
     fit = fit_whole_record(lik, log_prior, {"f": start["f"], "nu": start["nu"]}, n_draws=n_draws, rng=rng,
                            extra_starts=tuple({"nu": nu} for nu in NU_STARTS))

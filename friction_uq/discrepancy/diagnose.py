@@ -47,6 +47,7 @@ from .exact_model import exact_posterior
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .front_delay import round_shared_delay
 from .misfit import MisfitDecision, decide, misfit_detected
+from .record_likelihood import HOOP_GAIN_SD
 from .candidates_mixture import (Resolve, draw_mixture, further_members, mixture, open_rounds, rival_mixture,
                                  superfluous_mixture)
 from .diagnosis import Diagnosis, Ranked
@@ -124,7 +125,8 @@ class _Search:
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
              hoop: bool, seed: int, n_draws: int = 1000, progress: Callable[[str], None] | None = None,
              base_scales: Mapping[str, tuple[float, float]] | None = None, max_causes: int = MAX_CAUSES,
-             workers: int | None = None, stationary_f: np.ndarray | None = None, nu_cut: bool = False) -> Diagnosis:
+             workers: int | None = None, stationary_f: np.ndarray | None = None, nu_cut: bool = False,
+             hoop_calibration: tuple[float, float] = (1.0, HOOP_GAIN_SD)) -> Diagnosis:
     """Fit the baseline and every mechanism, rank them and name the cause(s) (module docstring).
 
     ``base_scales``: Gaussian stand-ins (centre, sd in the unbounded coordinate) of the f and nu
@@ -135,15 +137,18 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
     that f is reported from (the baseline, each round's reference, the final model, the mixtures' members) from the
     cut posterior, nu read from the record's stationary windows under the model (:mod:`.nu_cut`; the names are the
     joint fits'), the other candidates' f their joint fits' (``ModelFit.f_from``: the cut is made only where f is
-    reported, half of a model's fitting time); False: f is each model's joint fit's.
+    reported, half of a model's fitting time); False: f is each model's joint fit's. ``hoop_calibration``: the hoop
+    gauge's factor known beforehand (median, relative sd; the run's prior file:
+    :func:`.record_likelihood.hoop_calibration`).
     """
     t0 = time.perf_counter()
     if workers is None:
         workers = min(MAX_WORKERS, os.cpu_count() or 1)
     say = progress or (lambda msg: None)
     dg = Diagnoser(prep, log_prior_f_nu, hoop=hoop, seed=seed, n_draws=n_draws, base_scales=base_scales,
-                   nominal=start, nu_cut=nu_cut)
-    say(f"baseline (up to {max_causes} rounds of up to {len(candidates(dg.in_baseline, dg.gauges))} extended models follow)")
+                   nominal=start, nu_cut=nu_cut, hoop_calibration=hoop_calibration)
+    n_models = len(candidates(dg.in_baseline, dg.gauges))
+    say(f"baseline (up to {max_causes} rounds of up to {n_models} extended models follow)")
     base = dg.fit((), start, "baseline")
     st = _search(dg, prep, _Search(base, base), max_causes=max_causes, workers=workers, seed=seed, say=say, t0=t0)
     final, causes, rounds, verdicts = st.reference, st.causes, st.rounds, st.verdicts

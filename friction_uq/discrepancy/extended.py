@@ -34,6 +34,7 @@ from ..stats.ar1 import ar1_block_loo
 from ..stats.streams import stream
 from .block_loo import Elpd, calibration_loo, takeuchi_block_loo, with_calibration
 from .fit import WholeRecordFit, WholeRecordLikelihood, fit_whole_record
+from .record_likelihood import HOOP_GAIN_SD
 from .mechanisms import MECHANISMS, Context, Mechanism
 from .nu_cut import CutFit, conditional_fit, window_nu
 from .whole_record import CHANNEL_LABELS
@@ -94,8 +95,11 @@ class Diagnoser:
 
     def __init__(self, prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], *, hoop: bool,
                  seed: int, n_draws: int = 60, base_scales: Mapping[str, tuple[float, float]] | None = None,
-                 nominal: Mapping[str, float] | None = None, nu_cut: bool = False) -> None:
+                 nominal: Mapping[str, float] | None = None, nu_cut: bool = False,
+                 hoop_calibration: tuple[float, float] = (1.0, HOOP_GAIN_SD)) -> None:
         self.prep = prep
+        #: the hoop gauge's known factor (median, relative sd) every model's likelihood reads it with
+        self.hoop_calibration = hoop_calibration
         #: a model's f from the cut posterior, nu from the record's stationary window (:mod:`.nu_cut`); else the joint fit's
         self.nu_cut = nu_cut
         rec = prep.record
@@ -145,7 +149,7 @@ class Diagnoser:
         ``cut`` is False: then f is the joint fit's until :meth:`resolved` is asked for it (the names and the evidence
         do not depend on the cut; the cut is seeded by the label, so it gives the same bits whenever it is made)."""
         model = self._model(variants)
-        lik = WholeRecordLikelihood(self.prep, model)
+        lik = WholeRecordLikelihood(self.prep, model, hoop_calibration=self.hoop_calibration)
         log_prior = self.log_prior(variants)
 
         st = {"f": start["f"], "nu": start["nu"], "sample_modulus": start.get("sample_modulus", self.E0)}
@@ -223,7 +227,8 @@ class Diagnoser:
         assert lik is not None  # every fit made here carries its likelihood
         log_prior, scales = self.log_prior(mf.variants), self._scales(mf.variants)
         nu_window = window_nu(self.prep, lik.model, log_prior, dict(mode) | {"sample_modulus": self.E0},
-                              n_draws=NU_WINDOW_DRAWS, rng=stream(self.seed, "nu window", label), prior_scale=scales)
+                              n_draws=NU_WINDOW_DRAWS, rng=stream(self.seed, "nu window", label), prior_scale=scales,
+                              hoop_calibration=self.hoop_calibration)
         return conditional_fit(lik, log_prior, mode, nu_window, n_draws=self.n_draws,
                                rng=stream(self.seed, "nu cut", label), prior_scale=scales,
                                score_blocks=lik.blocks(self.block))
@@ -273,7 +278,8 @@ class Diagnoser:
         parts = forked_map(fit_job, jobs, workers=workers)
         out = []
         for (variants, _, label), (fit, gain, elpd, f_eff, predicted, cut_fit) in zip(jobs, parts):
-            lik = WholeRecordLikelihood(self.prep, self._model(variants))  # closures do not cross processes
+            lik = WholeRecordLikelihood(self.prep, self._model(variants),  # closures do not cross processes
+                                        hoop_calibration=self.hoop_calibration)
             mf = ModelFit(label=label, variants=variants, fit=fit, hoop_gain=gain, elpd=elpd,
                           f_effective=f_eff, predicted=predicted, lik=lik, cut=cut_fit)
             if cut_fit is not None:

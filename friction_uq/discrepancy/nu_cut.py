@@ -44,7 +44,7 @@ from ..analysis import Prepared
 from ..models.parameters import Parameter
 from ..models.simulator import SimulatorModel
 from .fit import LogPrior, WholeRecordFit, fit_whole_record
-from .record_likelihood import WholeRecordLikelihood
+from .record_likelihood import HOOP_GAIN_SD, WholeRecordLikelihood
 from .whole_record import CHANNEL_LABELS
 
 #: Central-difference step of d(residual)/d nu (nu itself, not its unbounded coordinate).
@@ -110,11 +110,12 @@ class CutFit:
 
 
 def window_nu(prep: Prepared, model: SimulatorModel, log_prior: LogPrior, start: Mapping[str, float], *,
-              n_draws: int, rng: np.random.Generator, prior_scale: Mapping[str, tuple[float, float]]) -> NuCut:
+              n_draws: int, rng: np.random.Generator, prior_scale: Mapping[str, tuple[float, float]],
+              hoop_calibration: tuple[float, float] = (1.0, HOOP_GAIN_SD)) -> NuCut:
     """nu's posterior from every gauge's stationary window under the model (module docstring): every parameter of
     the model free under its prior (``prior_scale``: their Gaussian stand-ins), the search from ``start`` (the joint
     fit's mode), the gauges' calibrations and slow bends marginalised; its normal approximation's draws."""
-    lik = WholeRecordLikelihood(prep, model, window_only=True,
+    lik = WholeRecordLikelihood(prep, model, window_only=True, hoop_calibration=hoop_calibration,
                                 shape_sd={(c, "stationary"): WINDOW_SHAPE_SD for c in CHANNEL_LABELS})
     free = {k: v for k, v in start.items() if k != "hoop_gain"}
     fit = fit_whole_record(lik, log_prior, free, n_draws=n_draws, rng=rng, importance=False,

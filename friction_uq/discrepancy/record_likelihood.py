@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -40,6 +41,18 @@ GAIN_SD = {"internal_output_bar": 0.01, "external_output_bar": 0.01}
 #: The hoop gauge's calibration factor (relative sd), marginalised like the bar gauges' (the default prior
 #: file's ``hoop_gain``: gauge factor, bonding, kernel fit).
 HOOP_GAIN_SD = 0.05
+def hoop_calibration(prior: Any) -> tuple[float, float]:
+    """The hoop gauge's calibration factor as a prior file's ``hoop_gain`` states it: (its median, its relative sd,
+    half the spread of the log of its 16 % and 84 % quantiles, at least :data:`HOOP_GAIN_SD`). The whole-record
+    likelihood was calibrated with that sd: a prior file's tighter one is not taken (the check would flag more than
+    its calibrated rate), a wider one is (a lab that does not know its hoop gauge's factor says so); its median
+    always is. The package's prior files (lognormal, median 1, sigma 0.05) give (1, :data:`HOOP_GAIN_SD`)."""
+    median, low, high = (float(prior.ppf(q)) for q in (0.5, 0.1586553, 0.8413447))
+    if not 0.0 < low <= median <= high < math.inf:
+        raise ValueError(f"the hoop gauge's factor prior has quantiles {low}, {median}, {high}: not a factor")
+    return median, max(math.log(high / low) / 2.0, HOOP_GAIN_SD)
+
+
 #: The likelihood's relative model tolerance where it differs from the channels' (:data:`~.whole_record.TOLERANCE`),
 #: per (channel, phase): none. Measured, not applied (docs/trust.md): on clean records of the axisymmetric simulation
 #: the hoop's shape around the window departs from the 1-D model's by more than 3 %, and diagnose's baseline bends nu
@@ -74,14 +87,16 @@ def _refuse_unknown(table: Mapping[tuple[str, str], float], what: str) -> None:
 class WholeRecordLikelihood:
     """log p(record | parameters) over every gauge's span (module docstring)."""
 
-    def __init__(self, prep: Prepared, model: SimulatorModel, *, hoop_gain_sd: float = HOOP_GAIN_SD,
+    def __init__(self, prep: Prepared, model: SimulatorModel, *,
+                 hoop_calibration: tuple[float, float] = (1.0, HOOP_GAIN_SD),
                  phase_tolerance: Mapping[tuple[str, str], float] | None = None,
                  shape_sd: Mapping[tuple[str, str], float] | None = None, window_only: bool = False) -> None:
         """``phase_tolerance``: the relative tolerance of a (channel, phase) where it is not the channel's
         (:data:`~.whole_record.TOLERANCE`); None: :data:`LIKELIHOOD_TOLERANCE`, {}: the channel's everywhere (the
         whole-record check's fit, as its decision was calibrated). ``shape_sd``: the phases with smooth shape terms
         (:data:`SHAPE_SD`, the default when None; {}: none). ``window_only``: every gauge over its stationary window
-        alone (the quasi-static part of the record, :mod:`.nu_cut`'s module for nu)."""
+        alone (the quasi-static part of the record, :mod:`.nu_cut`'s module for nu). ``hoop_calibration``: the hoop
+        gauge's calibration factor known beforehand (median, relative sd; :func:`hoop_calibration`)."""
         rec = prep.record
         self.phase_tolerance = LIKELIHOOD_TOLERANCE if phase_tolerance is None else phase_tolerance
         self.shape_sd = SHAPE_SD if shape_sd is None else shape_sd
@@ -90,8 +105,10 @@ class WholeRecordLikelihood:
         self.model = model
         self.channels = tuple(c for c in CHANNEL_LABELS if c in rec.channels and (c != "tube_hoop" or model.hoop))
         #: relative sd of each marginalised gain error, by channel
-        self.gain_sd = {c: sd for c, sd in (GAIN_SD | {"tube_hoop": hoop_gain_sd}).items()
+        self.gain_sd = {c: sd for c, sd in (GAIN_SD | {"tube_hoop": hoop_calibration[1]}).items()
                         if c in self.channels and sd > 0.0}
+        #: the hoop gauge's factor the predictions are scaled by before its error (sd ``gain_sd``) is marginalised
+        self.hoop_median = float(hoop_calibration[0])
         self.bounds = channel_spans(prep, self.channels)
         if window_only:
             self.bounds = {c: (b[1], b[1], b[2], b[2]) for c, b in self.bounds.items()}
@@ -197,8 +214,8 @@ class WholeRecordLikelihood:
         """The hoop gauge's calibration factor given a prediction at factor 1: its most probable value under
         its prior (jointly with the channel's offset error and shape terms)."""
         if "tube_hoop" not in self.gain_sd:
-            return 1.0
-        return 1.0 + self.gain_posterior("tube_hoop", predicted_unit)[0]
+            return self.hoop_median
+        return self.hoop_median * (1.0 + self.gain_posterior("tube_hoop", predicted_unit)[0])
 
     def gain_posterior(self, c: str, predicted_unit: np.ndarray) -> tuple[float, float]:
         """Posterior mean and variance of channel ``c``'s gain error (its calibration included, jointly with
@@ -210,9 +227,9 @@ class WholeRecordLikelihood:
         return float(d[k]), float(np.linalg.inv(V.T @ V + np.diag(1.0 / sds**2))[k, k])
 
     def unit_strains(self, values: Mapping[str, float]) -> dict[str, np.ndarray]:
-        """Predicted strains with the hoop gauge's factor 1: what the likelihood conditions on (the gauges'
-        calibration errors are its nuisances)."""
-        return self.model.predict(dict(values) | {"hoop_gain": 1.0}).strains
+        """Predicted strains with the hoop gauge's factor at its known median (1 unless a prior file says otherwise):
+        what the likelihood conditions on (the gauges' calibration errors are its nuisances)."""
+        return self.model.predict(dict(values) | {"hoop_gain": self.hoop_median}).strains
 
     def strains(self, values: Mapping[str, float]) -> tuple[dict[str, np.ndarray], float]:
         """Predicted strains with the hoop gauge's most probable factor applied; returns (strains, factor)."""
@@ -221,10 +238,10 @@ class WholeRecordLikelihood:
     def scaled(self, pred: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray], float]:
         """:meth:`unit_strains`' prediction with the hoop gauge's most probable factor applied."""
         pred = dict(pred)
-        g = 1.0
+        g = self.hoop_median
         if "tube_hoop" in self.channels:
             g = self.hoop_gain(pred["tube_hoop"])
-            pred["tube_hoop"] = g * pred["tube_hoop"]
+            pred["tube_hoop"] = (g / self.hoop_median) * pred["tube_hoop"]
         return pred, g
 
     def whitened(self, values: Mapping[str, float]) -> np.ndarray:

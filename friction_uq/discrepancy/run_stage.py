@@ -13,6 +13,7 @@ from ..models.simulator import NU
 from ..priors import Priors
 from .check import WholeRecordCheck, check_whole_record
 from .diagnose import Diagnosis, diagnose
+from .record_likelihood import HOOP_GAIN_SD, hoop_calibration
 
 
 def f_nu_log_prior(priors: Priors) -> Callable[[Mapping[str, float]], float]:
@@ -24,11 +25,17 @@ def f_nu_log_prior(priors: Priors) -> Callable[[Mapping[str, float]], float]:
     return log_prior
 
 
+def _hoop_calibration(priors: Priors) -> tuple[float, float]:
+    """The hoop gauge's factor as the run's prior file states it (a prior file without ``hoop_gain``: 1 +- 5 %)."""
+    return hoop_calibration(priors["hoop_gain"]) if "hoop_gain" in priors else (1.0, HOOP_GAIN_SD)
+
+
 def whole_record_check(prep: Prepared, priors: Priors, start: Mapping[str, float], *, hoop: bool,
                        seed: int) -> WholeRecordCheck:
     """:func:`.check.check_whole_record` with the run's f and nu priors, started from ``start`` (run: the
     lab's eq. 17 estimate)."""
-    return check_whole_record(prep, f_nu_log_prior(priors), start, hoop=hoop and prep.record.has_hoop, seed=seed)
+    return check_whole_record(prep, f_nu_log_prior(priors), start, hoop=hoop and prep.record.has_hoop, seed=seed,
+                              hoop_calibration=_hoop_calibration(priors))
 
 
 def run_diagnose(prep: Prepared, priors: Priors, start: Mapping[str, float], *, hoop: bool, seed: int,
@@ -42,7 +49,7 @@ def run_diagnose(prep: Prepared, priors: Priors, start: Mapping[str, float], *, 
     scales = {par.name: par.gaussian_stand_in(priors[par.name]) for par in (F, NU)}
     dg = diagnose(prep, f_nu_log_prior(priors), start, hoop=hoop and prep.record.has_hoop, seed=seed,
                   progress=lambda m: say(f"diagnose: {m}"), base_scales=scales, stationary_f=stationary_f,
-                  nu_cut=True)
+                  nu_cut=True, hoop_calibration=_hoop_calibration(priors))
     return dg if check is None else replace(dg, check_hoop_gain=check.hoop_gain)
 
 
