@@ -108,6 +108,7 @@ def test_pdf_pages_in_order_though_made_on_two_cores(paper_run):
                     ("10-11", "whole test vs gauges")):
         assert f"{n} {what}" in " ".join(pages.split()), (n, what)  # the summary's list uses the same numbers
     assert "(1/2)" in texts[9] and "(2/2)" in texts[10]
+    assert "the bars' dispersion not corrected" in " ".join(texts[0].split())  # how the forces were read
     assert reader.metadata["/Title"] == "friction-uq paper P-01"
     # the window's change as the JSON gives it, in words on the first page
     doc = json.loads((out / "paper_P-01.json").read_text())
