@@ -170,6 +170,7 @@ def _analyze(args: argparse.Namespace) -> int:
         out = ident.to_json()
         out["test_id"], out["campaign"] = rec.test_id, rec.campaign
         out["gauge_notes"] = list(prep.gauge_notes)
+        out["window_automatic"], out["dispersion_correction"] = prep.window.automatic, prep.forces.dispersion
         print(json.dumps(out))
     else:
         print(identification_table(rec, ident) + "".join(f"\ngauge note: {n}" for n in prep.gauge_notes))

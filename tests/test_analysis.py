@@ -110,6 +110,8 @@ def test_analyze_json_cli(paper_record, capsys):
         assert key in out
     assert out["f"] == pytest.approx(0.05, abs=0.003)
     assert len(out["window"]) == 2
+    # how the record was read, so that the file alone reproduces it
+    assert out["window_automatic"] is True and out["dispersion_correction"] is False
 
 
 def test_a_reversed_output_gauge_is_refused(tmp_path):
