@@ -393,10 +393,18 @@ def test_a_hoop_calibration_finding_needs_the_baseline_and_the_final_model_to_ag
     from types import SimpleNamespace
 
     dg = SimpleNamespace(baseline=SimpleNamespace(hoop_gain=1.0), check_hoop_gain=base,
-                         final=SimpleNamespace(hoop_gain=final, predicted={"tube_hoop": None}))
+                         final=SimpleNamespace(hoop_gain=final, predicted={"tube_hoop": None}),
+                         hoop_calibration=(1.0, 0.05))
     assert diagnosis_words.hoop_gain_off(dg) is found
     dg.baseline.hoop_gain, dg.check_hoop_gain = base, None  # diagnose alone: its own baseline
     assert diagnosis_words.hoop_gain_off(dg) is found
+    # a factor the prior file states (the gauge known to read 0.85) is no finding; a departure from it is
+    dg.hoop_calibration = (0.85, 0.05)
+    dg.baseline.hoop_gain, dg.final.hoop_gain = 0.85 * base, 0.85 * final
+    assert diagnosis_words.hoop_gain_off(dg) is found
+    dg.baseline.hoop_gain, dg.final.hoop_gain = 0.85, 0.85
+    assert diagnosis_words.hoop_gain_off(dg) is False
+    assert diagnosis_words.hoop_prior_words(dg) == "a 5 % prior about 0.85"
 
 
 @pytest.mark.slow  # a whole diagnose with exact posteriors, 50-110 s

@@ -189,7 +189,8 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
                      baseline_comparison=a, final_comparison=b, pareto_k=k, importance_ess=ess,
                      posterior_method=method, posterior_converged=converged, context=dg.context, seed=seed,
                      verdicts=tuple(verdicts), mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src, swaps=swaps,
-                     swap_models=checked, mixture_of=mixture_of, shared_delay=shared)
+                     swap_models=checked, mixture_of=mixture_of, shared_delay=shared,
+                     hoop_calibration=dg.hoop_calibration)
 
 
 def _mixture_after_causes(final: ModelFit, rounds: list, verdicts: list, causes: list, swaps: tuple, checked: tuple,

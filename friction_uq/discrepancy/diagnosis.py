@@ -56,6 +56,8 @@ class Diagnosis:
     #: the hoop gauge's calibration factor as the whole-record check reads it (f and nu free only: the model
     #: the misfit decision judges), when ``run`` made the check
     check_hoop_gain: float | None = None
+    #: the hoop gauge's factor known beforehand (median, relative sd) every model read it with (a prior file's)
+    hoop_calibration: tuple[float, float] = (1.0, 0.05)
     #: the final model's normal approximation against its exact posterior (:func:`.exact_model.exact_posterior`),
     #: when a cause was named: Pareto k, the kept draws' effective sample size, how the exact draws were obtained
     #: (friction_uq.stats.exact: "importance", "importance (second proposal)" or "emcee") and whether they reached

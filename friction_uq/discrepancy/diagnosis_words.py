@@ -196,7 +196,8 @@ def hoop_gain_off(dg: Diagnosis) -> bool:
     is a calibration finding."""
     if "tube_hoop" not in dg.final.predicted:
         return False
-    a, b = baseline_hoop_gain(dg) - 1.0, dg.final.hoop_gain - 1.0
+    known = dg.hoop_calibration[0]  # a factor the prior file states is no finding: its departure from it is
+    a, b = baseline_hoop_gain(dg) / known - 1.0, dg.final.hoop_gain / known - 1.0
     return abs(a) > HOOP_GAIN_FINDING and abs(b) > HOOP_GAIN_FINDING and a * b > 0
 
 
@@ -205,4 +206,10 @@ def _hoop_finding(dg: Diagnosis) -> str:
         return ""
     g = dg.final.hoop_gain
     return (f"the tube hoop gauge reads {g:.2f} times the model's strain, {baseline_hoop_gain(dg):.2f} without "
-            "the causes (its calibration factor, most probable value under a 5 % prior)")
+            f"the causes (its calibration factor, most probable value under {hoop_prior_words(dg)})")
+
+
+def hoop_prior_words(dg: Diagnosis) -> str:
+    """The hoop factor's prior in words: "a 5 % prior" (the package's), or with the median a prior file states."""
+    median, sd = dg.hoop_calibration
+    return f"a {100 * sd:.0f} % prior" + ("" if median == 1.0 else f" about {median:.3g}")

@@ -12,7 +12,7 @@ from .candidates_mixture import STATIONARY
 from .diagnosis import Diagnosis, ModelFit, Ranked
 from .diagnosed_f import member_variants, mixture_label
 from .cause_words import chain_gauge
-from .diagnosis_words import baseline_hoop_gain, hoop_gain_off, sentence
+from .diagnosis_words import baseline_hoop_gain, hoop_gain_off, hoop_prior_words, sentence
 from .effective_prior import log_prior_f_effective
 from .exact_model import IMPORTANCE_DRAWS
 from .verdict import FORM_SHIFT
@@ -166,7 +166,7 @@ def _posterior_json(dg: Diagnosis, f_without: dict[str, float]) -> dict[str, obj
         "hoop_gain": None if "tube_hoop" not in dg.final.predicted else {  # no hoop gauge read: nothing to say
             "value": hoop, "without_causes": baseline_hoop_gain(dg), "finding": hoop_gain_off(dg),
             "meaning": "calibration factor of the tube hoop gauge (recorded / true) at the final model's whole-record "
-                       "fit: its most probable value under a 5 % prior"},
+                       f"fit: its most probable value under {hoop_prior_words(dg)}"},
         "residual_rms": {ch: {ph: {"before": b, "after": a} for ph, (b, a) in phases.items()}
                          for ch, phases in dg.rms.items()},
     }

@@ -15,6 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..discrepancy.diagnosis import Diagnosis
+from ..discrepancy.diagnosis_words import hoop_prior_words
 from ..stats import RULE
 from ..discrepancy.outcome import kappa_draws
 from ..discrepancy.verdict import FORM_SHIFT
@@ -94,7 +95,7 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
              f"f, model '{dg.final.label}': {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] "
              f"(nu {np.median(dg.final.fit.draws['nu']):.3f}, kappa {np.median(kappa_draws(dg.final)):.4f})",
              *_nu_source_line(dg),
-             *([f"hoop gauge gain (final model, most probable under its 5 % prior): {dg.final.hoop_gain:.3f}"]
+             *([f"hoop gauge gain (final model, most probable under {hoop_prior_words(dg)}): {dg.final.hoop_gain:.3f}"]
                if "tube_hoop" in dg.final.predicted else []), ""]
     for v in dg.causes:
         turn = "" if v in dg.named_causes else (" (in the model within the check's tolerance, not named)"
