@@ -166,15 +166,17 @@ def test_a_short_exact_posterior_is_a_warning_that_names_its_effective_size():
 
 def test_exact_draws_go_on_where_one_draw_carries_every_weight():
     """A normal approximation a thousand times too wide: one draw of the first proposal carries all the weight (the
-    others' underflow to 0), its weighted covariance was nan and the second proposal an internal error; now the
-    second proposal is the robust covariance around that draw, and the draws end as the exact posterior's."""
+    others' underflow to 0), its weighted covariance was nan and the second proposal an internal error; now emcee
+    takes over from the first proposal's draws (the second's scale would be the one that failed), as it does when
+    the second proposal fails, and the draws are on the posterior's scale, not the proposal's."""
     from friction_uq.stats.exact import exact_draws
 
     def log_post(z):
         return float(-0.5 * np.sum((np.asarray(z) / 1e-3) ** 2))
 
-    ex = exact_draws(log_post, np.zeros(2), np.eye(2), np.eye(2), rng=np.random.default_rng(1))
-    assert ex.converged
-    n = len(ex.z)
-    np.testing.assert_allclose(np.std(ex.z, axis=0), 1e-3, rtol=5 * 1.0 / np.sqrt(2 * ex.ess) + 0.05)
-    assert np.all(np.abs(np.mean(ex.z, axis=0)) < 5e-3 / np.sqrt(ex.ess)) and n > 0
+    for seed in (1, 2, 3):
+        ex = exact_draws(log_post, np.zeros(2), np.eye(2), np.eye(2), rng=np.random.default_rng(seed))
+        assert ex.method == "emcee"
+        sd = np.std(ex.z, axis=0)
+        # a fallback from a degenerate start: within a factor 2 of the posterior's sd and its mean within one sd
+        assert np.all((0.5e-3 < sd) & (sd < 2e-3)) and np.all(np.abs(ex.z.mean(axis=0)) < 1e-3), (seed, sd)

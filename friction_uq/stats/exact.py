@@ -171,18 +171,18 @@ def _emcee(log_post_rows: Callable[[np.ndarray], np.ndarray], z: np.ndarray, log
     return flat[rng.choice(len(flat), size=n, replace=len(flat) < n)], float(ess), nwalkers * total, converged
 
 
-def _second_proposal(first: _Stage, cov_robust: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Centre and scale of the second proposal: the first's weighted draws' mean and covariance (x 1.5), or, where
-    fewer draws than dimensions carry the weight (their covariance is singular: one draw carrying it all gave nan),
-    the heaviest draw with the robust covariance x 1.5."""
-    ndim = first.z.shape[1]
+def _second_proposal(first: _Stage) -> tuple[np.ndarray, np.ndarray] | None:
+    """Centre and scale of the second proposal: the first's weighted draws' mean and covariance (x 1.5); None where
+    one draw carries every weight (the others' underflow to 0: the covariance is nan, and the first proposal's scale
+    is the one that failed), and emcee takes over from the first's draws."""
     top = float(np.max(first.log_weights))
-    w = np.exp(first.log_weights - top) if math.isfinite(top) else np.zeros(len(first.z))
-    if not w.sum() > 0.0 or float(w.sum()) ** 2 / float(w @ w) < ndim + 1:
-        best = int(np.argmax(w)) if w.sum() > 0.0 else int(np.argmax(first.log_target))
-        return first.z[best], 1.5 * np.atleast_2d(cov_robust) + 1e-12 * np.eye(ndim)
+    if not math.isfinite(top):
+        return None
+    w = np.exp(first.log_weights - top)
     w /= w.sum()
-    cov = np.atleast_2d(np.cov(first.z, rowvar=False, aweights=w)) * 1.5 + 1e-12 * np.eye(ndim)
+    if float(w @ w) >= 1.0 - 1e-12:
+        return None
+    cov = np.atleast_2d(np.cov(first.z, rowvar=False, aweights=w)) * 1.5 + 1e-12 * np.eye(first.z.shape[1])
     return w @ first.z, cov
 
 
@@ -209,13 +209,15 @@ def exact_draws(log_post: Callable[[np.ndarray], float], mode: np.ndarray, cov_l
     calls, st, method = len(first.z), first, "importance"
     omega = sandwich_map(mode, cov_laplace, cov_robust)
     if not first.kept(floor):
-        mean, cov = _second_proposal(first, cov_robust)
-        st = _importance(log_post_rows, stats.multivariate_t(mean, cov, df=5, allow_singular=True),
-                         n_importance, rng, floor)
-        calls += len(st.z)
-        method = "importance (second proposal)"
-        if not st.kept(floor):
-            zz, ll = np.concatenate([first.z, st.z]), np.concatenate([first.log_weights, st.log_weights])
+        second = _second_proposal(first)
+        if second is not None:
+            st = _importance(log_post_rows, stats.multivariate_t(*second, df=5, allow_singular=True),
+                             n_importance, rng, floor)
+            calls += len(st.z)
+            method = "importance (second proposal)"
+        if second is None or not st.kept(floor):
+            zz, ll = (first.z, first.log_weights) if second is None else (
+                np.concatenate([first.z, st.z]), np.concatenate([first.log_weights, st.log_weights]))
             out, ess, n_calls, ok = _emcee(log_post_rows, zz, ll, n_out, rng, steps=emcee_steps, burn=emcee_burn,
                                            floor=floor)
             return ExactDraws(out, mode + (out - mode) @ omega.T, "emcee", first.k, math.nan, ess,
