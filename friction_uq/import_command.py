@@ -7,7 +7,8 @@ until the command runs.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
+
+from .cli_arguments import path_argument
 
 HELP = "oscilloscope files (CSV, TSV, TDMS, LeCroy .trc, Tektronix/Rigol .wfm) to a test record (test.h5)"
 DESCRIPTION = (
@@ -20,10 +21,10 @@ DESCRIPTION = (
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("import", help=HELP, description=DESCRIPTION)
-    s.add_argument("files", type=Path, nargs="*", metavar="FILE",
+    s.add_argument("files", type=path_argument, nargs="*", metavar="FILE",
                    help="one file with every channel, or one file per channel")
-    s.add_argument("--setup", type=Path, metavar="SETUP.toml", help="what the files hold and the apparatus")
-    s.add_argument("-o", "--output", type=Path, help="record to write (test.h5)")
+    s.add_argument("--setup", type=path_argument, metavar="SETUP.toml", help="what the files hold and the apparatus")
+    s.add_argument("-o", "--output", type=path_argument, help="record to write (test.h5)")
     s.add_argument("--template", action="store_true", help="print a commented SETUP.toml (the paper's set-up) and exit")
     s.add_argument("--show", action="store_true",
                    help="print what each FILE holds (layout, columns or channels, first values) and exit: "

@@ -8,6 +8,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from .cli_arguments import path_argument
+
 HELP = "list the materials with prior files, or write starting prior files for a new sample material"
 DESCRIPTION = (
     "Without MATERIAL: the materials whose prior files come with friction-uq (and those in --out), each with its "
@@ -34,7 +36,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--nu", type=float, help="your estimate of the sample's Poisson ratio, in (0, 0.5)")
     s.add_argument("--nu-sd", type=float, help="its uncertainty (one standard deviation), e.g. 0.03")
     s.add_argument("--source", default="", help="where the estimate comes from (written into the files)")
-    s.add_argument("--out", type=Path, default=Path("."), help="folder to write to (default: the current folder)")
+    s.add_argument("--out", type=path_argument, default=Path("."), help="folder to write to (default: the current folder)")
     s.add_argument("--force", action="store_true", help="replace files of the same names")
 
 

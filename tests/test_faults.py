@@ -231,6 +231,8 @@ def test_a_real_full_disk_is_one_sentence_and_leaves_nothing(record, tmp_path):
     (["run", "{rec}", "--out", ""], "argument --out: an empty path"),
     (["campaign", "{rec}", "--out", ""], "argument --out: an empty path"),
     (["analyze", ""], "argument file: an empty path"),
+    (["priors", "I1", "--nu", "0.4", "--out", ""], "argument --out: an empty path"),
+    (["import", "--setup", "", "-o", "{tmp}/x.h5"], "argument --setup: an empty path"),
     (["analyze", "{tmp}"], "is a directory"),
 ])
 def test_bad_input_is_one_sentence_before_any_work(record, tmp_path, capsys, argv, words):
