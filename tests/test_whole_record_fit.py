@@ -295,3 +295,36 @@ def test_a_hoop_gauge_known_to_read_low_is_read_with_its_known_factor(tmp_path):
     assert known.hoop_gain == pytest.approx(0.85, abs=0.02) and nu[0] <= 0.4 <= nu[1] and f[0] <= 0.05 <= f[1]
     unknown, nu, f = baseline((1.0, HOOP_GAIN_SD))  # what it read before: the factor pulled toward 1, nu and f off
     assert unknown.hoop_gain > 0.9 and nu[1] < 0.4 and f[0] > 0.05
+
+
+def test_the_hoop_prediction_carries_the_known_factor_once(clean_record):
+    """The prediction the likelihood conditions on is at the known median; strains() scales it by the most
+    probable factor over that median: the hoop strain is the model's at the factor reported, not at its square."""
+    prep = prepare(clean_record)
+    model = SimulatorModel(clean_record.apparatus, measured_loading(clean_record, prep.forces), hoop=True)
+    lik = WholeRecordLikelihood(prep, model, hoop_calibration=(0.85, HOOP_GAIN_SD))
+    values = {"f": 0.06, "nu": 0.4}
+    pred, g = lik.strains(values)
+    np.testing.assert_allclose(pred["tube_hoop"], model.predict(values | {"hoop_gain": g}).strains["tube_hoop"],
+                               rtol=1e-12, atol=1e-18)
+
+
+def test_a_prior_files_hoop_factor_reaches_the_check_and_diagnose(tmp_path, clean_record, monkeypatch):
+    from friction_uq.discrepancy import run_stage
+    from friction_uq.prior_loader import default_prior_path, load_priors
+
+    text = default_prior_path("I1").read_text()
+    path = tmp_path / "low.toml"
+    hoop = 'distribution = "lognormal"\nmedian = 1.0\nsigma = 0.05'  # the package's hoop_gain table
+    assert text.count(hoop) == 1
+    path.write_text(text.replace(hoop, hoop.replace("median = 1.0", "median = 0.85")))
+    priors = load_priors(path)
+    assert float(priors["hoop_gain"].ppf(0.5)) == pytest.approx(0.85)
+    seen = {}
+    monkeypatch.setattr(run_stage, "check_whole_record", lambda *a, **k: seen.setdefault("check", k))
+    monkeypatch.setattr(run_stage, "diagnose", lambda *a, **k: seen.setdefault("diagnose", k))
+    prep = prepare(clean_record)
+    run_stage.whole_record_check(prep, priors, {"f": 0.06, "nu": 0.4}, hoop=True, seed=1)
+    run_stage.run_diagnose(prep, priors, {"f": 0.06, "nu": 0.4}, hoop=True, seed=1)
+    for k in ("check", "diagnose"):
+        assert seen[k]["hoop_calibration"] == (pytest.approx(0.85), HOOP_GAIN_SD), k

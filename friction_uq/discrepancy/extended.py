@@ -251,7 +251,7 @@ class Diagnoser:
     def _calibration(self, lik: WholeRecordLikelihood, fit: WholeRecordFit, unit: Mapping[str, np.ndarray],
                      modulus_scale: tuple[float, float]) -> dict[str, tuple[float, float, float]]:
         """The calibration data left out in turn (:func:`~.elpd.calibration_loo`): the hoop gauge's factor
-        (1 +- its prior sd) and the sample's modulus (the header's, its prior's Gaussian stand-in in the
+        (its known median +- its prior sd) and the sample's modulus (the header's, its prior's Gaussian stand-in in the
         unbounded coordinate), each from the fit's posterior at the mode."""
         out = {}
         if "tube_hoop" in lik.gain_sd:

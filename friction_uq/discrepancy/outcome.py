@@ -74,10 +74,11 @@ RULE_TEXT = ("a cause is named only of a misfit the whole-record check found, wh
              "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
              f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
              "the entry stays in the model within the check's tolerance (within_tolerance), not named")
-def elpd_text(hoop: bool) -> str:
-    """How the ELPD is computed, in words (the JSON's ``elpd``); ``hoop``: the models read the hoop gauge."""
-    data = "hoop gauge factor 1 +- 5 %, the header's sample modulus +- 10 %" if hoop else \
-        "the header's sample modulus +- 10 %"
+def elpd_text(hoop: tuple[float, float] | None) -> str:
+    """How the ELPD is computed, in words (the JSON's ``elpd``); ``hoop``: the hoop gauge's known factor and its
+    relative sd where the models read the hoop gauge, else None."""
+    data = "the header's sample modulus +- 10 %" if hoop is None else \
+        f"hoop gauge factor {hoop[0]:.3g} +- {100 * hoop[1]:.0f} %, the header's sample modulus +- 10 %"
     return ("exact leave-one-block-out (10 us blocks per gauge) for AR(1) noise, first order around the mode, "
             f"plus the calibration data ({data}) each left out in turn (calibration_elpd per model)")
 
@@ -92,7 +93,7 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
         "rule": RULE_TEXT,
         "reference_misfit": [{"statistic": m.statistic, "threshold": m.threshold, "detected": m.detected}
                              for m in dg.misfits],
-        "elpd": elpd_text("tube_hoop" in dg.final.predicted),
+        "elpd": elpd_text(dg.hoop_calibration if "tube_hoop" in dg.final.predicted else None),
         "seconds": dg.seconds,
         "sentence": sentence(dg, f_without if f_without_quoted is None else f_without_quoted),
     }
@@ -235,7 +236,8 @@ def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
               "calibration_elpd": (("calibration",), mf.elpd.calibration)}
         method = dg.posterior_method if mf is dg.final and dg.causes else "normal approximation (robust covariance)"
         dt[f"discrepancy_{key}/posterior"] = xr.DataTree(xr.Dataset(post, attrs={
-            "model": mf.label, "hoop_gain": mf.hoop_gain, "posterior_method": method, "f_from": mf.f_from}))
+            "model": mf.label, "posterior_method": method, "f_from": mf.f_from}
+            | ({"hoop_gain": mf.hoop_gain} if "tube_hoop" in mf.predicted else {})))
         dt[f"discrepancy_{key}/log_likelihood"] = xr.DataTree(xr.Dataset(
             ll, coords={"calibration": list(mf.elpd.calibration_names)}, attrs={
             "elpd": mf.elpd.total, "elpd_se": mf.elpd.se,

@@ -41,6 +41,8 @@ GAIN_SD = {"internal_output_bar": 0.01, "external_output_bar": 0.01}
 #: The hoop gauge's calibration factor (relative sd), marginalised like the bar gauges' (the default prior
 #: file's ``hoop_gain``: gauge factor, bonding, kernel fit).
 HOOP_GAIN_SD = 0.05
+
+
 def hoop_calibration(prior: Any) -> tuple[float, float]:
     """The hoop gauge's calibration factor as a prior file's ``hoop_gain`` states it: (its median, its relative sd,
     half the spread of the log of its 16 % and 84 % quantiles, at least :data:`HOOP_GAIN_SD`). The whole-record
@@ -211,15 +213,16 @@ class WholeRecordLikelihood:
         return slice(i0, i3)
 
     def hoop_gain(self, predicted_unit: np.ndarray) -> float:
-        """The hoop gauge's calibration factor given a prediction at factor 1: its most probable value under
-        its prior (jointly with the channel's offset error and shape terms)."""
+        """The hoop gauge's calibration factor given a prediction at its known median factor (:meth:`unit_strains`):
+        its most probable value under its prior (jointly with the channel's offset error and shape terms)."""
         if "tube_hoop" not in self.gain_sd:
             return self.hoop_median
         return self.hoop_median * (1.0 + self.gain_posterior("tube_hoop", predicted_unit)[0])
 
     def gain_posterior(self, c: str, predicted_unit: np.ndarray) -> tuple[float, float]:
         """Posterior mean and variance of channel ``c``'s gain error (its calibration included, jointly with
-        the channel's offset error and shape terms) given a prediction at factor 1."""
+        the channel's offset error and shape terms) given a prediction at factor 1 (the hoop's: at its known
+        median, :meth:`unit_strains`)."""
         nz = self.noise[c]
         w = whiten(self._raw_scaled(c, predicted_unit), sd=nz.sd, rho=nz.rho_long_run)
         d, _, V, sds, _ = self._nuisances(c, predicted_unit, w)
