@@ -77,6 +77,9 @@ def test_tests_analysed_otherwise_are_said_apart(two_campaigns):
     doc = json.loads(two_campaigns[0].read_text()) | {"prior_file": "/lab/I1-mine.toml"}
     two_campaigns[0].write_text(json.dumps(doc))
     assert "the prior file: A-01: I1-mine.toml; A-02: I1.toml" in comparison_table(compare(two_campaigns))
+    doc = json.loads(two_campaigns[0].read_text()) | {"prior_file": "/lab/I1.toml"}  # two files of one name
+    two_campaigns[0].write_text(json.dumps(doc))
+    assert "the prior file: A-01: /lab/I1.toml; A-02: /x/priors/I1.toml" in comparison_table(compare(two_campaigns))
 
 
 def test_a_file_that_is_not_a_result_is_refused(tmp_path, capsys):

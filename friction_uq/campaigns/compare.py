@@ -215,8 +215,11 @@ def settings_differences(results: list[TestResult]) -> list[str]:
     for key, words in SETTINGS.items():
         values = {r.test_id if len({q.test_id for q in results}) == len(results) else f"{r.campaign} {r.test_id}":
                   dict(r.settings).get(key) for r in results}
-        if len(set(values.values())) > 1:
-            said = "; ".join(f"{t}: {_setting_text(v)}" for t, v in values.items())
+        distinct = set(values.values())
+        if len(distinct) > 1:
+            whole = len({_setting_text(v) for v in distinct}) < len(distinct)  # two files of one name: their paths
+            said = "; ".join(f"{t}: {v if whole and isinstance(v, str) else _setting_text(v)}"
+                             for t, v in values.items())
             out.append(f"analysed differently, {words}: {said} (the trends above mix them)")
     return out
 
