@@ -252,5 +252,5 @@ def test_a_channel_over_the_limit_is_refused_right_after_parsing(tmp_path, monke
     monkeypatch.setattr(binary, "MAX_SAMPLES", 100)
     with pytest.raises(ScopeFileError) as e:
         read_binary(path, ["CH1"])
-    assert str(e.value) == (f"{path}: channel 1 (CH 1), by the header's record length, holds 500 samples, more "
+    assert str(e.value) == (f"{path}: channel 1 (CH 1), as RigolWFM decoded it, holds 500 samples, more "
                             "than the 100 a record may hold (docs/limits.md); export a shorter or decimated record")

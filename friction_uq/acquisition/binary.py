@@ -92,7 +92,7 @@ def _pick_channel(path: Path, chans: list[Any], col: str | int) -> Any:
         raise ScopeFileError(f"{path}: no channel {col!r} with data; the file has {have}")
     c = hits[0]
     if len(c.volts) > MAX_SAMPLES:
-        raise over_limit(path, f"channel {c.channel_number} ({c.name}), by the header's record length,",
+        raise over_limit(path, f"channel {c.channel_number} ({c.name}), as RigolWFM decoded it,",
                          len(c.volts), "holds", MAX_SAMPLES)
     return c
 

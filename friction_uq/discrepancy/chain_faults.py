@@ -61,9 +61,7 @@ OUTPUT_BARS = ("internal_output_bar", "external_output_bar")
 
 def _bar_modulus(v: Mapping[str, float], s: dict[str, Any], g: dict[str, Reading], ch: str | None) -> None:
     app = s["apparatus"]
-    for name in OUTPUT_BARS:
-        if f"modulus_factor_{name}" not in v:  # a bar whose gauge the record does not read
-            continue
+    for name in OUTPUT_BARS:  # both output bars' gauges are in every record
         k = float(v[f"modulus_factor_{name}"])
         bar = getattr(app, name)
         app = replace(app, **{name: replace(bar, young_modulus=bar.young_modulus * k,
