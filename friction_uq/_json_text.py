@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -31,6 +32,23 @@ def finite_or_null(obj: Any) -> Any:
     if isinstance(obj, (float, np.floating)):
         return float(obj) if math.isfinite(obj) else None
     return obj
+
+
+def read_json_file(path: Path, what: str = "result file") -> Any:
+    """The JSON document of an input file (a run's result), read as every text input is
+    (:func:`~friction_uq.plausible.text_of`: a regular file, its size, UTF-8); else one FrictionUQError naming the
+    file: not a ``what``, or not JSON (an integer of more than 4300 digits and a nesting too deep included)."""
+    from .errors import FrictionUQError
+    from .plausible import MAX_TEXT_BYTES, NotText, text_of
+
+    try:
+        text = text_of(path, what, MAX_TEXT_BYTES)
+    except NotText as why:
+        raise FrictionUQError(f"{path}: {why}") from None
+    try:
+        return json.loads(text)
+    except (ValueError, RecursionError) as exc:
+        raise FrictionUQError(f"{path}: not a friction-uq {what} (not JSON: {exc})") from None
 
 
 def json_text(doc: Any, *, indent: int | None = 2) -> str:

@@ -12,7 +12,6 @@ until a function is called.
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -86,17 +85,13 @@ def read_result(path: str | os.PathLike[str]) -> Result:
     FrictionUQError
         The file is missing, not JSON, or not a run result (another schema).
     """
+    from ._json_text import read_json_file
     from .api_arguments import path_argument
     from .errors import FrictionUQError
 
     p = path_argument("path", path)
     js = p.with_suffix(".json") if p.suffix in (".nc", ".pdf", "") else p
-    try:
-        doc = json.loads(js.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise FrictionUQError(f"{js}: cannot be read ({exc.strerror or exc})") from None
-    except (ValueError, RecursionError) as exc:  # not JSON, not UTF-8, nested too deep, a 4300-digit integer
-        raise FrictionUQError(f"{js}: not a friction-uq result file (not JSON: {exc})") from None
+    doc = read_json_file(js)
     if not isinstance(doc, dict) or doc.get("schema") != RUN_SCHEMA:
         raise FrictionUQError(f"{js}: not a run result (key 'schema' is not {RUN_SCHEMA!r})")
     if not isinstance(doc.get("f"), dict):

@@ -18,7 +18,7 @@ from pathlib import Path
 from . import __version__, import_command, priors_command
 from .errors import FrictionUQError, OutputError, os_error_text
 from .cli_arguments import (FIGURE_SUFFIXES, RECORD_SUFFIXES, config_file, nu_argument, output_file, path_argument,
-                            result_files, seed_argument, striker_velocity_argument, window_argument, workers_argument)
+                            seed_argument, striker_velocity_argument, window_argument, workers_argument)
 
 EXIT_BAD_INPUT = 2
 #: Exit status of an unexpected error (a bug), said in one line; FRICTION_UQ_TRACEBACK=1 shows its traceback.
@@ -213,7 +213,6 @@ def _simulate(args: argparse.Namespace) -> int:
 def _compare(args: argparse.Namespace) -> int:
     if args.output:
         output_file(args.output, FIGURE_SUFFIXES, "figure")
-    result_files(args.results)
     from .campaigns import compare, comparison_table
 
     comp = compare(args.results)

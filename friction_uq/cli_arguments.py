@@ -4,7 +4,6 @@ refusal one sentence (argparse's usage error, or a FrictionUQError naming the fi
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -77,16 +76,6 @@ def config_file(path: Path) -> None:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None
     except RecursionError:
         raise ConfigError(f"{path}: nested too deeply to be a simulation configuration") from None
-
-
-def result_files(paths: Sequence[Path]) -> None:
-    """Refuse a ``compare`` input that is not a JSON result (an HDF5 record, a binary, bad JSON)."""
-    for path in paths:
-        text = text_file(path, "result file (JSON written by run)", FrictionUQError)
-        try:
-            json.loads(text)
-        except (ValueError, RecursionError) as exc:  # JSONDecodeError, or an integer of more than 4300 digits
-            raise FrictionUQError(f"{path}: not a friction-uq result file (not JSON: {exc})") from None
 
 
 _TIME_UNITS = {"s": "1", "ms": "1e-3", "us": "1e-6", "\u00b5s": "1e-6"}  # exact decimal scales

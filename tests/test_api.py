@@ -57,8 +57,11 @@ def test_read_result_reads_the_json_and_refuses_others(tmp_path):
     with pytest.raises(FrictionUQError, match=r"y.json: not a friction-uq result file \(not JSON"):
         fu.read_result(tmp_path / "y.json")
     (tmp_path / "z.json").write_bytes(b'{"x": "\xff"}')  # not UTF-8
-    with pytest.raises(FrictionUQError, match=r"z.json: not a friction-uq result file"):
+    with pytest.raises(FrictionUQError, match=r"z.json: is not UTF-8 text \(byte 7\); save the result file as UTF-8"):
         fu.read_result(tmp_path / "z.json")
+    (tmp_path / "d.json").mkdir()  # read as every text input is: a folder named as a result is said so
+    with pytest.raises(FrictionUQError, match=r"d.json: is a folder, not a result file"):
+        fu.read_result(tmp_path / "d.json")
 
 
 @pytest.mark.slow

@@ -11,7 +11,6 @@ either is confounded; a second campaign with another impedance ratio puts the te
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from dataclasses import dataclass
@@ -91,17 +90,11 @@ def load_result(path: str | os.PathLike[str]) -> TestResult:
     file and the key, one that is not a JSON object with the ids as text and each summary as finite numbers. Its
     f is the stationary analysis' (``f_stationary``, given the bars' header values, as its kappa; ``f`` in a
     file of schema 1)."""
-    from ..plausible import MAX_TEXT_BYTES, escaped, unprintable
+    from .._json_text import read_json_file
+    from ..plausible import escaped, unprintable
 
     p = Path(path)
-    try:
-        with open(p, "rb") as fh:
-            raw = fh.read(MAX_TEXT_BYTES + 1)
-        if len(raw) > MAX_TEXT_BYTES:
-            raise FrictionUQError(f"{p}: more than {MAX_TEXT_BYTES} bytes, not a friction-uq result file")
-        doc = json.loads(raw)
-    except (OSError, ValueError, RecursionError) as exc:
-        raise FrictionUQError(f"{p}: not a friction-uq result file ({exc})") from None
+    doc = read_json_file(p)
     if not isinstance(doc, dict):
         raise FrictionUQError(f"{p}: not a friction-uq run result (a JSON {type(doc).__name__}, not an object)")
     from ..record_run.outputs import RUN_SCHEMA, RUN_SCHEMA_VERSION
