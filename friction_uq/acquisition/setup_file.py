@@ -23,11 +23,11 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SetupError
-from ..plausible import NotText, text_of
+from ..plausible import MAX_TEXT_BYTES, NotText, text_of
 from ..record.contract import CHANNELS, REQUIRED_CHANNELS
 
-#: Largest set-up file read (bytes).
-MAX_SETUP_BYTES = 1_000_000
+#: Largest set-up file read (bytes): every text input's (docs/limits.md)
+MAX_SETUP_BYTES = MAX_TEXT_BYTES
 #: Units a channel may be recorded in, and the factor to the unit stored in the record.
 CHANNEL_UNITS = {"V": ("V", 1.0), "mV": ("V", 1e-3), "strain": ("strain", 1.0), "microstrain": ("microstrain", 1.0)}
 #: Time column units and their factor to seconds.
