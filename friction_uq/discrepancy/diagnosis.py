@@ -14,6 +14,7 @@ from .extended import ModelFit, Variant
 from .front_delay import SharedDelay
 from .mechanisms import Context
 from .misfit import MisfitDecision
+from .record_likelihood import HOOP_GAIN_SD
 from .rival_swaps import Swap
 from .verdict import Verdict
 from .whole_record import WholeRecord
@@ -57,7 +58,7 @@ class Diagnosis:
     #: the misfit decision judges), when ``run`` made the check
     check_hoop_gain: float | None = None
     #: the hoop gauge's factor known beforehand (median, relative sd) every model read it with (a prior file's)
-    hoop_calibration: tuple[float, float] = (1.0, 0.05)
+    hoop_calibration: tuple[float, float] = (1.0, HOOP_GAIN_SD)
     #: the final model's normal approximation against its exact posterior (:func:`.exact_model.exact_posterior`),
     #: when a cause was named: Pareto k, the kept draws' effective sample size, how the exact draws were obtained
     #: (friction_uq.stats.exact: "importance", "importance (second proposal)" or "emcee") and whether they reached

@@ -74,6 +74,8 @@ RULE_TEXT = ("a cause is named only of a misfit the whole-record check found, wh
              "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
              f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
              "the entry stays in the model within the check's tolerance (within_tolerance), not named")
+
+
 def elpd_text(hoop: tuple[float, float] | None) -> str:
     """How the ELPD is computed, in words (the JSON's ``elpd``); ``hoop``: the hoop gauge's known factor and its
     relative sd where the models read the hoop gauge, else None."""
