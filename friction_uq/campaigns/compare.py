@@ -200,7 +200,6 @@ def comparison_table(c: Comparison) -> str:
     return "\n".join(lines)
 
 
-
 def settings_differences(results: list[TestResult]) -> list[str]:
     """One line per setting the tests were analysed with that differs among them (the trends then mix analyses:
     a dispersion correction moves kappa by a few per cent), naming each test's value."""
