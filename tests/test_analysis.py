@@ -146,3 +146,20 @@ def test_every_gauge_read_a_thousand_times_small_is_said_not_passed(tmp_path, ca
     assert "gauge note: /signals/input_bar reads an incident wave 0.00099" in capsys.readouterr().out
     assert main(["analyze", str(path), "--json"]) == 0
     assert any("eq. 14" in n for n in json.loads(capsys.readouterr().out)["gauge_notes"])
+
+
+def test_a_spike_on_the_input_bar_is_said_to_leave_the_gauges_unchecked(tmp_path, capsys):
+    """One spike as the input force's peak leaves no loading above half of it: inspect said "signs agree and the
+    output forces sum to nan %", a pass, though neither check had run."""
+    import h5py
+
+    from friction_uq.cli import main
+
+    rec = write_closed_form_record(tmp_path / "spike.h5", ClosedFormTest(), seed=3)
+    with h5py.File(rec, "r+") as fh:
+        x = fh["signals/input_bar"][...]
+        x[len(x) // 2] = 20 * x[np.argmax(np.abs(x))]
+        fh["signals/input_bar"][...] = x
+    main(["inspect", str(rec)])
+    out = capsys.readouterr().out
+    assert "nan %" not in out and "not checked: neither the gauges' signs nor the output forces" in out
