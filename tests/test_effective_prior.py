@@ -75,7 +75,8 @@ def _model(label: str, names: tuple[str, ...], f: np.ndarray):
     elpd = SimpleNamespace(pointwise=np.zeros(3), calibration=np.zeros(1), calibration_names=("hoop_gain",),
                            total=0.0, se=0.0)
     return SimpleNamespace(label=label, variants=_variants(*names), f_effective=f, f_from="cut posterior",
-                           hoop_gain=1.0, elpd=elpd, fit=SimpleNamespace(draws={"f": f, "nu": np.full(f.size, 0.4)}))
+                           hoop_gain=1.0, predicted={"tube_hoop": None}, elpd=elpd,
+                           fit=SimpleNamespace(draws={"f": f, "nu": np.full(f.size, 0.4)}))
 
 
 def _written(dg, tmp_path):
