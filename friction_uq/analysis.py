@@ -15,7 +15,7 @@ import numpy as np
 from .forces import Forces, compute_forces
 from .physics import cell
 from .errors import NoStationaryPhase, SignalError
-from .gauge_check import gauge_findings, scale_findings
+from .gauge_check import flat_run_notes, gauge_findings, scale_findings
 from .record import Record
 from .signals import moving_average
 from .stats.ar1 import ar1_mean_sd
@@ -38,6 +38,7 @@ class Prepared:
     window: Window
     data: StationaryData
     gauge_notes: tuple[str, ...] = ()  # what the gauge check found (friction_uq.gauge_check), for the warnings
+    flat_runs: tuple[str, ...] = ()  # peaks on one value that may be a saturated digitiser (gauge_check.flat_run_notes)
 
 
 def prepare(
@@ -69,7 +70,7 @@ def prepare(
         striker_velocity=record.striker_velocity,
     )
     _check_polarity(record, data)
-    return Prepared(record, forces, win, data, notes)
+    return Prepared(record, forces, win, data, notes, flat_run_notes(record))
 
 
 def _automatic_window(record: Record, forces, criterion: WindowCriterion,

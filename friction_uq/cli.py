@@ -169,11 +169,11 @@ def _analyze(args: argparse.Namespace) -> int:
     if args.json:
         out = ident.to_json()
         out["test_id"], out["campaign"] = rec.test_id, rec.campaign
-        out["gauge_notes"] = list(prep.gauge_notes)
+        out["gauge_notes"] = list(prep.gauge_notes + prep.flat_runs)
         out["window_automatic"], out["dispersion_correction"] = prep.window.automatic, prep.forces.dispersion
         print(json.dumps(out))
     else:
-        print(identification_table(rec, ident) + "".join(f"\ngauge note: {n}" for n in prep.gauge_notes))
+        print(identification_table(rec, ident) + "".join(f"\ngauge note: {n}" for n in prep.gauge_notes + prep.flat_runs))
     return 0
 
 

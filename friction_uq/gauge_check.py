@@ -185,6 +185,22 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *,
         "restores both (check its strain_per_volt, gauge factor, amplifier gain or units)"))]
 
 
+def flat_run_notes(record: Record) -> tuple[str, ...]:
+    """Channels whose peak sits on one value for a run their pre-trigger noise cannot tell from a saturated digitiser
+    (:mod:`friction_uq.record.saturation`; the reader refuses the runs it can tell): one sentence each."""
+    from .record.saturation import flat_run
+
+    notes = []
+    for name, channel in record.channels.items():
+        run = flat_run(channel.strain)
+        if run is None or run.saturated:
+            continue
+        notes.append(f"/signals/{name} sits on one value for {run.run} consecutive samples at its peak, and its "
+                     "pre-trigger noise, below one digitiser step, cannot tell a plateau on one code from a saturated "
+                     "digitiser: if the scope's range ends at that value, the channel is clipped")
+    return tuple(notes)
+
+
 def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFinding]]:
     """(faults, notes) of a record's gauges, for ``inspect`` and ``import``.
 
@@ -210,6 +226,7 @@ def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFi
         faults += hoop_findings(forces, record.apparatus, forces.channels["tube_hoop"].noise.sd)
     if faults:
         return faults, []
+    found += [GaugeFinding("", "flat", note) for note in flat_run_notes(record)]
     s = force_balance(forces)
     if not np.isfinite(s):  # no loading to weigh (a spike as the input bar's peak): nothing was checked
         return [], found or [GaugeFinding("", "ok", (

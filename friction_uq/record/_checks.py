@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import RecordError
 from ..plausible import MAX_ATTRIBUTE_BYTES, MAX_CHUNKS, MAX_SAMPLES, text_bytes
-from .contract import CLIP_RUN
+from .saturation import RUN_ALPHA, flat_run
 
 
 class Reader:
@@ -133,29 +133,14 @@ def check_samples(raw: np.ndarray, where: str, r: Reader) -> None:
         raise r.fail(where, f"has {int(bad.sum())} non-finite samples ({kind} first at index {i})")
     if raw.size and np.ptp(raw) == 0.0:
         raise r.fail(where, f"is flat (every sample equals {float(raw[0])!r}): the gauge recorded no signal")
-    head = raw[: max(32, raw.size // 50)]
-    if np.ptp(head) == 0.0:
-        return
-    median = float(np.median(raw))
-    swing = float(np.max(np.abs(raw - median)))
-    for extreme, label in ((raw.max(), "maximum"), (raw.min(), "minimum")):
-        if abs(float(extreme) - median) < 0.5 * swing:
-            continue  # the extreme of the side the pulse does not reach: baseline noise
-        run = longest_run(raw == extreme)
-        if run >= CLIP_RUN:
-            raise r.fail(
-                where,
-                f"is clipped: {run} consecutive samples sit at the {label} value {float(extreme)!r} "
-                "(amplifier or digitiser saturated); re-record with a smaller gain",
-            )
-
-
-def longest_run(mask: np.ndarray) -> int:
-    if not mask.any():
-        return 0
-    padded = np.concatenate(([0], mask.astype(np.int8), [0]))
-    edges = np.flatnonzero(np.diff(padded))
-    return int((edges[1::2] - edges[0::2]).max())
+    run = flat_run(raw)
+    if run is not None and run.saturated:
+        raise r.fail(
+            where,
+            f"is clipped: {run.run} consecutive samples sit at the {run.side} value {run.value!r} "
+            "(amplifier or digitiser saturated), a run its pre-trigger noise leaves with a chance below "
+            f"{RUN_ALPHA:g}; re-record with a smaller gain",
+        )
 
 
 def check_strain(strain: np.ndarray, where: str, r: Reader) -> None:

@@ -24,10 +24,9 @@ CHANNELS = REQUIRED_CHANNELS + OPTIONAL_CHANNELS
 
 UNITS = {"strain": 1.0, "microstrain": 1e-6, "V": None}
 
-#: Minimum run of identical samples at a channel's extreme value that marks it as clipped.
-#: The test applies only to channels whose pre-trigger head (first 2 %, at least 32 samples)
-#: shows resolved noise: in a noise-free (synthetic) record or one whose noise is below one
-#: digitiser step, a run of equal values is a plateau, not a saturated amplifier.
+#: Minimum run of identical samples at a channel's extreme value that can mark it as clipped; the
+#: run must also be longer than its pre-trigger noise leaves by chance (:mod:`.saturation`): a
+#: plateau read by a digitiser whose step is coarser than its noise sits on one code too.
 CLIP_RUN = 8
 
 #: Minimum number of samples in a channel.

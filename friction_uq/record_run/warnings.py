@@ -13,6 +13,7 @@ Checks and their limits (``docs/trust.md`` gives the calibration):
 * the whole-record check misses a gauge: over the *stationary* phase (the phase eq. 17 reads) on a
   gauge f depends on, or anywhere else (a cause such as a plug friction shows outside that phase
   and biases f inside it);
+* a gauge's peak sits on one value for a run its noise cannot tell from a saturated digitiser;
 * a gauge disagrees over the loading (:mod:`friction_uq.gauge_check`), or the output forces do not
   sum to the input force within :data:`EQUILIBRIUM_TOL` over the window (eq. 5);
 * convergence of the sampler; the prior-data check;
@@ -151,6 +152,14 @@ def gauge_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
             "ratio and is off by as much as their gains are; `friction-uq diagnose` fits a gauge's gain.")
 
 
+def flat_run_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
+    """A gauge's peak on one value that may be a saturated digitiser (:func:`friction_uq.gauge_check.flat_run_notes`)."""
+    if not notes:
+        return None
+    return (f"{'; '.join(notes)}. A clipped gauge reads less than it carried, and {_f_text(f)} with it: check the "
+            "scope's range at that value, or re-record with the gauge's peak well inside it.")
+
+
 def convergence_warning(conv: Convergence) -> str | None:
     if conv.ok:
         return None
@@ -180,10 +189,10 @@ def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
                  conv: Convergence, conflict: PriorDataConflict | None,
                  check: WholeRecordCheck | None, gauge_notes: Sequence[str] = (),
-                 diagnosis=None) -> list[str]:
+                 diagnosis=None, flat_runs: Sequence[str] = ()) -> list[str]:
     """Every check's warning, in the order a reader should see them; empty when all pass."""
     found: Sequence[str | None] = (
-        gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f),
+        flat_run_warning(flat_runs, f), gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f),
         stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f, diagnosis),
         convergence_warning(conv), exact_posterior_warning(diagnosis), conflict_warning(conflict),
     )
