@@ -30,6 +30,10 @@ class SignalError(FrictionUQError):
     """The signals of a record cannot be analysed (no pulse, no stationary phase, ...)."""
 
 
+class ShortPreTrigger(SignalError):
+    """A channel's pulse begins too soon after the record's start to leave a baseline before it."""
+
+
 class NoStationaryPhase(SignalError):
     """No window in which the forces are steady within their noise."""
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from .physics import bars as eq
 from .record import Bar, Record
-from .errors import SignalError
+from .errors import ShortPreTrigger, SignalError
 from .signals import NoiseEstimate, noise_estimate, prepulse_noise, transport, window_mask
 
 
@@ -169,6 +169,8 @@ def _incident_arrival(record: Record, x: np.ndarray, span: int) -> tuple[NoiseEs
     no front at all is refused, naming the file and the channel."""
     try:
         return prepulse_noise(x, span=span, polarity=+1)
+    except ShortPreTrigger as exc:
+        raise SignalError(f"{record.path}: /signals/input_bar: {exc}") from None
     except SignalError as exc:
         try:  # a compression front in the negated signal: the gauge (or its bridge) is wired the other way
             prepulse_noise(-np.asarray(x, float), span=span, polarity=+1)

@@ -29,15 +29,21 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft as scipy_fft
+from scipy.ndimage import median_filter
 
 from .dispersion import propagate
-from .errors import SignalError
+from .errors import ShortPreTrigger, SignalError
 from .stats.ar1 import ar1_mean_sd
 
 #: Threshold, in noise standard deviations, for the first crossing that starts an arrival search.
 ARRIVAL_SIGMAS = 8.0
 #: The crossing must also exceed this fraction of the channel's largest excursion.
 ARRIVAL_FRACTION = 0.05
+#: Width (samples) of the median filter through which a pulse's first crossing and its peak are found: a spike of up
+#: to half as many samples (less one) is passed over, a monotone front is kept as it is.
+SPIKE_FILTER = 7
+#: A pre-pulse sample further than this many robust sd from its running median is a spike, not noise.
+SPIKE_SIGMAS = 8.0
 #: Minimum pre-pulse segment (samples) for a noise estimate.
 MIN_BASELINE_SAMPLES = 32
 
@@ -87,7 +93,7 @@ class NoiseEstimate:
 
 
 def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate:
-    """Offset, standard deviation and lag-1 autocorrelation of ``x[start:stop]``.
+    """Offset, standard deviation and lag-1 autocorrelation of ``x[start:stop]``, its spikes left out (:func:`despiked`).
 
     >>> rng = np.random.default_rng(1)
     >>> e = noise_estimate(3.0 + rng.normal(0, 2.0, 20000), stop=20000)
@@ -100,6 +106,7 @@ def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate
             f"the pre-pulse segment has {seg.size} samples, at least {MIN_BASELINE_SAMPLES} are needed "
             "to estimate the baseline and noise"
         )
+    seg = despiked(seg)
     offset = float(seg.mean())
     d = seg - offset
     var = float(np.mean(d * d))
@@ -109,6 +116,21 @@ def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate
     tau = integrated_autocorrelation(d)
     rho_eff = float(np.clip((tau - 1.0) / (tau + 1.0), 0.0, 0.99))
     return NoiseEstimate(offset=offset, sd=sd, rho=rho, start=int(start), stop=int(stop), rho_eff=rho_eff)
+
+
+def despiked(seg: np.ndarray) -> np.ndarray:
+    """``seg`` with its spikes (samples more than :data:`SPIKE_SIGMAS` robust sd from its running median of
+    :data:`SPIKE_FILTER` samples) replaced by that median: a spike of pick-up is neither offset nor noise. Gaussian
+    noise, white or coloured, has no such sample (a chance of about 1e-15 each): its statistics keep their bits."""
+    if seg.size < SPIKE_FILTER:
+        return seg
+    running = median_filter(seg, SPIKE_FILTER, mode="nearest")
+    r = seg - running
+    sd = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    spikes = np.abs(r) > SPIKE_SIGMAS * sd
+    if sd == 0.0 or not spikes.any():
+        return seg
+    return np.where(spikes, running, seg)
 
 
 def integrated_autocorrelation(d: np.ndarray) -> float:
@@ -194,6 +216,8 @@ def pulse_front(
         excursion = np.abs(y[start:])
     else:
         excursion = polarity * y[start:]
+    if excursion.size >= SPIKE_FILTER:  # a spike (EMI, a trigger's pick-up) is no pulse: a median filter keeps the
+        excursion = median_filter(excursion, SPIKE_FILTER, mode="nearest")  # fronts, as they are monotone
     peak_all = float(excursion.max()) if excursion.size else 0.0
     level = max(ARRIVAL_SIGMAS * sd, ARRIVAL_FRACTION * peak_all)
     hit = np.flatnonzero(excursion >= level)
@@ -223,26 +247,37 @@ def prepulse_noise(
     """Noise estimate from the pre-pulse segment, and the first pulse's arrival (fractional index).
 
     A provisional, robust baseline (median and median absolute deviation of the first
-    ``initial_fraction`` of the record, at least 32 samples) locates the first pulse; the segment
-    then runs from the start to ``margin`` samples before that arrival and is estimated again.
+    ``initial_fraction`` of the record, at least 32 samples, cut where a first look from the first 32
+    finds the pulse's front: a pre-trigger may be shorter) locates the first pulse; the segment then
+    runs from the start to ``margin`` samples before that arrival and is estimated again.
     """
     n = len(x)
     n0 = min(n, max(MIN_BASELINE_SAMPLES, int(initial_fraction * n)))
-    head = np.asarray(x[:n0], dtype=float)
-    med = float(np.median(head))
-    mad_sd = 1.4826 * float(np.median(np.abs(head - med)))
+    med, mad_sd = _robust_baseline(x[:MIN_BASELINE_SAMPLES])
+    arrival, t10, t50 = pulse_front(x, offset=med, sd=max(mad_sd, 1e-300), span=span, polarity=polarity)
+    # a pre-trigger shorter than the head: the head ends where the pulse begins, or its median is the pulse's
+    n0 = max(MIN_BASELINE_SAMPLES, min(n0, int(np.floor(arrival - (t50 - t10))) - margin))
+    med, mad_sd = _robust_baseline(x[:n0])
     arrival, t10, t50 = pulse_front(x, offset=med, sd=max(mad_sd, 1e-300), span=span, polarity=polarity)
     # a smooth front starts before its extrapolated foot: stay one 10-50 % rise time further away
     stop = int(np.floor(arrival - (t50 - t10))) - margin
     if stop < MIN_BASELINE_SAMPLES:
-        raise SignalError(
-            f"the first pulse arrives at sample {arrival:.0f}, leaving no pre-pulse baseline "
-            f"(at least {MIN_BASELINE_SAMPLES + margin} samples needed)"
+        raise ShortPreTrigger(
+            f"the first pulse arrives at sample {arrival:.0f}, its front rising from sample "
+            f"{arrival - (t50 - t10):.0f}, leaving {max(stop, 0)} samples of pre-pulse baseline where at least "
+            f"{MIN_BASELINE_SAMPLES} are needed: record a longer pre-trigger"
         )
     est = noise_estimate(x, stop=stop)
     # a second pass with the refined baseline
     arrival = pulse_arrival(x, offset=est.offset, sd=max(est.sd, 1e-300), span=span, polarity=polarity)
     return est, arrival
+
+
+def _robust_baseline(head: np.ndarray) -> tuple[float, float]:
+    """Median and median absolute deviation (as a normal sd) of a baseline."""
+    head = np.asarray(head, dtype=float)
+    med = float(np.median(head))
+    return med, 1.4826 * float(np.median(np.abs(head - med)))
 
 
 def window_mask(n: int, start: float, stop: float) -> np.ndarray:

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from friction_uq.errors import SignalError
-from friction_uq.signals import noise_estimate, prepulse_noise, pulse_arrival, transport
+from friction_uq.errors import ShortPreTrigger, SignalError
+from friction_uq.signals import despiked, noise_estimate, prepulse_noise, pulse_arrival, transport
 from friction_uq.noise import white_and_ar1_noise
 
 FS = 5e6
@@ -168,3 +168,52 @@ def test_units_round_trip(units, spv, amp):
     for name, e in eps.items():
         assert np.allclose(rec.strain(name), e, rtol=1e-12, atol=1e-18)
         assert rec.channels[name].units == units
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(40.0, 300.0), st.floats(-3.0, 3.0), st.integers(1, 3))
+def test_a_spike_before_the_pulse_moves_neither_its_arrival_nor_the_baseline(seed, before, height, width):
+    """A spike of pick-up (1-3 samples, up to 3 times the pulse, either sign) before the front: the arrival and the
+    baseline's offset and sd are those of the record without it (it took the spike for the pulse's front, and its
+    sd into the noise)."""
+    rng = np.random.default_rng(seed)
+    n, foot = 4000, 900.0
+    clean = ramp_pulse(n, foot) + white_and_ar1_noise(n, sd=5e-6, rho=0.5, white_fraction=0.3, rng=rng)
+    spiked = clean.copy()
+    at = int(foot - before)
+    spiked[at:at + width] += height * 1e-3
+    e0, a0 = prepulse_noise(clean)
+    e1, a1 = prepulse_noise(spiked)
+    assert a1 == pytest.approx(a0, abs=0.05)  # the spike sample is the running median now, not the noise it hid
+    assert e1.sd == pytest.approx(e0.sd, rel=0.05) and abs(e1.offset - e0.offset) < 0.2 * e0.sd
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 0.995))
+def test_gaussian_noise_is_not_despiked(seed, rho):
+    """The spike filter leaves Gaussian noise, white or coloured (lag-1 up to 0.995), as it is: same bits."""
+    x = white_and_ar1_noise(5000, sd=3e-6, rho=rho, white_fraction=0.2, rng=np.random.default_rng(seed))
+    assert np.array_equal(despiked(x), x)
+
+
+@pytest.mark.parametrize("pre", [140, 200, 400])
+def test_a_pre_trigger_shorter_than_the_head_leaves_the_baseline_as_it_is(pre):
+    """A pre-trigger shorter than the provisional head (2 % of 20 000 samples: 400) but long enough for a baseline:
+    offset and arrival as with a long pre-trigger (the head's median once took the pulse's front in)."""
+    rng = np.random.default_rng(11)
+    n, foot = 20_000, 2000.0
+    x = 3e-5 + ramp_pulse(n, foot, plateau=8000) + white_and_ar1_noise(n, sd=5e-6, rho=0.5, white_fraction=0.3,
+                                                                        rng=rng)
+    e_long, a_long = prepulse_noise(x)
+    cut = int(foot) - pre
+    e, a = prepulse_noise(x[cut:])
+    assert a + cut == pytest.approx(a_long, abs=0.5)
+    assert abs(e.offset - e_long.offset) < 3 * e.offset_sd
+
+
+def test_a_pre_trigger_too_short_asks_for_a_longer_one():
+    n, foot = 20_000, 20.0
+    x = ramp_pulse(n, foot, plateau=8000) + white_and_ar1_noise(n, sd=5e-6, rho=0.5, white_fraction=0.3,
+                                                                rng=np.random.default_rng(2))
+    with pytest.raises(ShortPreTrigger, match="record a longer pre-trigger"):
+        prepulse_noise(x)
