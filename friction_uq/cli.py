@@ -228,7 +228,7 @@ def _run(args: argparse.Namespace) -> int:
     """``run`` and ``diagnose``: a bad record or prior file is refused before the analysis' libraries load."""
     from .record import read_record
 
-    rec = read_record(args.file)
+    rec = read_record(args.file, hoop=not args.no_hoop)
     from .prior_loader import load_priors, record_prior_path
 
     load_priors(args.priors or record_prior_path(rec.path, rec.apparatus.sample.material))

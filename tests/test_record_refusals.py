@@ -684,3 +684,29 @@ def test_a_provenance_attribute_hdf5_cannot_read_is_named(record_copy) -> None:
         fh.require_group("provenance").attrs["x"] = h5py.Empty("f8")
     with pytest.raises(RecordError, match=rf"^{re.escape(str(path))}: /provenance@x: cannot be read"):
         read_record(path)
+
+
+def test_a_dead_hoop_bridge_is_refused_with_the_way_round_it(record_copy: Callable[..., Path]) -> None:
+    """A hoop channel reading one constant (a dead bridge): refused, saying --no-hoop analyses without it; read with
+    hoop=False (what --no-hoop does), the record has no hoop gauge and its other channels are as they were."""
+    path = channel(HOOP, lambda x: np.full_like(x, 1.5))(record_copy())
+    with pytest.raises(RecordError, match=r"/signals/tube_hoop: is flat .*--no-hoop analyses the record without it"):
+        read_record(path)
+    rec = read_record(path, hoop=False)
+    assert not rec.has_hoop
+    assert np.array_equal(rec.strain("input_bar"), read_record(record_copy("good.h5")).strain("input_bar"))
+
+
+def test_a_missing_required_channel_is_not_excused_by_no_hoop(record_copy: Callable[..., Path]) -> None:
+    path = h5edit(lambda fh: fh["signals"][IB].attrs.__setitem__("units", "furlongs"))(record_copy())
+    with pytest.raises(RecordError, match=r"/signals/input_bar@units: is 'furlongs'") as info:
+        read_record(path, hoop=False)
+    assert "--no-hoop" not in str(info.value)
+
+
+def test_no_hoop_sets_up_a_run_on_a_dead_hoop_bridge(record_copy: Callable[..., Path], tmp_path: Path) -> None:
+    from friction_uq.record_run.steps import set_up
+
+    path = channel(HOOP, lambda x: np.full_like(x, 1.5))(record_copy())
+    s = set_up(path, None, tmp_path / "out", window=None, dispersion=False, hoop=False)
+    assert not s.use_hoop and s.prepared.data.hoop is None

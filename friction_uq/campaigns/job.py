@@ -240,7 +240,7 @@ def run_record(task: RecordTask) -> RecordResult:
     out = Path(task.out_dir)
     base = RecordResult(path=str(task.path), status="failed", settings=task.settings)
     try:
-        record = read_record(task.path)
+        record = read_record(task.path, hoop=task.hoop)
         material = record.apparatus.sample.material
         prior = Path(task.priors_path) if task.priors_path else record_prior_path(record.path, material)
         stem = safe_stem(record.campaign, record.test_id)

@@ -47,13 +47,16 @@ from .contract import (
 )
 
 
-def read_record(path: str | os.PathLike[str]) -> Record:
+def read_record(path: str | os.PathLike[str], *, hoop: bool = True) -> Record:
     """Read, check and convert a ``test.h5`` record.
 
     Parameters
     ----------
     path
         The record file.
+    hoop
+        Read the hoop gauge (``/signals/tube_hoop``, optional) if the record has one; False leaves it
+        unread and unchecked (``--no-hoop``: a dead hoop bridge does not stop the analysis).
 
     Returns
     -------
@@ -90,19 +93,19 @@ def read_record(path: str | os.PathLike[str]) -> Record:
         raise r.fail("/", f"is a damaged or truncated HDF5 file ({exc})") from None
     try:
         with fh:
-            return _read_open(fh, p, r)
+            return _read_open(fh, p, r, hoop)
     except RecordError:
         raise
     except (OSError, KeyError, RuntimeError) as exc:
         raise r.fail("/", f"is a damaged or truncated HDF5 file ({exc})") from None
 
 
-def _read_open(fh: Any, p: Path, r: Reader) -> Record:
+def _read_open(fh: Any, p: Path, r: Reader, hoop: bool = True) -> Record:
     """The record of an open file, checked part by part in the order of the contract: the root's attributes, the
     apparatus, the signals, the provenance; the first problem raises ``r.fail`` (file, field, problem)."""
     header = _read_header(fh, r)
     apparatus = _read_apparatus(fh, r)
-    sample_rate, t0, channels = _read_signals(fh, r, apparatus)
+    sample_rate, t0, channels = _read_signals(fh, r, apparatus, hoop)
     return Record(
         path=str(p),
         sample_rate=sample_rate,
@@ -183,9 +186,10 @@ def _read_apparatus(fh: Any, r: Reader) -> Apparatus:
     return apparatus
 
 
-def _read_signals(fh: Any, r: Reader, apparatus: Apparatus) -> tuple[float, float, dict[str, Channel]]:
-    """/signals: the sample rate, t0 and every channel (the required ones present, all of one length), the record
-    long enough for the reflected wave to pass the input-bar gauge."""
+def _read_signals(fh: Any, r: Reader, apparatus: Apparatus,
+                  hoop: bool = True) -> tuple[float, float, dict[str, Channel]]:
+    """/signals: the sample rate, t0 and every channel (the required ones present, all of one length; the hoop
+    gauge's only with ``hoop``), the record long enough for the reflected wave to pass the input-bar gauge."""
     sig = _group(fh, "signals", r)
     sample_rate = r.attr(sig, "/signals", "sample_rate", "float")
     if sample_rate <= 0:
@@ -198,7 +202,7 @@ def _read_signals(fh: Any, r: Reader, apparatus: Apparatus) -> tuple[float, floa
     channels: dict[str, Channel] = {}
     length: int | None = None
     first: str | None = None
-    for name in CHANNELS:
+    for name in CHANNELS if hoop else REQUIRED_CHANNELS:
         where = f"/signals/{name}"
         ds = r.member(sig, name, where)
         if ds is None:
@@ -214,7 +218,13 @@ def _read_signals(fh: Any, r: Reader, apparatus: Apparatus) -> tuple[float, floa
             raise r.fail(
                 where, f"has {ds.shape[0]} samples but /signals/{first} has {length}; channels must have equal length"
             )
-        channels[name] = _read_channel(ds, name, where, r, channels)
+        try:
+            channels[name] = _read_channel(ds, name, where, r, channels)
+        except RecordError as exc:
+            if name in REQUIRED_CHANNELS:
+                raise
+            raise RecordError(exc.file, exc.where, f"{exc.problem} (the hoop gauge is optional: --no-hoop analyses "
+                              "the record without it)") from None
     assert length is not None  # REQUIRED_CHANNELS is not empty
     duration = length / sample_rate
     needed = 2.0 * apparatus.input_bar.gauge_delay + apparatus.pulse_duration

@@ -70,7 +70,7 @@ class RunSetup:
 def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | None, out_dir: Path, *,
            window: tuple[float, float] | None, dispersion: bool, hoop: bool) -> RunSetup:
     """Every input checked (record, priors, the output folder and names) and the signals prepared."""
-    record = read_record(path)
+    record = read_record(path, hoop=hoop)  # --no-hoop: the hoop channel unread (a dead bridge stops nothing)
     p_path = Path(priors_path) if priors_path else record_prior_path(record.path, record.apparatus.sample.material)
     priors = load_priors(p_path)  # every input is checked before the signals' work, the busy folder too
     stem = safe_stem(record.campaign, record.test_id)
