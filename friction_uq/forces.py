@@ -197,7 +197,8 @@ def _input_bar_waves(record: Record, span: int, dispersion: bool,
     eps_i = _transported(inc, ib, +ib.gauge_distance, dt, dispersion)
     eps_r = _transported(ref, ib, -ib.gauge_distance, dt, dispersion)
     d_in = ib.gauge_delay * fs
-    valid_until_in = min(echo - d_in, sep + d_in) - margin  # far-end echo, end of the incident window
+    # far-end echo, end of the incident window, end of the record (the reflected wave brought back by d_in)
+    valid_until_in = min(echo - d_in, sep + d_in, n - d_in) - margin
     valid_in = window_mask(n, arr_inc + d_in - margin, valid_until_in)
     info["incident"] = ChannelInfo("incident", noise_in, arr_inc + d_in, valid_until_in)
     info["input_bar"] = ChannelInfo("input_bar", noise_in, arr_inc, echo - margin)
@@ -216,7 +217,7 @@ def _transmitted_wave(record: Record, name: str, span: int, incident_at_cell: fl
     echo = arr + 2.0 * (bar.length - bar.gauge_distance) / bar.wave_speed * fs
     y = np.where(window_mask(n, 0, echo - margin), x - nz.offset, 0.0)
     eps = _transported(y, bar, -bar.gauge_distance, record.sample_interval, dispersion)
-    valid_until = echo - d - margin
+    valid_until = min(echo, n) - d - margin  # its far-end echo, or the record's end, brought back by d
     info[name] = ChannelInfo(name, nz, arr - d, valid_until, found)
     return np.where(window_mask(n, 0, valid_until), eps, np.nan)
 
