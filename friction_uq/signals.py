@@ -29,21 +29,17 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft as scipy_fft
-from scipy.ndimage import median_filter
 
 from .dispersion import propagate
 from .errors import ShortPreTrigger, SignalError
 from .stats.ar1 import ar1_mean_sd
+from .record.contract import HEAD_FRACTION
+from .stats.robust import SPIKE_FILTER, SPIKE_SIGMAS, despiked, median_and_sd, running_median
 
 #: Threshold, in noise standard deviations, for the first crossing that starts an arrival search.
 ARRIVAL_SIGMAS = 8.0
 #: The crossing must also exceed this fraction of the channel's largest excursion.
 ARRIVAL_FRACTION = 0.05
-#: Width (samples) of the median filter through which a pulse's first crossing and its peak are found: a spike of up
-#: to half as many samples (less one) is passed over, a monotone front is kept as it is.
-SPIKE_FILTER = 7
-#: A pre-pulse sample further than this many robust sd from its running median is a spike, not noise.
-SPIKE_SIGMAS = 8.0
 #: Minimum pre-pulse segment (samples) for a noise estimate.
 MIN_BASELINE_SAMPLES = 32
 
@@ -93,7 +89,8 @@ class NoiseEstimate:
 
 
 def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate:
-    """Offset, standard deviation and lag-1 autocorrelation of ``x[start:stop]``, its spikes left out (:func:`despiked`).
+    """Offset, standard deviation and lag-1 autocorrelation of ``x[start:stop]``, its spikes left out
+    (:func:`friction_uq.stats.robust.despiked`).
 
     >>> rng = np.random.default_rng(1)
     >>> e = noise_estimate(3.0 + rng.normal(0, 2.0, 20000), stop=20000)
@@ -106,7 +103,7 @@ def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate
             f"the pre-pulse segment has {seg.size} samples, at least {MIN_BASELINE_SAMPLES} are needed "
             "to estimate the baseline and noise"
         )
-    seg = despiked(seg)
+    seg = despiked(seg, width=SPIKE_FILTER, sigmas=SPIKE_SIGMAS)
     offset = float(seg.mean())
     d = seg - offset
     var = float(np.mean(d * d))
@@ -116,21 +113,6 @@ def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate
     tau = integrated_autocorrelation(d)
     rho_eff = float(np.clip((tau - 1.0) / (tau + 1.0), 0.0, 0.99))
     return NoiseEstimate(offset=offset, sd=sd, rho=rho, start=int(start), stop=int(stop), rho_eff=rho_eff)
-
-
-def despiked(seg: np.ndarray) -> np.ndarray:
-    """``seg`` with its spikes (samples more than :data:`SPIKE_SIGMAS` robust sd from its running median of
-    :data:`SPIKE_FILTER` samples) replaced by that median: a spike of pick-up is neither offset nor noise. Gaussian
-    noise, white or coloured, has no such sample (a chance of about 1e-15 each): its statistics keep their bits."""
-    if seg.size < SPIKE_FILTER:
-        return seg
-    running = median_filter(seg, SPIKE_FILTER, mode="nearest")
-    r = seg - running
-    sd = 1.4826 * float(np.median(np.abs(r - np.median(r))))
-    spikes = np.abs(r) > SPIKE_SIGMAS * sd
-    if sd == 0.0 or not spikes.any():
-        return seg
-    return np.where(spikes, running, seg)
 
 
 def integrated_autocorrelation(d: np.ndarray) -> float:
@@ -216,8 +198,8 @@ def pulse_front(
         excursion = np.abs(y[start:])
     else:
         excursion = polarity * y[start:]
-    if excursion.size >= SPIKE_FILTER:  # a spike (EMI, a trigger's pick-up) is no pulse: a median filter keeps the
-        excursion = median_filter(excursion, SPIKE_FILTER, mode="nearest")  # fronts, as they are monotone
+    # a spike (EMI, a trigger's pick-up) is no pulse: a running median keeps the fronts, as they are monotone
+    excursion = running_median(excursion, SPIKE_FILTER)
     peak_all = float(excursion.max()) if excursion.size else 0.0
     level = max(ARRIVAL_SIGMAS * sd, ARRIVAL_FRACTION * peak_all)
     hit = np.flatnonzero(excursion >= level)
@@ -227,7 +209,7 @@ def pulse_front(
     sign = polarity if polarity != 0 else (1 if y[i0] > 0 else -1)
     s = sign * y
     stop = len(s) if span is None else min(len(s), i0 + span)
-    peak = float(s[i0:stop].max())
+    peak = float(running_median(s[i0:stop], SPIKE_FILTER).max())  # a spike on the pulse is not its peak either
     t50 = first_crossing(s, 0.5 * peak, start=max(start, i0 - 1))
     t10_start = start
     # walk back from the 50 % crossing to the last sample below 10 % of the peak
@@ -242,25 +224,38 @@ def pulse_front(
 
 
 def prepulse_noise(
-    x: np.ndarray, *, margin: int = 8, initial_fraction: float = 0.02, span: int | None = None, polarity: int = 0
+    x: np.ndarray, *, margin: int = 8, initial_fraction: float = HEAD_FRACTION, span: int | None = None,
+    polarity: int = 0,
 ) -> tuple[NoiseEstimate, float]:
     """Noise estimate from the pre-pulse segment, and the first pulse's arrival (fractional index).
 
     A provisional, robust baseline (median and median absolute deviation of the first
-    ``initial_fraction`` of the record, at least 32 samples, cut where a first look from the first 32
-    finds the pulse's front: a pre-trigger may be shorter) locates the first pulse; the segment then
-    runs from the start to ``margin`` samples before that arrival and is estimated again.
+    ``initial_fraction`` of the record, at least 32 samples) locates the first pulse; when the pulse's
+    front is in that head (a pre-trigger shorter than it) or no front is found from it, the head is
+    cut where a first look from the first 32 samples finds the front, and the pulse located again.
+    The segment then runs from the start to ``margin`` samples before that arrival and is estimated
+    again.
     """
     n = len(x)
     n0 = min(n, max(MIN_BASELINE_SAMPLES, int(initial_fraction * n)))
-    med, mad_sd = _robust_baseline(x[:MIN_BASELINE_SAMPLES])
-    arrival, t10, t50 = pulse_front(x, offset=med, sd=max(mad_sd, 1e-300), span=span, polarity=polarity)
-    # a pre-trigger shorter than the head: the head ends where the pulse begins, or its median is the pulse's
-    n0 = max(MIN_BASELINE_SAMPLES, min(n0, int(np.floor(arrival - (t50 - t10))) - margin))
-    med, mad_sd = _robust_baseline(x[:n0])
-    arrival, t10, t50 = pulse_front(x, offset=med, sd=max(mad_sd, 1e-300), span=span, polarity=polarity)
-    # a smooth front starts before its extrapolated foot: stay one 10-50 % rise time further away
-    stop = int(np.floor(arrival - (t50 - t10))) - margin
+
+    def front(head: int) -> tuple[float, float, float]:
+        med, sd = median_and_sd(x[:head])
+        return pulse_front(x, offset=med, sd=max(sd, 1e-300), span=span, polarity=polarity)
+
+    def clear_of(arrival: float, t10: float, t50: float) -> int:
+        """Samples before the front less the margin (a smooth front starts one 10-50 % rise before its foot)."""
+        return int(np.floor(arrival - (t50 - t10))) - margin
+
+    try:
+        arrival, t10, t50 = front(n0)
+        head_clean = clear_of(arrival, t10, t50) >= n0
+    except SignalError:
+        head_clean = False
+    if not head_clean:  # a pre-trigger shorter than the head: cut it where a first look from 32 samples finds the front
+        first = front(MIN_BASELINE_SAMPLES)
+        arrival, t10, t50 = front(max(MIN_BASELINE_SAMPLES, min(n0, clear_of(*first))))
+    stop = clear_of(arrival, t10, t50)
     if stop < MIN_BASELINE_SAMPLES:
         raise ShortPreTrigger(
             f"the first pulse arrives at sample {arrival:.0f}, its front rising from sample "
@@ -271,13 +266,6 @@ def prepulse_noise(
     # a second pass with the refined baseline
     arrival = pulse_arrival(x, offset=est.offset, sd=max(est.sd, 1e-300), span=span, polarity=polarity)
     return est, arrival
-
-
-def _robust_baseline(head: np.ndarray) -> tuple[float, float]:
-    """Median and median absolute deviation (as a normal sd) of a baseline."""
-    head = np.asarray(head, dtype=float)
-    med = float(np.median(head))
-    return med, 1.4826 * float(np.median(np.abs(head - med)))
 
 
 def window_mask(n: int, start: float, stop: float) -> np.ndarray:

@@ -52,14 +52,15 @@ def test_model_predicts_by_name_and_without_hoop():
 #: the data); the force values, which that does not touch, are the original ones. They are of the
 #: sample-by-sample force term (force_mode="series"), the default before the ratio was read from
 #: the window's levels. All four were recomputed (the likelihood code unchanged: the old data still give the old
-#: values) when a pulse's front came to be found through a median filter: the external bar's 50 % crossing had been
-#: a noise sample's, its pre-pulse segment now ends 11 samples earlier (its noise sd 2e-4 relative apart).
+#: values) when a pulse's front and peak came to be found through a running median: the external bar's 50 % crossing
+#: had been a noise sample's, its pre-pulse segment now ends 12 samples earlier, the input bar's one later (their
+#: noise sds 2e-4 and 1.4e-3 relative apart).
 THETA = np.array([[0.05, 0.4, 1.0], [0.06, 0.35, 1.05], [0.04, 0.45, 0.9]])
 FROZEN = {
-    "level": [-13017.127153649368, -13039.503919211043, -13022.38637819257],
-    "series": [9501.356702779516, -6734.5979289254665, 2642.823218767424],
-    "series_no_axial": [9135.128261320055, -11755.277716172544, 5003.725057342441],
-    "force": [-13028.522668638429, -13033.648304856653, -13029.277654425254],
+    "level": [-13017.093879454958, -13039.454754453895, -13022.345398798576],
+    "series": [9501.389974384558, -6734.5486487403305, 2642.8640240105833],
+    "series_no_axial": [9135.161666306736, -11755.22806521967, 5003.765844734973],
+    "force": [-13028.4893944436, -13033.599140297132, -13029.236674908718],
 }
 
 

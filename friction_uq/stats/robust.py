@@ -1,0 +1,50 @@
+"""Robust statistics of a baseline: its median and scale, and its spikes left out.
+
+A pre-pulse baseline is Gaussian noise (white or coloured) plus, in a laboratory, the odd spike of
+pick-up (a trigger, a valve, a relay): a sample far from its neighbours. A spike is told from the
+noise by its distance from the running median of its neighbours, in units of a robust scale of
+those distances. The residuals that are exactly zero (the sample *is* its window's median: one in
+``width`` of continuous data, most of data quantised more coarsely than its noise) are left out of
+that scale, or they would shrink it to nothing and make the noise look like spikes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.ndimage import median_filter
+
+#: Normal sd per median absolute deviation.
+MAD_SD = 1.4826
+#: Width (samples) of the running median through which spikes are seen: a spike of up to half as many samples (less
+#: one) is passed over, a monotone front is kept as it is.
+SPIKE_FILTER = 7
+#: A baseline sample further than this many robust sd from its running median is a spike, not noise.
+SPIKE_SIGMAS = 8.0
+
+
+def median_and_sd(x: np.ndarray) -> tuple[float, float]:
+    """Median and median absolute deviation (as a normal sd) of ``x``."""
+    x = np.asarray(x, dtype=float)
+    med = float(np.median(x))
+    return med, MAD_SD * float(np.median(np.abs(x - med)))
+
+
+def running_median(x: np.ndarray, width: int) -> np.ndarray:
+    """Centred running median over ``width`` samples (the ends repeat the edge sample); ``x`` if shorter."""
+    x = np.asarray(x, dtype=float)
+    return median_filter(x, width, mode="nearest") if x.size >= width else x
+
+
+def despiked(seg: np.ndarray, *, width: int = SPIKE_FILTER, sigmas: float = SPIKE_SIGMAS) -> np.ndarray:
+    """``seg`` with its spikes (samples more than ``sigmas`` robust sd from their running median of ``width``)
+    replaced by that median; ``seg`` itself when it has none."""
+    seg = np.asarray(seg, dtype=float)
+    if seg.size < width:
+        return seg
+    running = running_median(seg, width)
+    r = seg - running
+    moved = np.abs(r[r != 0.0])
+    if moved.size == 0:
+        return seg
+    spikes = np.abs(r) > sigmas * MAD_SD * float(np.median(moved))
+    return np.where(spikes, running, seg) if spikes.any() else seg
