@@ -195,9 +195,12 @@ def flat_run_notes(record: Record) -> tuple[str, ...]:
         run = flat_run(channel.strain)
         if run is None or run.saturated:
             continue
-        notes.append(f"/signals/{name} sits on one value for {run.run} consecutive samples at its peak, and its "
-                     "pre-trigger noise, below one digitiser step, cannot tell a plateau on one code from a saturated "
-                     "digitiser: if the scope's range ends at that value, the channel is clipped")
+        noise = ("is not resolved (its pre-trigger holds two values or fewer)" if math.isinf(run.needed) else
+                 f"({run.noise_steps:.1f} digitiser steps) leaves runs that long on one code by chance (one "
+                 f"of {run.needed:.0f} would not be)")
+        notes.append(f"/signals/{name} sits on one value for {run.run} consecutive samples at its peak, and its noise "
+                     f"{noise}: a plateau on one digitiser code cannot be told from a saturated digitiser there; if "
+                     "the scope's range ends at that value, the channel is clipped")
     return tuple(notes)
 
 

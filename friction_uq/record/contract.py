@@ -28,6 +28,9 @@ UNITS = {"strain": 1.0, "microstrain": 1e-6, "V": None}
 #: run must also be longer than its pre-trigger noise leaves by chance (:mod:`.saturation`): a
 #: plateau read by a digitiser whose step is coarser than its noise sits on one code too.
 CLIP_RUN = 8
+#: A channel's pre-trigger as first read (its noise, a provisional baseline): its first 2 %, at least 32 samples.
+HEAD_FRACTION = 0.02
+MIN_HEAD_SAMPLES = 32
 
 #: Minimum number of samples in a channel.
 MIN_SAMPLES = 64

@@ -3,16 +3,21 @@
 A channel that saturates sits on one value, its rail, for as long as the signal would exceed it.
 A plateau read by a coarse digitiser (an 8-bit scope) also sits on one value, a digitiser code,
 when the noise is smaller than one code: the record does not say where the digitiser's range
-ends, so a run of equal samples tells a rail from a code only through the noise, resolved by the
-pre-trigger when it spans three codes or more (:func:`noise_sd`). A noise of sd sigma on codes q wide keeps a sample in its code with probability at most
+ends, so a run of equal samples tells a rail from a code only through the noise, as the
+pre-trigger shows it (its first 2 %, spikes left out, cut where the pulse's front begins). The
+chance p that the noise keeps a sample on its code is taken as the larger of
 
-    p = erf(q / (2 sqrt(2) sigma))      (the code centred on the noise's mean),
+* erf(q / (2 sqrt(2) sigma)), white noise of sd sigma (the pre-trigger's, less the rounding:
+  Sheppard's correction) on codes q wide, its mean at a code's centre (where runs are likeliest);
+* the pre-trigger's own share of neighbouring samples on one code, at its 95 % upper bound
+  (coloured noise stays longer than white noise of its sd);
 
-so a run of L equal samples anywhere among n is the noise's doing with probability at most about
-n p^(L - 1) (white noise). A run is **saturated** when that chance is below :data:`RUN_ALPHA`
-and the run is at least :data:`~friction_uq.record.contract.CLIP_RUN` long; a shorter one at
-least ``CLIP_RUN`` long is **undecided** (a plateau or a rail, the noise cannot tell): the reader
-refuses the first, the analysis warns of the second (:func:`flat_runs`).
+and a run of L equal samples anywhere among n is the noise's doing with a chance of about
+n p^(L - 1). A run is **saturated** when that chance is below :data:`RUN_ALPHA` and the run is at
+least :data:`~friction_uq.record.contract.CLIP_RUN` long; a shorter one at least ``CLIP_RUN``
+long is **undecided** (a plateau or a rail, the noise cannot tell), and so is every run of a
+channel whose pre-trigger holds two values or fewer (its noise not resolved): the reader refuses
+the first, the analysis warns of the second (:func:`friction_uq.gauge_check.flat_run_notes`).
 """
 
 from __future__ import annotations
@@ -21,16 +26,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats
 from scipy.special import erf
 
-from .contract import CLIP_RUN
+from ..stats.robust import despiked, median_and_sd
+from .contract import CLIP_RUN, HEAD_FRACTION, MIN_HEAD_SAMPLES
 
 #: Chance, at most, that the noise alone leaves a run of equal samples as long as one called saturated.
 RUN_ALPHA = 1e-3
-#: Fraction of the record, at least 32 samples, read at its start for the noise (the pre-trigger).
-HEAD_FRACTION = 0.02
-
-
 @dataclass(frozen=True)
 class FlatRun:
     """The longest run of equal samples at a channel's peak value, and what its noise makes of it."""
@@ -54,17 +57,28 @@ def digitiser_step(x: np.ndarray) -> float:
     return float(np.median(gaps)) if gaps.size else 0.0
 
 
-def run_needed(noise_sd: float, step: float, n: int) -> float:
-    """Least run of equal samples that white noise of sd ``noise_sd`` on codes ``step`` wide leaves among ``n``
-    samples with a chance below :data:`RUN_ALPHA` (never below ``CLIP_RUN``; inf when one code holds the noise)."""
-    if step <= 0.0:
+def run_needed(stay: float, n: int) -> float:
+    """Least run of equal samples that a noise keeping a sample on its code with chance ``stay`` leaves among ``n``
+    samples with a chance below :data:`RUN_ALPHA` (never below ``CLIP_RUN``; inf when it never leaves)."""
+    if stay >= 1.0:
+        return math.inf
+    if stay <= 0.0:
         return float(CLIP_RUN)
-    if noise_sd <= 0.0:
-        return math.inf
-    p = float(erf(step / (2.0 * math.sqrt(2.0) * noise_sd)))
-    if p >= 1.0:
-        return math.inf
-    return max(float(CLIP_RUN), 1.0 + math.ceil(math.log(RUN_ALPHA / max(n, 1)) / math.log(p)))
+    return max(float(CLIP_RUN), 1.0 + math.ceil(math.log(RUN_ALPHA / max(n, 1)) / math.log(stay)))
+
+
+def stay_chance(head: np.ndarray, step: float) -> float:
+    """The chance that the pre-trigger's noise keeps a sample on its code (module docstring); 1 when its noise is
+    not resolved (two values or fewer), 0 when the channel is not quantised (``step`` 0)."""
+    if step <= 0.0:
+        return 0.0
+    if np.unique(head).size <= 2:
+        return 1.0
+    sd = noise_sd(head, step)
+    white = float(erf(step / (2.0 * math.sqrt(2.0) * sd))) if sd > 0.0 else 0.0  # less than the rounding: seen only
+    same = int(np.count_nonzero(head[1:] == head[:-1]))
+    seen = float(stats.beta.ppf(0.95, same + 1, head.size - 1 - same + 1))
+    return max(white, seen)
 
 
 def longest_run(mask: np.ndarray) -> int:
@@ -75,6 +89,17 @@ def longest_run(mask: np.ndarray) -> int:
     return int((edges[1::2] - edges[0::2]).max())
 
 
+def pre_trigger(x: np.ndarray) -> np.ndarray:
+    """The channel's first :data:`HEAD_FRACTION` (at least :data:`MIN_HEAD_SAMPLES`), spikes left out, cut where it
+    first departs from its first samples' median by a tenth of the channel's swing (a pulse's front in it)."""
+    n0 = min(x.size, max(MIN_HEAD_SAMPLES, int(HEAD_FRACTION * x.size)))
+    med, _ = median_and_sd(x[:MIN_HEAD_SAMPLES])
+    swing = float(np.max(np.abs(x - med)))
+    off = np.flatnonzero(np.abs(x[:n0] - med) > 0.1 * swing)
+    head = x[: max(MIN_HEAD_SAMPLES, int(off[0]) if off.size else n0)]
+    return despiked(head)
+
+
 def flat_run(x: np.ndarray) -> FlatRun | None:
     """The longest run of at least ``CLIP_RUN`` equal samples at the extreme the pulse reaches, or None.
 
@@ -82,8 +107,10 @@ def flat_run(x: np.ndarray) -> FlatRun | None:
     exactly flat and nothing tells a rail from it.
     """
     x = np.asarray(x, dtype=float)
-    head = x[: max(32, int(HEAD_FRACTION * x.size))]
-    if x.size == 0 or np.ptp(head) == 0.0:
+    if x.size == 0:
+        return None
+    head = pre_trigger(x)
+    if np.ptp(head) == 0.0:
         return None
     median = float(np.median(x))
     swing = float(np.max(np.abs(x - median)))
@@ -94,9 +121,8 @@ def flat_run(x: np.ndarray) -> FlatRun | None:
         run = longest_run(x == extreme)
         if run >= CLIP_RUN and (found is None or run > found.run):
             step = digitiser_step(x)
-            sd = noise_sd(head, step)
-            found = FlatRun(run, extreme, side, step, sd / step if step > 0 else math.inf,
-                            run_needed(sd, step, x.size))
+            found = FlatRun(run, extreme, side, step, noise_sd(head, step) / step if step > 0 else math.inf,
+                            run_needed(stay_chance(head, step), x.size))
     return found
 
 
