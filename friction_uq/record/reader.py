@@ -204,27 +204,26 @@ def _read_signals(fh: Any, r: Reader, apparatus: Apparatus,
     first: str | None = None
     for name in CHANNELS if hoop else REQUIRED_CHANNELS:
         where = f"/signals/{name}"
-        ds = r.member(sig, name, where)
-        if ds is None:
-            if name in REQUIRED_CHANNELS:
-                raise r.fail(where, "required channel is missing")
-            continue
-        check_dataset(ds, where, r)
-        if length is None:
-            length, first = ds.shape[0], name
-            if length < MIN_SAMPLES:
-                raise r.fail(where, f"has {length} samples, at least {MIN_SAMPLES} are needed")
-        elif ds.shape[0] != length:
-            raise r.fail(
-                where, f"has {ds.shape[0]} samples but /signals/{first} has {length}; channels must have equal length"
-            )
         try:
+            ds = r.member(sig, name, where)
+            if ds is None:
+                if name in REQUIRED_CHANNELS:
+                    raise r.fail(where, "required channel is missing")
+                continue
+            check_dataset(ds, where, r)
+            if length is None:
+                length, first = ds.shape[0], name
+                if length < MIN_SAMPLES:
+                    raise r.fail(where, f"has {length} samples, at least {MIN_SAMPLES} are needed")
+            elif ds.shape[0] != length:
+                raise r.fail(where, f"has {ds.shape[0]} samples but /signals/{first} has {length}; channels must "
+                             "have equal length")
             channels[name] = _read_channel(ds, name, where, r, channels)
         except RecordError as exc:
             if name in REQUIRED_CHANNELS:
                 raise
-            raise RecordError(exc.file, exc.where, f"{exc.problem} (the hoop gauge is optional: --no-hoop analyses "
-                              "the record without it)") from None
+            raise RecordError(exc.file, exc.where, f"{exc.problem} (the hoop gauge is optional: `run`, `diagnose` "
+                              "and `campaign` analyse the record without it with --no-hoop)") from None
     assert length is not None  # REQUIRED_CHANNELS is not empty
     duration = length / sample_rate
     needed = 2.0 * apparatus.input_bar.gauge_delay + apparatus.pulse_duration
