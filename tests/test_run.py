@@ -305,3 +305,14 @@ def test_the_report_has_no_character_its_fonts_cannot_show(paper_run):
     assert strings, "no text drawn with the standard fonts"
     assert any(re.fullmatch(rb"-\d[\d.]*", s) for s in strings), "no negative tick label to check"
     assert not [s for s in strings if re.fullmatch(rb"\?\d.*", s)], "a tick label lost its minus sign"
+
+
+def test_the_prior_data_warning_is_said_once_as_a_warning():
+    """The run's warnings are printed after "WARNING: "; the conflict's sentence carried its own: "WARNING: WARNING:"."""
+    from friction_uq.prior_sensitivity import PriorDataConflict
+    from friction_uq.record_run.warnings import conflict_warning
+
+    flagged = PriorDataConflict(prior={"nu": 0.12}, likelihood={"nu": 0.05}, diagnosis={"nu": "prior-data conflict"},
+                                flagged=("nu",), threshold=0.05)
+    said = conflict_warning(flagged)
+    assert said.startswith("The priors, not the data, drive the result - nu:") and "WARNING" not in said

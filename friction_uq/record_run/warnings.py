@@ -182,7 +182,8 @@ def exact_posterior_warning(diagnosis) -> str | None:
 def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
     if conflict is None or not conflict.flagged:
         return None
-    return (conflict.sentence().rstrip(".") + ": f then follows the prior file as much as the record; "
+    said = conflict.sentence().removeprefix("WARNING: ").rstrip(".")  # each warning is printed after "WARNING: " once
+    return (said[:1].upper() + said[1:] + ": f then follows the prior file as much as the record; "
             "quote it with f under the other nu priors (the report's nu page).")
 
 
