@@ -56,7 +56,8 @@ def prepare(
         raise SignalError(f"{record.path}: {wired[0].sentence}")
     # a channel's scale off by a factor (a gauge factor, a unit: eq. 5, 6 and 14) leaves f's ratio as it is when every
     # channel shares it, but not the forces, the pressure and the velocity: said, as the balance's notes are
-    scaled = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
+    scaled = [g for g in scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
+              if g.kind != "striker"]  # a striker speed recorded wrong: inspect's note, not the analysis' (f does not use it)
     notes = tuple(g.sentence for g in findings + scaled)
     if window is None:
         win, notes = _automatic_window(record, forces, criterion, notes)

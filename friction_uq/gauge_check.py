@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .forces import Forces
+from .plausible import out_of_range
 from .record import Apparatus, Record
 from .stats.ar1 import ar1_mean_sd
 
@@ -160,6 +161,15 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *,
     q = float("nan")
     if striker_velocity:
         q = incident_plateau(forces) / (striker_velocity / (2.0 * apparatus.input_bar.wave_speed))
+        implied = q * striker_velocity
+        if abs(math.log(q)) > math.log(SCALE_FACTOR) and abs(s - 1.0) <= BALANCE_TOL and abs(
+                math.log(r)) < VELOCITY_LOG_TOL and not out_of_range("striker_velocity", implied):
+            # the gauges agree with each other at a speed a gas gun fires: the speed recorded is the odd one out
+            return [GaugeFinding("", "striker", (
+                f"the incident wave stands for a striker at {implied:.3g} m/s (eq. 14) where the record's "
+                f"striker_velocity says {striker_velocity:g} m/s; as {evidence}, the gauges agree with each other: "
+                f"the speed recorded looks wrong (f does not use it), or every gauge's scale is off by {q:.3g} (the "
+                "forces and pressures with it, not f's ratio)"))]
         if abs(math.log(q)) > math.log(SCALE_FACTOR):
             return [GaugeFinding("input_bar", "scale", (
                 f"/signals/input_bar reads an incident wave {q:.3g} times what the striker's {striker_velocity:g} m/s "
@@ -224,19 +234,23 @@ def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFi
     faults = [g for g in found if g.kind in ("reversed", "swapped")]
     if faults:
         return faults, []
-    faults = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
+    scaled = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
+    faults = [g for g in scaled if g.kind != "striker"]
+    found += [g for g in scaled if g.kind == "striker"]  # the speed recorded, not a gauge: a note
     if "tube_hoop" in forces.channels:
         faults += hoop_findings(forces, record.apparatus, forces.channels["tube_hoop"].noise.sd)
     if faults:
         return faults, []
     found += [GaugeFinding("", "flat", note) for note in flat_run_notes(record)]
+    if any(g.kind == "balance" for g in found):  # the balance said with its finding
+        return [], found
     s = force_balance(forces)
     if not np.isfinite(s):  # no loading to weigh (a spike as the input bar's peak): nothing was checked
-        return [], found or [GaugeFinding("", "ok", (
+        return [], [GaugeFinding("", "ok", (
             "not checked: neither the gauges' signs nor the output forces against the input force (no loading "
-            "above half the input force's peak for 8 samples: a spike on the input bar?)"))]
-    return [], found or [GaugeFinding("", "ok", (
-        f"signs agree and the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5)"))]
+            "above half the input force's peak for 8 samples: a spike on the input bar?)"))] + found
+    return [], [GaugeFinding("", "ok", (
+        f"signs agree and the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5)"))] + found
 
 
 #: Largest hoop-gauge kernel factor: a uniform band as long as the sample, read at its middle (docs/physics.md

@@ -371,6 +371,21 @@ def test_input_scale_without_the_striker_speed_names_both_candidates(tmp_path, s
     assert 90 < v_s < 110  # ten times the 9.9 m/s fired: the input gauge is the one off
 
 
+def test_a_wrong_striker_speed_with_gauges_that_agree_is_a_note_not_a_refusal(tmp_path, scope_csv, capsys):
+    """A light gate read 6 m/s for a 9.9 m/s shot: the incident wave disagrees with it by 1.6, but the output forces
+    balance the input force and the ends' velocities agree, so no gauge is off. It was refused, the input gauge
+    blamed; now imported, with a warning that names the speed recorded."""
+    doc = setup_doc()
+    doc["record"]["striker_velocity"] = 6.0
+    setup = write_setup(tmp_path / "SETUP.toml", doc)
+    assert main(["import", str(scope_csv), "--setup", str(setup), "-o", str(tmp_path / "r.h5")]) == 0
+    out = capsys.readouterr().out
+    assert "WARNING: the incident wave stands for a striker at 9." in out and "says 6 m/s" in out
+    assert main(["inspect", str(tmp_path / "r.h5")]) == 0
+    out = capsys.readouterr().out
+    assert "GAUGE FAULT" not in out and "gauges      signs agree" in out and "the speed recorded looks wrong" in out
+
+
 def test_swapped_output_channels_are_named(tmp_path, scope_csv, capsys):
     doc = setup_doc()
     ch = doc["channels"]
