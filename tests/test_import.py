@@ -283,9 +283,20 @@ def test_a_damaged_row_near_the_end_is_named_by_its_line(tmp_path, scope_csv, ca
     assert f"where the rows around it are {ncols} numbers each" in err, err
 
 
+@pytest.mark.parametrize("footer", [["End"], ["End of data", "Points: 6500"]])
+def test_a_footer_after_the_rows_is_named_by_its_line(tmp_path, scope_csv, capsys, footer):
+    """A footer after the data: refused as "not rows of numbers in any of the usual layouts: is it an oscilloscope
+    export?", which named no line; now its first line, and what to do."""
+    lines = scope_csv.read_text().splitlines()
+    scope_csv.write_text("\n".join(lines + footer) + "\n")
+    err = _refused(tmp_path, [scope_csv], setup_doc(), capsys)
+    assert f"scope.csv: line {len(lines) + 1} follows the last row of numbers and is not one ('{footer[0]}')" in err
+    assert "a footer; delete it" in err
+
+
 def test_a_damaged_row_is_found_by_its_place_not_by_its_text(tmp_path):
     """A flat signal: every row the same, one cut short, whose text is the start of every later row; and a footer
-    after the data, which is not a damaged row (the general sentence stays)."""
+    after the data, which is not a damaged row: named as a footer, by its line."""
     from friction_uq.acquisition.delimited import read_delimited
 
     rows = ["time,a,b"] + ["0.000,0.000,0.000"] * 100
@@ -297,7 +308,8 @@ def test_a_damaged_row_is_found_by_its_place_not_by_its_text(tmp_path):
             read_delimited(path, [1, 2])
     footer = tmp_path / "footer.csv"
     footer.write_text("\n".join(["time,a,b"] + [f"{k},1,2" for k in range(100)] + ["END OF DATA"]) + "\n")
-    with pytest.raises(ScopeFileError, match="its last lines are not rows of numbers"):
+    with pytest.raises(ScopeFileError, match=r"line 102 follows the last row of numbers and is not one \('END OF DATA'\): "
+                       r"a footer; delete it and the lines after it \(the rows before it are 3 numbers each\)$"):
         read_delimited(footer, [1, 2])
 
 

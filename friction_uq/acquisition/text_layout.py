@@ -72,6 +72,8 @@ def find_dialect(path: Path, tail: list[tuple[int, str]], text: str) -> tuple[st
             best = (delim, dec, n)
     if best is None:
         odd = odd_line(tail, text)
+        if odd is not None and "a footer" in odd[0]:
+            raise ScopeFileError(f"{path}: {odd[0]} (the rows before it are {odd[1]} numbers each)")
         if odd is not None:
             raise ScopeFileError(f"{path}: {odd[0]}, where the rows around it are {odd[1]} numbers each (a truncated "
                                  "or damaged row near the end of the export)")
@@ -85,7 +87,8 @@ def odd_line(tail: list[tuple[int, str]], text: str) -> tuple[str, int] | None:
     """The first line of ``tail`` (offset, line) that breaks the layout more than half of them share (of such
     layouts, the one with the most numbers per row): a row of numbers with another count of them, or a line
     between rows of the layout that is not a row of numbers ('line N has k fields'), and the rows' count of
-    numbers; None when there is no such layout or no such line (a footer after the data, a header above it)."""
+    numbers; a line after the last row that is not a row of numbers (a footer); None when there is no such layout or
+    no such line (a header above the rows)."""
     lines = [ln for _, ln in tail]
     shared: tuple[int, int, str | None, str] | None = None  # (rows, fields, delimiter, decimal mark)
     for delim, dec in DIALECTS:
@@ -105,6 +108,10 @@ def odd_line(tail: list[tuple[int, str]], text: str) -> tuple[str, int] | None:
             what = f"has {n} field{'s' if n != 1 else ''}"
         elif any(fits[:k]) and any(fits[k + 1:]):
             what = f"is not a row of numbers ({line.strip()[:40]!r})"
+        elif any(fits[:k]):  # after the last row: a footer, which the export's rows must not have
+            what = (f"follows the last row of numbers and is not one ({line.strip()[:40]!r}): a footer; delete it and "
+                    "the lines after it")
+            return f"line {text.count(chr(10), 0, pos) + 1} {what}", ncols
         else:
             continue
         return f"line {text.count(chr(10), 0, pos) + 1} {what}", ncols
