@@ -23,7 +23,7 @@ import numpy as np
 from .physics import bars as eq
 from .record import Bar, Record
 from .errors import ShortPreTrigger, SignalError
-from .signals import NoiseEstimate, noise_estimate, prepulse_noise, transport, window_mask
+from .signals import NoiseEstimate, noise_estimate, padding, prepulse_noise, transport, window_mask
 
 
 @dataclass(frozen=True)
@@ -102,9 +102,9 @@ def _noise_and_arrival(
         nz, arr = prepulse_noise(x, span=span, polarity=polarity)
     except SignalError:
         stop = int(np.floor(earliest)) - 8
-        return noise_estimate(x, stop=stop), float(earliest), False
+        return noise_estimate(x, start=padding(x), stop=stop), float(earliest), False
     if nz.stop > earliest:  # a pulse "before" the earliest possible arrival: keep to physics
-        nz = noise_estimate(x, stop=int(np.floor(earliest)) - 8)
+        nz = noise_estimate(x, start=nz.start, stop=int(np.floor(earliest)) - 8)
     return nz, arr, True
 
 
@@ -192,7 +192,7 @@ def _input_bar_waves(record: Record, span: int, dispersion: bool,
     sep = arr_inc + 2.0 * ib.gauge_delay * fs  # reflected wave's front at the gauge
     margin = _margin(record)
     echo = arr_inc + 2.0 * ib.length / ib.wave_speed * fs  # far-end echo of the reflected wave
-    inc = np.where(window_mask(n, 0, sep - margin), y, 0.0)
+    inc = np.where(window_mask(n, noise_in.start, sep - margin), y, 0.0)  # not an unfilled pre-trigger's samples
     ref = np.where(window_mask(n, sep - margin, echo - margin), y, 0.0)
     eps_i = _transported(inc, ib, +ib.gauge_distance, dt, dispersion)
     eps_r = _transported(ref, ib, -ib.gauge_distance, dt, dispersion)
@@ -215,7 +215,7 @@ def _transmitted_wave(record: Record, name: str, span: int, incident_at_cell: fl
     margin = _margin(record)
     nz, arr, found = _noise_and_arrival(x, earliest=incident_at_cell + d, span=span, polarity=+1)
     echo = arr + 2.0 * (bar.length - bar.gauge_distance) / bar.wave_speed * fs
-    y = np.where(window_mask(n, 0, echo - margin), x - nz.offset, 0.0)
+    y = np.where(window_mask(n, nz.start, echo - margin), x - nz.offset, 0.0)
     eps = _transported(y, bar, -bar.gauge_distance, record.sample_interval, dispersion)
     valid_until = min(echo, n) - d - margin  # its far-end echo, or the record's end, brought back by d
     info[name] = ChannelInfo(name, nz, arr - d, valid_until, found)
@@ -228,4 +228,4 @@ def _hoop_strain(record: Record, span: int, incident_at_cell: float, info: dict[
     x = record.strain("tube_hoop")
     nz, arr, found = _noise_and_arrival(x, earliest=incident_at_cell, span=span, polarity=-1)
     info["tube_hoop"] = ChannelInfo("tube_hoop", nz, arr, float(record.n_samples), found)
-    return x - nz.offset
+    return np.where(np.arange(record.n_samples) >= nz.start, x - nz.offset, 0.0)

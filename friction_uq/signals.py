@@ -33,7 +33,7 @@ import scipy.fft as scipy_fft
 from .dispersion import propagate
 from .errors import ShortPreTrigger, SignalError
 from .stats.ar1 import ar1_mean_sd
-from .record.contract import HEAD_FRACTION
+from .record.contract import CLIP_RUN, HEAD_FRACTION
 from .stats.robust import SPIKE_FILTER, SPIKE_SIGMAS, despiked, median_and_sd, running_median
 
 #: Threshold, in noise standard deviations, for the first crossing that starts an arrival search.
@@ -237,15 +237,17 @@ def prepulse_noise(
     again.
     """
     n = len(x)
-    n0 = min(n, max(MIN_BASELINE_SAMPLES, int(initial_fraction * n)))
+    lead = padding(x)  # an unfilled pre-trigger: the baseline starts after it
+    n0 = min(n - lead, max(MIN_BASELINE_SAMPLES, int(initial_fraction * n)))
 
     def front(head: int) -> tuple[float, float, float]:
-        med, sd = median_and_sd(x[:head])
-        return pulse_front(x, offset=med, sd=max(sd, 1e-300), span=span, polarity=polarity)
+        med, sd = median_and_sd(x[lead:lead + head])
+        return pulse_front(x, offset=med, sd=max(sd, 1e-300), start=lead, span=span, polarity=polarity)
 
     def clear_of(arrival: float, t10: float, t50: float) -> int:
-        """Samples before the front less the margin (a smooth front starts one 10-50 % rise before its foot)."""
-        return int(np.floor(arrival - (t50 - t10))) - margin
+        """Samples before the front less the margin (a smooth front starts one 10-50 % rise before its foot), from
+        the baseline's start."""
+        return int(np.floor(arrival - (t50 - t10))) - margin - lead
 
     try:
         arrival, t10, t50 = front(n0)
@@ -255,17 +257,32 @@ def prepulse_noise(
     if not head_clean:  # a pre-trigger shorter than the head: cut it where a first look from 32 samples finds the front
         first = front(MIN_BASELINE_SAMPLES)
         arrival, t10, t50 = front(max(MIN_BASELINE_SAMPLES, min(n0, clear_of(*first))))
-    stop = clear_of(arrival, t10, t50)
-    if stop < MIN_BASELINE_SAMPLES:
+    if clear_of(arrival, t10, t50) < MIN_BASELINE_SAMPLES:
+        unfilled = f" after {lead} samples that all repeat the first (an unfilled pre-trigger)" if lead else ""
         raise ShortPreTrigger(
             f"the first pulse arrives at sample {arrival:.0f}, its front rising from sample "
-            f"{arrival - (t50 - t10):.0f}, leaving {max(stop, 0)} samples of pre-pulse baseline where at least "
-            f"{MIN_BASELINE_SAMPLES} are needed: record a longer pre-trigger"
+            f"{arrival - (t50 - t10):.0f}, leaving {max(clear_of(arrival, t10, t50), 0)} samples of pre-pulse "
+            f"baseline{unfilled} where at least {MIN_BASELINE_SAMPLES} are needed: record a longer pre-trigger"
         )
-    est = noise_estimate(x, stop=stop)
+    est = noise_estimate(x, start=lead, stop=lead + clear_of(arrival, t10, t50))
     # a second pass with the refined baseline
-    arrival = pulse_arrival(x, offset=est.offset, sd=max(est.sd, 1e-300), span=span, polarity=polarity)
+    arrival = pulse_arrival(x, offset=est.offset, sd=max(est.sd, 1e-300), start=lead, span=span, polarity=polarity)
     return est, arrival
+
+
+def padding(x: np.ndarray) -> int:
+    """Samples at the start that all repeat the first exactly (a zero-padded export, an unfilled pre-trigger buffer)
+    when a noisy baseline follows them: at least :data:`~friction_uq.record.contract.CLIP_RUN` of them, and the
+    next 32 samples' steps changing sign 4 times or more (noise; a noise-free record's constant baseline runs into
+    its pulse's monotone front); else 0."""
+    x = np.asarray(x)
+    moved = np.flatnonzero(x != x[0]) if x.size else np.array([], int)
+    k = int(moved[0]) if moved.size else 0
+    if k < CLIP_RUN:
+        return 0
+    steps = np.diff(x[k:k + MIN_BASELINE_SAMPLES])
+    steps = steps[steps != 0]
+    return k if int(np.count_nonzero(np.diff(np.sign(steps)))) >= 4 else 0
 
 
 def window_mask(n: int, start: float, stop: float) -> np.ndarray:

@@ -6,7 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from friction_uq.errors import ShortPreTrigger, SignalError
-from friction_uq.signals import SPIKE_FILTER, SPIKE_SIGMAS, noise_estimate, prepulse_noise, pulse_arrival, transport
+from friction_uq.signals import (SPIKE_FILTER, SPIKE_SIGMAS, noise_estimate, padding, prepulse_noise, pulse_arrival,
+                                 transport)
 from friction_uq.stats.robust import despiked
 from friction_uq.noise import white_and_ar1_noise
 
@@ -243,3 +244,27 @@ def test_a_pre_trigger_too_short_asks_for_a_longer_one():
                                                                 rng=np.random.default_rng(2))
     with pytest.raises(ShortPreTrigger, match="record a longer pre-trigger"):
         prepulse_noise(x)
+
+
+@pytest.mark.parametrize("pad", [20, 100, 400])
+def test_an_unfilled_pre_trigger_is_not_the_baseline(pad):
+    """The first samples exactly 0 (a zero-padded export, an unfilled buffer), then the baseline's noise about an
+    offset: the arrival and the noise are those of the baseline after them (the step at their end was taken for the
+    pulse, the noise for nothing, and the record refused as a gain off by 20 %)."""
+    rng = np.random.default_rng(5)
+    n, foot = 6000, 1200.0
+    x = 2e-5 + ramp_pulse(n, foot) + white_and_ar1_noise(n, sd=3e-6, rho=0.5, white_fraction=0.3, rng=rng)
+    padded = x.copy()
+    padded[:pad] = 0.0
+    e0 = noise_estimate(x, start=pad, stop=prepulse_noise(x)[0].stop)
+    e, a = prepulse_noise(padded)
+    assert padding(padded) == pad and e.start == pad
+    assert a == pytest.approx(prepulse_noise(x)[1], abs=0.05)  # the second pass's offset is the shorter segment's
+    assert e.stop == e0.stop and e.offset == pytest.approx(e0.offset, rel=1e-12) and e.sd == pytest.approx(e0.sd,
+                                                                                                       rel=1e-12)
+
+
+def test_a_noise_free_baseline_is_no_padding():
+    """A synthetic record's baseline is exactly constant up to its front: not an unfilled pre-trigger."""
+    x = ramp_pulse(6000, 1200.0, rise=2000)  # a slow front: its first 32 samples barely move, and never back
+    assert padding(x) == 0 and padding(np.zeros(100)) == 0
