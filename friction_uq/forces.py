@@ -23,8 +23,8 @@ import numpy as np
 from .physics import bars as eq
 from .record import Bar, Record
 from .errors import ShortPreTrigger, SignalError
-from .signals import NoiseEstimate, noise_estimate, padding, prepulse_noise, transport, window_mask
-from .stats.robust import despiked
+from .signals import NoiseEstimate, noise_estimate, prepulse_noise, transport, window_mask
+from .stats.robust import despiked, padding
 
 
 @dataclass(frozen=True)

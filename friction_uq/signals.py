@@ -33,13 +33,15 @@ import scipy.fft as scipy_fft
 from .dispersion import propagate
 from .errors import ShortPreTrigger, SignalError
 from .stats.ar1 import ar1_mean_sd
-from .record.contract import CLIP_RUN, HEAD_FRACTION
-from .stats.robust import SPIKE_FILTER, SPIKE_SIGMAS, despiked, median_and_sd, running_median
+from .record.contract import HEAD_FRACTION
+from .stats.robust import SPIKE_FILTER, SPIKE_SIGMAS, despiked, median_and_sd, padding, running_median
 
 #: Threshold, in noise standard deviations, for the first crossing that starts an arrival search.
 ARRIVAL_SIGMAS = 8.0
 #: The crossing must also exceed this fraction of the channel's largest excursion.
 ARRIVAL_FRACTION = 0.05
+#: A head whose median departs from its first 32 samples' by this fraction of the channel's swing holds the pulse.
+HEAD_MEDIAN_SHIFT = 0.25
 #: Minimum pre-pulse segment (samples) for a noise estimate.
 MIN_BASELINE_SAMPLES = 32
 
@@ -249,9 +251,14 @@ def prepulse_noise(
         the baseline's start."""
         return int(np.floor(arrival - (t50 - t10))) - margin - lead
 
+    med_first, _ = median_and_sd(x[lead:lead + MIN_BASELINE_SAMPLES])
+    swing = float(np.max(np.abs(np.asarray(x[lead:], dtype=float) - med_first))) if n > lead else 0.0
     try:
         arrival, t10, t50 = front(n0)
-        head_clean = clear_of(arrival, t10, t50) >= n0
+        # the front beyond the head, and the head's median its first samples' (a pulse filling most of a short
+        # pre-trigger's head, quantised more coarsely than its noise, makes the median the pulse's and the MAD 0)
+        head_clean = clear_of(arrival, t10, t50) >= n0 and abs(median_and_sd(x[lead:lead + n0])[0] - med_first) <= (
+            HEAD_MEDIAN_SHIFT * swing)
     except SignalError:
         head_clean = False
     if not head_clean:  # a pre-trigger shorter than the head: cut it where a first look from 32 samples finds the front
@@ -268,21 +275,6 @@ def prepulse_noise(
     # a second pass with the refined baseline
     arrival = pulse_arrival(x, offset=est.offset, sd=max(est.sd, 1e-300), start=lead, span=span, polarity=polarity)
     return est, arrival
-
-
-def padding(x: np.ndarray) -> int:
-    """Samples at the start that all repeat the first exactly (a zero-padded export, an unfilled pre-trigger buffer)
-    when a noisy baseline follows them: at least :data:`~friction_uq.record.contract.CLIP_RUN` of them, and the
-    next 32 samples' steps changing sign 4 times or more (noise; a noise-free record's constant baseline runs into
-    its pulse's monotone front); else 0."""
-    x = np.asarray(x)
-    moved = np.flatnonzero(x != x[0]) if x.size else np.array([], int)
-    k = int(moved[0]) if moved.size else 0
-    if k < CLIP_RUN:
-        return 0
-    steps = np.diff(x[k:k + MIN_BASELINE_SAMPLES])
-    steps = steps[steps != 0]
-    return k if int(np.count_nonzero(np.diff(np.sign(steps)))) >= 4 else 0
 
 
 def window_mask(n: int, start: float, stop: float) -> np.ndarray:

@@ -11,6 +11,7 @@ that scale, or they would shrink it to nothing and make the noise look like spik
 from __future__ import annotations
 
 import numpy as np
+from scipy import stats
 from scipy.ndimage import median_filter
 
 #: Normal sd per median absolute deviation.
@@ -48,3 +49,30 @@ def despiked(seg: np.ndarray, *, width: int = SPIKE_FILTER, sigmas: float = SPIK
         return seg
     spikes = np.abs(r) > sigmas * MAD_SD * float(np.median(moved))
     return np.where(spikes, running, seg) if spikes.any() else seg
+
+
+#: Fewest leading samples, all equal to the first, that can be padding rather than a baseline on one code.
+PADDING_MIN = 8
+#: Samples after the padding that must look like noise.
+PADDING_CHECK = 32
+
+
+def padding(x: np.ndarray) -> int:
+    """Samples at the start that all repeat the first exactly (a zero-padded export, an unfilled pre-trigger buffer):
+    at least :data:`PADDING_MIN` of them, followed by :data:`PADDING_CHECK` samples of noise (their steps changing
+    sign 4 times or more: a noise-free record's constant baseline runs into its pulse's monotone front), and more
+    of them than that noise leaves on one value by chance (a baseline quantised more coarsely than its noise sits
+    on one code for a while): its chance of two equal neighbours, at its 95 % upper bound, to the power of the
+    run, below 1e-3; else 0."""
+    x = np.asarray(x)
+    moved = np.flatnonzero(x != x[0]) if x.size else np.array([], int)
+    k = int(moved[0]) if moved.size else 0
+    if k < PADDING_MIN:
+        return 0
+    after = x[k:k + PADDING_CHECK]
+    steps = np.diff(after)
+    if after.size < PADDING_CHECK or int(np.count_nonzero(np.diff(np.sign(steps[steps != 0])))) < 4:
+        return 0
+    same = int(np.count_nonzero(steps == 0))
+    stay = float(stats.beta.ppf(0.95, same + 1, steps.size - same + 1))
+    return k if (k - 1) * np.log(stay) < np.log(1e-3) else 0
