@@ -137,3 +137,17 @@ def test_8bit_channel_below_its_noise_clipped_is_warned_of(tmp_path: Path) -> No
     path = a03_with(tmp_path, "internal_output_bar", lambda x: quantised(x, 1.25))
     prep = prepare(read_record(path))
     assert any("internal_output_bar sits on one value" in n for n in prep.flat_runs)
+
+
+def test_a_rail_behind_an_unfilled_pre_trigger_is_still_refused(tmp_path: Path) -> None:
+    """The external bar at 8 bits, its range ending at 60 % of its peak (refused), and its first 100 samples 0 (an
+    unfilled pre-trigger): the pre-trigger the run is judged by starts after them (it was all zeros: no run judged,
+    the record read)."""
+    def clipped_and_padded(x: np.ndarray) -> np.ndarray:
+        q = quantised(x, 1.6)
+        q[:100] = 0.0
+        return q
+
+    path = a03_with(tmp_path, "external_output_bar", clipped_and_padded)
+    with pytest.raises(RecordError, match=r"/signals/external_output_bar: is clipped"):
+        read_record(path)

@@ -8,7 +8,8 @@ pre-trigger shows it (its first 2 %, spikes left out, cut where the pulse's fron
 chance p that the noise keeps a sample on its code is taken as the larger of
 
 * erf(q / (2 sqrt(2) sigma)), white noise of sd sigma (the pre-trigger's, less the rounding:
-  Sheppard's correction) on codes q wide, its mean at a code's centre (where runs are likeliest);
+  Sheppard's correction, or at least what its samples off the commonest code say) on codes q wide,
+  its mean at a code's centre (where runs are likeliest);
 * the pre-trigger's own share of neighbouring samples on one code, at its 95 % upper bound
   (coloured noise stays longer than white noise of its sd);
 
@@ -29,7 +30,7 @@ import numpy as np
 from scipy import stats
 from scipy.special import erf
 
-from ..stats.robust import despiked, median_and_sd
+from ..stats.robust import despiked, median_and_sd, padding
 from .contract import CLIP_RUN, HEAD_FRACTION, MIN_HEAD_SAMPLES
 
 #: Chance, at most, that the noise alone leaves a run of equal samples as long as one called saturated.
@@ -74,11 +75,27 @@ def stay_chance(head: np.ndarray, step: float) -> float:
         return 0.0
     if np.unique(head).size <= 2:
         return 1.0
-    sd = noise_sd(head, step)
-    white = float(erf(step / (2.0 * math.sqrt(2.0) * sd))) if sd > 0.0 else 0.0  # less than the rounding: seen only
+    sd = resolved_sd(head, step)
+    white = float(erf(step / (2.0 * math.sqrt(2.0) * sd))) if sd > 0.0 else 1.0
     same = int(np.count_nonzero(head[1:] == head[:-1]))
     seen = float(stats.beta.ppf(0.95, same + 1, head.size - 1 - same + 1))
     return max(white, seen)
+
+
+def resolved_sd(head: np.ndarray, step: float) -> float:
+    """The pre-trigger noise's sd as the run test takes it: the larger of the rounding-corrected sd
+    (:func:`noise_sd`) and the least sd that leaves as many samples off the commonest code (at its 5 % lower
+    bound; the noise's mean at the code's centre): a noise well below one code has a corrected sd of 0, though
+    the samples it moves off the code say how large it is."""
+    if step <= 0.0:
+        return noise_sd(head, step)
+    _, counts = np.unique(head, return_counts=True)
+    off = int(head.size - counts.max())
+    floor = 0.0
+    if off > 0:
+        p_low = float(stats.beta.ppf(0.05, off, head.size - off + 1))
+        floor = step / (2.0 * float(stats.norm.isf(p_low / 2.0)))
+    return max(noise_sd(head, step), floor)
 
 
 def longest_run(mask: np.ndarray) -> int:
@@ -90,8 +107,11 @@ def longest_run(mask: np.ndarray) -> int:
 
 
 def pre_trigger(x: np.ndarray) -> np.ndarray:
-    """The channel's first :data:`HEAD_FRACTION` (at least :data:`MIN_HEAD_SAMPLES`), spikes left out, cut where it
-    first departs from its first samples' median by a tenth of the channel's swing (a pulse's front in it)."""
+    """The channel's first :data:`HEAD_FRACTION` (at least :data:`MIN_HEAD_SAMPLES`) after its padding (an unfilled
+    pre-trigger: :func:`friction_uq.stats.robust.padding`), spikes left out, cut where it first departs from its
+    first samples' median by a tenth of the channel's swing (a pulse's front in it)."""
+    lead = padding(x)
+    x = x[lead:]
     n0 = min(x.size, max(MIN_HEAD_SAMPLES, int(HEAD_FRACTION * x.size)))
     med, _ = median_and_sd(x[:MIN_HEAD_SAMPLES])
     swing = float(np.max(np.abs(x - med)))
@@ -121,7 +141,8 @@ def flat_run(x: np.ndarray) -> FlatRun | None:
         run = longest_run(x == extreme)
         if run >= CLIP_RUN and (found is None or run > found.run):
             step = digitiser_step(x)
-            found = FlatRun(run, extreme, side, step, noise_sd(head, step) / step if step > 0 else math.inf,
+            sd = resolved_sd(head, step) if np.unique(head).size > 2 else 0.0
+            found = FlatRun(run, extreme, side, step, sd / step if step > 0 else math.inf,
                             run_needed(stay_chance(head, step), x.size))
     return found
 
