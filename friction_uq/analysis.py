@@ -39,6 +39,7 @@ class Prepared:
     data: StationaryData
     gauge_notes: tuple[str, ...] = ()  # what the gauge check found (friction_uq.gauge_check), for the warnings
     flat_runs: tuple[str, ...] = ()  # peaks on one value that may be a saturated digitiser (gauge_check.flat_run_notes)
+    speed_notes: tuple[str, ...] = ()  # an incident wave at odds with striker_velocity while the gauges agree
 
 
 def prepare(
@@ -56,9 +57,9 @@ def prepare(
         raise SignalError(f"{record.path}: {wired[0].sentence}")
     # a channel's scale off by a factor (a gauge factor, a unit: eq. 5, 6 and 14) leaves f's ratio as it is when every
     # channel shares it, but not the forces, the pressure and the velocity: said, as the balance's notes are
-    scaled = [g for g in scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
-              if g.kind != "striker"]  # a striker speed recorded wrong: inspect's note, not the analysis' (f does not use it)
-    notes = tuple(g.sentence for g in findings + scaled)
+    scaled = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
+    speed = tuple(g.sentence for g in scaled if g.kind == "striker")  # the speed recorded, or every gauge's scale
+    notes = tuple(g.sentence for g in findings + scaled if g.kind != "striker")
     if window is None:
         win, notes = _automatic_window(record, forces, criterion, notes)
     else:
@@ -71,7 +72,7 @@ def prepare(
         striker_velocity=record.striker_velocity,
     )
     _check_polarity(record, data)
-    return Prepared(record, forces, win, data, notes, flat_run_notes(record))
+    return Prepared(record, forces, win, data, notes, flat_run_notes(record), speed)
 
 
 def _automatic_window(record: Record, forces, criterion: WindowCriterion,

@@ -166,14 +166,15 @@ def _analyze(args: argparse.Namespace) -> int:
     rec = read_record(args.file)
     prep = prepare(rec, window=args.window, dispersion=args.dispersion)
     ident = identify(prep, nu=args.nu)
+    notes = prep.gauge_notes + prep.flat_runs + prep.speed_notes
     if args.json:
         out = ident.to_json()
         out["test_id"], out["campaign"] = rec.test_id, rec.campaign
-        out["gauge_notes"] = list(prep.gauge_notes + prep.flat_runs)
+        out["gauge_notes"] = list(notes)
         out["window_automatic"], out["dispersion_correction"] = prep.window.automatic, prep.forces.dispersion
         print(json.dumps(out))
     else:
-        print(identification_table(rec, ident) + "".join(f"\ngauge note: {n}" for n in prep.gauge_notes + prep.flat_runs))
+        print(identification_table(rec, ident) + "".join(f"\ngauge note: {n}" for n in notes))
     return 0
 
 

@@ -38,8 +38,9 @@ LOADED_FRACTION = 0.5
 
 @dataclass(frozen=True)
 class GaugeFinding:
-    """One disagreement: the channel suspected (or "" when the balance cannot say which), the kind
-    ("reversed", "swapped" or "balance") and a sentence with the evidence."""
+    """One finding: the channel suspected (or "" when the evidence cannot say which), the kind ("reversed",
+    "swapped", "balance", "scale", "hoop", "signal"; notes: "striker" for a striker speed at odds with gauges
+    that agree, "flat" for a peak on one value, "ok" for the checks passed) and a sentence with the evidence."""
 
     channel: str
     kind: str

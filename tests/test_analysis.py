@@ -221,3 +221,21 @@ def test_a_spike_before_the_incident_front_is_not_in_the_waves(tmp_path):
     lc, ls = measured_loading(clean, fc), measured_loading(spiked, fs)
     assert np.max(np.abs(ls.at_gauge - lc.at_gauge)) < 3 * noise
     assert np.nanmax(np.abs(fs.eps_incident - fc.eps_incident)) < 3 * noise
+
+
+def test_a_striker_speed_at_odds_with_agreeing_gauges_is_a_warning_of_its_own(tmp_path):
+    """A light gate read 6 m/s for 9.9: no gauge is blamed (the gauges agree), but the run says it, since a scale
+    every gauge shares would leave f and move the forces, the pressure and the velocity."""
+    import h5py
+
+    from friction_uq.record_run.warnings import speed_warning
+
+    path = tmp_path / "v6.h5"
+    shutil.copyfile(Path(__file__).parents[1] / "data" / "A" / "A-03.h5", path)
+    with h5py.File(path, "r+") as fh:
+        fh.attrs["striker_velocity"] = 6.0
+    prep = prepare(read_record(path))
+    assert prep.gauge_notes == () and len(prep.speed_notes) == 1
+    said = speed_warning(prep.speed_notes)
+    assert said.startswith("The incident wave stands for a striker at 9.") and "every gauge's scale is off" in said
+    assert prepare(read_record(Path(__file__).parents[1] / "data" / "A" / "A-03.h5")).speed_notes == ()

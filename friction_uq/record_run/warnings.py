@@ -160,6 +160,16 @@ def flat_run_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
             "scope's range at that value, or re-record with the gauge's peak well inside it.")
 
 
+def speed_warning(notes: Sequence[str]) -> str | None:
+    """The incident wave at odds with the striker's recorded speed while the gauges agree with each other
+    (:func:`friction_uq.gauge_check.scale_findings`, kind "striker")."""
+    if not notes:
+        return None
+    return (f"{'; '.join(notes)[:1].upper()}{'; '.join(notes)[1:]}. f reads the output forces' ratio and does not "
+            "move with a scale all the gauges share; the forces, the wall pressure and the sliding velocity do: check "
+            "striker_velocity and the gauges' strain_per_volt before quoting them.")
+
+
 def convergence_warning(conv: Convergence) -> str | None:
     if conv.ok:
         return None
@@ -190,11 +200,12 @@ def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
                  conv: Convergence, conflict: PriorDataConflict | None,
                  check: WholeRecordCheck | None, gauge_notes: Sequence[str] = (),
-                 diagnosis=None, flat_runs: Sequence[str] = ()) -> list[str]:
+                 diagnosis=None, flat_runs: Sequence[str] = (), speed_notes: Sequence[str] = ()) -> list[str]:
     """Every check's warning, in the order a reader should see them; empty when all pass."""
     found: Sequence[str | None] = (
         flat_run_warning(flat_runs, f), gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f),
-        stationarity_warning(ppc, excess_spread, dof, f, lab), misfit_warning(check, f, diagnosis),
+        speed_warning(speed_notes), stationarity_warning(ppc, excess_spread, dof, f, lab),
+        misfit_warning(check, f, diagnosis),
         convergence_warning(conv), exact_posterior_warning(diagnosis), conflict_warning(conflict),
     )
     return [w for w in found if w]
