@@ -15,7 +15,7 @@ import numpy as np
 from .forces import Forces, compute_forces
 from .physics import cell
 from .errors import NoStationaryPhase, SignalError
-from .gauge_check import flat_run_notes, gauge_findings, scale_findings
+from .gauge_check import flat_run_notes, gauge_and_speed, gauge_findings, scale_findings
 from .record import Record
 from .signals import moving_average
 from .stats.ar1 import ar1_mean_sd
@@ -57,9 +57,8 @@ def prepare(
         raise SignalError(f"{record.path}: {wired[0].sentence}")
     # a channel's scale off by a factor (a gauge factor, a unit: eq. 5, 6 and 14) leaves f's ratio as it is when every
     # channel shares it, but not the forces, the pressure and the velocity: said, as the balance's notes are
-    scaled = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
-    speed = tuple(g.sentence for g in scaled if g.kind == "striker")  # the speed recorded, or every gauge's scale
-    notes = tuple(g.sentence for g in findings + scaled if g.kind != "striker")
+    scaled, speed = gauge_and_speed(scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity))
+    notes = tuple(g.sentence for g in findings + scaled)
     if window is None:
         win, notes = _automatic_window(record, forces, criterion, notes)
     else:
@@ -72,7 +71,7 @@ def prepare(
         striker_velocity=record.striker_velocity,
     )
     _check_polarity(record, data)
-    return Prepared(record, forces, win, data, notes, flat_run_notes(record), speed)
+    return Prepared(record, forces, win, data, notes, flat_run_notes(record), tuple(g.sentence for g in speed))
 
 
 def _automatic_window(record: Record, forces, criterion: WindowCriterion,

@@ -196,6 +196,12 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *,
         "restores both (check its strain_per_volt, gauge factor, amplifier gain or units)"))]
 
 
+def gauge_and_speed(findings: list[GaugeFinding]) -> tuple[list[GaugeFinding], list[GaugeFinding]]:
+    """:func:`scale_findings` split into a gauge's faults and the note on the striker's recorded speed (kind
+    "striker": no gauge is off)."""
+    return [g for g in findings if g.kind != "striker"], [g for g in findings if g.kind == "striker"]
+
+
 def flat_run_notes(record: Record) -> tuple[str, ...]:
     """Channels whose peak sits on one value for a run their pre-trigger noise cannot tell from a saturated digitiser
     (:mod:`friction_uq.record.saturation`; the reader refuses the runs it can tell): one sentence each."""
@@ -235,9 +241,8 @@ def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFi
     faults = [g for g in found if g.kind in ("reversed", "swapped")]
     if faults:
         return faults, []
-    scaled = scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity)
-    faults = [g for g in scaled if g.kind != "striker"]
-    found += [g for g in scaled if g.kind == "striker"]  # the speed recorded, not a gauge: a note
+    faults, speed = gauge_and_speed(scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity))
+    found += speed  # the speed recorded, not a gauge: a note
     if "tube_hoop" in forces.channels:
         faults += hoop_findings(forces, record.apparatus, forces.channels["tube_hoop"].noise.sd)
     if faults:

@@ -33,6 +33,7 @@ from .forces import Forces
 from .record import Apparatus, Tube
 from .signals import moving_average
 from .stats.ar1 import ar1_mean_sd
+from .stats.robust import longest_true_run
 
 
 @dataclass(frozen=True)
@@ -163,16 +164,6 @@ def _close_gaps(mask: np.ndarray, max_gap: int) -> np.ndarray:
     return out
 
 
-def _longest_run(mask: np.ndarray) -> tuple[int, int]:
-    if not mask.any():
-        return 0, 0
-    padded = np.concatenate(([0], mask.astype(np.int8), [0]))
-    edges = np.flatnonzero(np.diff(padded))
-    starts, stops = edges[0::2], edges[1::2]
-    k = int(np.argmax(stops - starts))
-    return int(starts[k]), int(stops[k])
-
-
 def find_stationary_window(
     forces: Forces, apparatus: Apparatus, criterion: WindowCriterion = WindowCriterion(), *, velocity: bool = True,
 ) -> Window:
@@ -188,7 +179,7 @@ def find_stationary_window(
     dt = t[1] - t[0]
     steady, r_s, band = _steadiness(forces, apparatus, criterion, velocity=velocity)
     mask = _close_gaps(steady, int(round(criterion.max_gap / dt)))
-    i0, i1 = _longest_run(mask)
+    i0, i1 = longest_true_run(mask)
     if i1 > i0:
         a, b = _longest_banded(r_s[i0:i1], float(np.median(band[i0:i1])))
         i0, i1 = i0 + a, i0 + b

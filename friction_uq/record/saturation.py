@@ -30,7 +30,7 @@ import numpy as np
 from scipy import stats
 from scipy.special import erf
 
-from ..stats.robust import despiked, median_and_sd, padding
+from ..stats.robust import despiked, longest_true_run, median_and_sd, padding
 from .contract import CLIP_RUN, HEAD_FRACTION, MIN_HEAD_SAMPLES
 
 #: Chance, at most, that the noise alone leaves a run of equal samples as long as one called saturated.
@@ -98,14 +98,6 @@ def resolved_sd(head: np.ndarray, step: float) -> float:
     return max(noise_sd(head, step), floor)
 
 
-def longest_run(mask: np.ndarray) -> int:
-    if not mask.any():
-        return 0
-    padded = np.concatenate(([0], mask.astype(np.int8), [0]))
-    edges = np.flatnonzero(np.diff(padded))
-    return int((edges[1::2] - edges[0::2]).max())
-
-
 def pre_trigger(x: np.ndarray) -> np.ndarray:
     """The channel's first :data:`HEAD_FRACTION` (at least :data:`MIN_HEAD_SAMPLES`) after its padding (an unfilled
     pre-trigger: :func:`friction_uq.stats.robust.padding`), spikes left out, cut where it first departs from its
@@ -138,7 +130,8 @@ def flat_run(x: np.ndarray) -> FlatRun | None:
     for extreme, side in ((float(x.max()), "maximum"), (float(x.min()), "minimum")):
         if abs(extreme - median) < 0.5 * swing:
             continue  # the extreme of the side the pulse does not reach: baseline noise
-        run = longest_run(x == extreme)
+        start, stop = longest_true_run(x == extreme)
+        run = stop - start
         if run >= CLIP_RUN and (found is None or run > found.run):
             step = digitiser_step(x)
             sd = resolved_sd(head, step) if np.unique(head).size > 2 else 0.0

@@ -76,3 +76,14 @@ def padding(x: np.ndarray) -> int:
     same = int(np.count_nonzero(steps == 0))
     stay = float(stats.beta.ppf(0.95, same + 1, steps.size - same + 1))
     return k if (k - 1) * np.log(stay) < np.log(1e-3) else 0
+
+
+def longest_true_run(mask: np.ndarray) -> tuple[int, int]:
+    """(start, stop) of the longest run of True in ``mask`` ((0, 0) when there is none)."""
+    mask = np.asarray(mask, dtype=bool)
+    if not mask.any():
+        return 0, 0
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(np.int8), [0]))))
+    starts, stops = edges[0::2], edges[1::2]
+    k = int(np.argmax(stops - starts))
+    return int(starts[k]), int(stops[k])
