@@ -11,7 +11,10 @@ the forces at the cell before anything else is fitted:
 * balance (eq. 5): the output forces sum to the input force. Their ratio
   S = mean(F_io + F_eo) / mean(F_i) over the loading departs from 1 by a gauge's gain error; the
   plug's inertia and the waves' transit make it differ by a few percent at most on a sound record
-  (:data:`BALANCE_TOL`).
+  (:data:`BALANCE_TOL`). A departure is a gauge's only when the gauges' noise cannot make it: beyond
+  :data:`NOISE_SIGMAS` of its noise standard deviation (:mod:`friction_uq.force_noise`). A short
+  pre-trigger with strongly coloured noise leaves the input force's offset uncertain by tens of
+  percent of F_i (a difference of two large waves); its balance then says nothing of a gain.
 
 The findings name the gauge and the evidence; :func:`friction_uq.analysis.prepare` refuses a
 reversed output gauge with them, and says them instead of "no stationary phase" when a gauge fault
@@ -25,15 +28,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .force_noise import MeanForces, mean_forces
 from .forces import Forces
 from .plausible import out_of_range
 from .record import Apparatus, Record
-from .stats.ar1 import ar1_mean_sd
 
 #: Largest |S - 1| of a sound record's force balance over the loading.
 BALANCE_TOL = 0.05
 #: Input force fraction of its peak that marks the loading.
 LOADED_FRACTION = 0.5
+#: A mean force below zero, a balance or a channel's factor off, is the gauges' only beyond this many noise sd.
+NOISE_SIGMAS = 3.0
+#: How a balance note ends when the gauges' noise could make the imbalance (the warnings tell it by this).
+NOISE_CANNOT_TELL = "cannot be told from the gauges' noise"
 
 
 @dataclass(frozen=True)
@@ -71,36 +78,54 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
     if n < 8:
         return []
     out = []
-    ch = forces.channels
-    for name, channel, F, bar in (("F_io", "internal_output_bar", forces.F_io, apparatus.internal_output_bar),
-                                  ("F_eo", "external_output_bar", forces.F_eo, apparatus.external_output_bar)):
-        noise = ch[channel].noise
-        se = bar.area * bar.young_modulus * math.hypot(ar1_mean_sd(noise.sd, noise.rho_eff, n), noise.offset_sd)
-        mean = float(np.mean(F[m]))
-        if mean < -3.0 * se:
+    mf = mean_forces(forces, apparatus, m)
+    for name, channel, mean, se in (("F_io", "internal_output_bar", mf.F_io, mf.sd_io),
+                                    ("F_eo", "external_output_bar", mf.F_eo, mf.sd_eo)):
+        if mean < -NOISE_SIGMAS * se:
             out.append(GaugeFinding(channel, "reversed", (
                 f"/signals/{channel} reads tension through the loading ({name} mean {mean:.0f} N while the input "
-                f"force pushes with {float(np.mean(forces.F_i[m])):.0f} N): the gauge looks reversed (its wiring, "
+                f"force pushes with {mf.F_i:.0f} N): the gauge looks reversed (its wiring, "
                 "its bridge or the sign convention, elongation positive)")))
-    if float(np.mean(forces.F_i[m])) < 0.0:
+    if mf.F_i < 0.0:
         out.append(GaugeFinding("input_bar", "reversed", (
             "/signals/input_bar: the input force is tensile through the loading: the input bar's gauge looks "
             "reversed (the incident wave is a compression, negative strain in the record)")))
     if out:
         return out
-    s = force_balance(forces)
+    off = balance_departure(mf)
+    s = mf.balance
+    if off == "noise":  # beyond the tolerance, within what the noise makes of it: said, no gauge blamed
+        return [GaugeFinding("", "balance", (
+            f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
+            f"{BALANCE_TOL * 100:.0f} %), but the gauges' noise alone makes that sum uncertain by "
+            f"{_percent(mf.balance_log_sd)} % (1 sd, the pre-pulse noise's colour at its upper bound): a gain off by "
+            f"{abs(s - 1.0) * 100:.0f} % {NOISE_CANNOT_TELL}"))]
+    if off != "gauge":
+        return out
     swapped = _swapped_balance(forces, apparatus, m)
-    if math.isfinite(s) and abs(s - 1.0) > BALANCE_TOL and abs(swapped - 1.0) <= BALANCE_TOL:
+    if abs(swapped - 1.0) <= BALANCE_TOL:
         return [GaugeFinding("internal_output_bar", "swapped", (
             f"the output forces sum to {s * 100:.0f} % of the input force over the loading, and to "
             f"{swapped * 100:.0f} % with /signals/internal_output_bar and /signals/external_output_bar exchanged: the two output channels "
             "look swapped"))]
-    if math.isfinite(s) and abs(s - 1.0) > BALANCE_TOL:
-        out.append(GaugeFinding("", "balance", (
-            f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
-            f"{BALANCE_TOL * 100:.0f} %): a gauge's gain, its strain_per_volt or a bar's modulus is off by about "
-            f"{abs(s - 1.0) * 100:.0f} %")))
+    out.append(GaugeFinding("", "balance", (
+        f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
+        f"{BALANCE_TOL * 100:.0f} %; the gauges' noise, 1 sd: {_percent(mf.balance_log_sd)} %): a gauge's gain, its "
+        f"strain_per_volt or a bar's modulus is off by about {abs(s - 1.0) * 100:.0f} %")))
     return out
+
+
+def _percent(x: float) -> str:
+    """A fraction as a percentage: whole numbers from 10 %, one decimal below."""
+    return f"{x * 100:.0f}" if x >= 0.1 else f"{x * 100:.1f}"
+
+
+def balance_departure(mf: MeanForces) -> str:
+    """How the output forces' sum departs from the input force (eq. 5): "" within :data:`BALANCE_TOL`; "noise" beyond
+    it but within :data:`NOISE_SIGMAS` times what the gauges' noise makes of the ratio; "gauge" beyond both."""
+    if not (mf.F_i > 0.0 and mf.F_io + mf.F_eo > 0.0) or abs(mf.balance - 1.0) <= BALANCE_TOL:
+        return ""
+    return "gauge" if abs(math.log(mf.balance)) > NOISE_SIGMAS * mf.balance_log_sd else "noise"
 
 
 def _swapped_balance(forces: Forces, apparatus: Apparatus, m: np.ndarray) -> float:
@@ -143,13 +168,15 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *,
     candidate enters differently: the ends' velocities (eq. 6: V_io = V_i in the stationary state) take
     the input and internal output gauges but not the external one, and the incident wave's plateau
     against the striker's speed (eq. 14: eps_i = V_s / (2 c)) takes the input gauge alone. The
-    channel is named when it alone, rescaled, satisfies both relations, and its factor is beyond
-    :data:`SCALE_FACTOR` (an error of a gauge factor or a unit, not the few % a gain drifts).
+    channel is named when the balance is off (:func:`balance_departure`: "gauge"), it alone, rescaled, satisfies both
+    relations, and its factor is beyond :data:`SCALE_FACTOR` (an error of a gauge factor or a unit, not
+    the few % a gain drifts) and beyond :data:`NOISE_SIGMAS` times the factor's noise.
     """
     m = loading_mask(forces)
     if m.sum() < 8:
         return []
-    Fi, Fio, Feo = (float(np.mean(x[m])) for x in (forces.F_i, forces.F_io, forces.F_eo))
+    mf = mean_forces(forces, apparatus, m)
+    Fi, Fio, Feo = mf.F_i, mf.F_io, mf.F_eo
     Vi, Vio = float(np.mean(forces.V_i[m])), float(np.mean(forces.V_io[m]))
     if not (Fi > 0 and Fio > 0 and Feo > 0 and Vi > 0 and Vio > 0):
         return []  # signs are the reversed-gauge check's business
@@ -178,8 +205,13 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *,
         if abs(math.log(q)) < STRIKER_LOG_TOL:
             ok.pop("input_bar", None)
             evidence += f", while the incident wave matches the striker's speed within {abs(q - 1) * 100:.0f} %"
-    if set(ok) == {"input_bar", "internal_output_bar"} and min(abs(math.log(a)) for a in ok.values()) > math.log(
-            SCALE_FACTOR):
+    if balance_departure(mf) != "gauge":
+        return []  # no imbalance beyond the tolerance and the gauges' noise: no channel's scale to find from it
+
+    def beyond(channel: str) -> bool:  # off by more than SCALE_FACTOR and by more than the noise makes of the factor
+        return abs(math.log(ok[channel])) > max(math.log(SCALE_FACTOR), NOISE_SIGMAS * mf.rescaled_log_sd(channel))
+
+    if set(ok) == {"input_bar", "internal_output_bar"} and all(beyond(c) for c in ok):
         v_s = 2.0 * apparatus.input_bar.wave_speed * incident_plateau(forces)
         return [GaugeFinding("", "scale", (
             f"either /signals/input_bar looks {_off(ok['input_bar'])} or /signals/internal_output_bar "
@@ -189,7 +221,7 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *,
     if len(ok) != 1:
         return []
     ((channel, a),) = ok.items()
-    if abs(math.log(a)) < math.log(SCALE_FACTOR):
+    if not beyond(channel):
         return []
     return [GaugeFinding(channel, "scale", (
         f"/signals/{channel} looks {_off(a)}: {evidence}; multiplying that channel by {a:.3g} "
@@ -255,8 +287,10 @@ def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFi
         return [], [GaugeFinding("", "ok", (
             "not checked: neither the gauges' signs nor the output forces against the input force (no loading "
             "above half the input force's peak for 8 samples: a spike on the input bar?)"))] + found
+    noise = mean_forces(forces, record.apparatus, loading_mask(forces)).balance_log_sd
     return [], [GaugeFinding("", "ok", (
-        f"signs agree and the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5)"))] + found
+        f"signs agree and the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5; the "
+        f"gauges' noise, 1 sd: {_percent(noise)} %)"))] + found
 
 
 #: Largest hoop-gauge kernel factor: a uniform band as long as the sample, read at its middle (docs/physics.md
