@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .force_noise import mean_forces
 from .forces import Forces, compute_forces
 from .physics import cell
 from .errors import NoStationaryPhase, SignalError
@@ -132,6 +133,7 @@ class Identification:
     stationarity_error: float
     time: np.ndarray
     f_series: np.ndarray
+    equilibrium_sd: float = 0.0  # the gauges' noise in equilibrium_error
 
     def series_json(self, *, points: int = 50) -> dict:
         """f(t) over the window, decimated to about ``points`` values (it is smoothed over 10 us)."""
@@ -158,6 +160,7 @@ class Identification:
             "F_io": self.F_io,
             "F_eo": self.F_eo,
             "equilibrium_error": self.equilibrium_error,
+            "equilibrium_error_noise_sd": self.equilibrium_sd,
             "stationarity_error": self.stationarity_error,
             "window": list(self.window),
         }
@@ -167,7 +170,10 @@ def identify(prepared: Prepared, *, nu: float) -> Identification:
     """f (eq. 17), p_min, p_max (eq. 19), p_mean (eq. 20 and its approximation eq. 21), tau_mean (eq. 18), V (eq. 7).
 
     Means are taken over the window; the ratio is the ratio of the mean forces (noise in F_io
-    would bias a mean of ratios).
+    would bias a mean of ratios), and so are the equilibrium (eq. 5) and stationarity (eq. 6) errors
+    (a mean of (F_i - F_io - F_eo) / F_i divides by F_i's noise, which strongly coloured noise on a
+    short pre-trigger makes a fair share of F_i); the equilibrium error's noise from
+    :func:`friction_uq.force_noise.mean_forces`.
     """
     if not 0.0 < nu < 0.5:
         raise ValueError(f"nu must lie in (0, 0.5), got {nu!r}")
@@ -175,8 +181,8 @@ def identify(prepared: Prepared, *, nu: float) -> Identification:
     app = prepared.record.apparatus
     R, L = app.sample.radius, app.sample.length
     seg = win.slice
-    F_io = float(np.mean(fo.F_io[seg]))
-    F_eo = float(np.mean(fo.F_eo[seg]))
+    means = mean_forces(fo, app, seg)
+    F_io, F_eo = means.F_io, means.F_eo
     ratio = F_eo / F_io
     f = float(cell.friction_from_ratio(ratio, nu, radius=R, length=L))
     tau = float(cell.mean_friction_stress(F_eo, radius=R, length=L))
@@ -199,8 +205,9 @@ def identify(prepared: Prepared, *, nu: float) -> Identification:
         V=float(np.mean(fo.V[seg])),
         F_io=F_io,
         F_eo=F_eo,
-        equilibrium_error=float(np.mean(fo.equilibrium[seg])),
-        stationarity_error=float(np.mean(fo.stationarity[seg])),
+        equilibrium_error=1.0 - means.balance,
+        equilibrium_sd=means.balance * means.balance_log_sd,
+        stationarity_error=1.0 - float(np.mean(fo.V_io[seg])) / float(np.mean(fo.V_i[seg])),
         time=np.array(fo.time[seg]),
         f_series=np.asarray(cell.friction_from_ratio(np.clip(r_t, -0.999, None), nu, radius=R, length=L)),
     )

@@ -115,6 +115,7 @@ def identification_table(record: Record, ident: Identification) -> str:
         ("tau_mean (eq. 18)", f"{ident.tau_mean / 1e6:.3f}", "MPa"),
         ("V sliding (eq. 7)", f"{ident.V:.3f}", "m/s"),
         ("equilibrium error (eq. 5)", f"{100 * ident.equilibrium_error:+.2f}", "%"),
+        ("equilibrium error: gauges' noise sd", f"{100 * ident.equilibrium_sd:.2f}", "%"),
         ("stationarity error (eq. 6)", f"{100 * ident.stationarity_error:+.2f}", "%"),
         ("f over the window: sd", f"{np.std(ident.f_series):.4f}", "-"),
     ]

@@ -15,7 +15,8 @@ Checks and their limits (``docs/trust.md`` gives the calibration):
   and biases f inside it);
 * a gauge's peak sits on one value for a run its noise cannot tell from a saturated digitiser;
 * a gauge disagrees over the loading (:mod:`friction_uq.gauge_check`), or the output forces do not
-  sum to the input force within :data:`EQUILIBRIUM_TOL` over the window (eq. 5);
+  sum to the input force within :data:`EQUILIBRIUM_TOL` over the window (eq. 5), nor within
+  :data:`~friction_uq.gauge_check.NOISE_SIGMAS` times what the gauges' noise makes of it;
 * convergence of the sampler; the prior-data check;
 * with ``diagnose``: the named model's normal approximation against its exact posterior (Pareto k).
 """
@@ -27,6 +28,7 @@ from collections.abc import Sequence
 from scipy import stats
 
 from ..analysis import Identification
+from ..gauge_check import NOISE_CANNOT_TELL, NOISE_SIGMAS
 from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
@@ -136,7 +138,7 @@ def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary, diagnosis
 def equilibrium_warning(lab: Identification, f: VariableSummary) -> str | None:
     """The output forces do not balance the input force (eq. 5): a gauge's gain, sign or place is off."""
     e = lab.equilibrium_error
-    if abs(e) <= EQUILIBRIUM_TOL:
+    if abs(e) <= max(EQUILIBRIUM_TOL, NOISE_SIGMAS * lab.equilibrium_sd):
         return None
     return (f"The output forces sum to {(1.0 - e) * 100:.0f} % of the input force over the window (eq. 5 wants "
             f"100 % within {EQUILIBRIUM_TOL * 100:.0f} %): a gauge's gain, sign or distance is off, and "
@@ -145,9 +147,13 @@ def equilibrium_warning(lab: Identification, f: VariableSummary) -> str | None:
 
 
 def gauge_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
-    """What the gauge check found over the loading (:mod:`friction_uq.gauge_check`)."""
+    """What the gauge check found over the loading (:mod:`friction_uq.gauge_check`): a gauge that disagrees, or a
+    balance off by more than its tolerance that the gauges' noise could make (no gauge blamed)."""
     if not notes:
         return None
+    if all(n.endswith(NOISE_CANNOT_TELL) for n in notes):
+        return (f"The force balance cannot check the gauges on this record: {'; '.join(notes)}. {_f_text(f)} rests "
+                "on the output gauges' ratio, whose gains it then leaves unchecked.")
     return (f"A gauge disagrees with the others: {'; '.join(notes)}. {_f_text(f)} rests on the output gauges' "
             "ratio and is off by as much as their gains are; `friction-uq diagnose` fits a gauge's gain.")
 
