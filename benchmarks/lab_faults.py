@@ -27,6 +27,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+from scipy.signal import lfilter
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE = ROOT / "data" / "A" / "A-03.h5"
@@ -97,6 +98,19 @@ def clipped_with_noise(ch: Channels, attrs: dict) -> None:
     ch["external_output_bar"] = np.maximum(smooth, rail) + np.random.default_rng(5).normal(0.0, sd, x.size)
 
 
+def coloured_noise(rho: float, level: float, seed: int) -> Callable[[Channels, dict], None]:
+    """AR(1) noise of lag-1 ``rho`` and sd ``level`` times each channel's peak added to every channel (as
+    ``tests/test_force_noise.py`` makes it)."""
+    def edit(ch: Channels, attrs: dict) -> None:
+        rng = np.random.default_rng(seed)
+        for k in sorted(ch):
+            x = ch[k]
+            peak = float(np.max(np.abs(x - np.median(x[:200]))))
+            noise = lfilter([np.sqrt(1.0 - rho * rho)], [1.0, -rho], rng.normal(size=x.size + 5000))[5000:]
+            ch[k] = x + level * peak * noise
+    return edit
+
+
 def step_before(ch: Channels, attrs: dict) -> None:
     """A baseline step of 10 % of the external bar's peak 20 us before its wave (about sample 1830)."""
     x = ch["external_output_bar"]
@@ -125,6 +139,8 @@ FAULTS: dict[str, tuple[str, Callable[[Channels, dict], None]]] = {
     "striker_6_for_9.9": ("the light gate read 6 m/s for a 9.9 m/s shot", striker(6.0)),
     "zero_padded_external": ("the external bar's first 100 samples exactly 0 (an unfilled pre-trigger)",
                              with_channel("external_output_bar", zero_padded(100))),
+    "coloured_noise": ("lag-1 0.99 noise of 3 % of each channel's peak on every channel (seed 9)",
+                       coloured_noise(0.99, 0.03, 9)),
     # known gaps (docs/laboratory-faults.md): f moves, and nothing but the record's usual warning says so
     "hoop_gain_0.85": ("the hoop gauge reading 15 % low (a gauge factor or a lead's resistance)",
                        with_channel("tube_hoop", lambda x: 0.85 * x)),

@@ -138,7 +138,8 @@ def _summary_lines(r: ReportInputs) -> list[str]:
         f"({'automatic' if r.prepared.window.automatic else 'given by hand'}); sliding velocity "
         f"V = {r.V.q50:.2f} m/s, mean wall pressure p_mean = {s['p_mean'].q50 / 1e6:.1f} MPa." + _halves_text(r),
         f"The lab's point estimate (eq. 17 with nu = {r.lab.nu:g}): f = {r.lab.f:.4f}, "
-        f"F_eo/F_io = {r.lab.ratio:.4f}, equilibrium error {100 * r.lab.equilibrium_error:+.1f} %.",
+        f"F_eo/F_io = {r.lab.ratio:.4f}, equilibrium error {100 * r.lab.equilibrium_error:+.1f} % (the gauges' noise, "
+        f"1 sd: {100 * r.lab.equilibrium_sd:.1f} %).",
         f"Hoop gauge term: {'used' if r.samples.hoop else 'not used'}; the bars' dispersion "
         f"{'corrected' if r.prepared.forces.dispersion else 'not corrected'}. Convergence: "
         f"{'OK' if r.convergence.ok else 'NOT REACHED'} (R-hat max {r.convergence.r_hat_max:.3f}, "
