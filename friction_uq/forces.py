@@ -23,8 +23,8 @@ import numpy as np
 from .physics import bars as eq
 from .record import Bar, Record
 from .errors import ShortPreTrigger, SignalError
-from .signals import NoiseEstimate, noise_estimate, prepulse_noise, transport, window_mask
-from .stats.robust import despiked, padding
+from .signals import NoiseEstimate, baseline_free, noise_estimate, prepulse_noise, transport, window_mask
+from .stats.robust import padding
 
 
 @dataclass(frozen=True)
@@ -109,16 +109,6 @@ def _noise_and_arrival(
     return nz, arr, True
 
 
-def despiked_baseline(x: np.ndarray, nz: NoiseEstimate) -> np.ndarray:
-    """``x`` with the spikes of its pre-pulse segment left out of the waves as they are of its noise (a spike before
-    the incident front was a pulse of the simulated test's loading); the same array where there is none."""
-    seg = x[nz.start:nz.stop]
-    clean = despiked(seg)
-    if clean is seg or np.array_equal(clean, seg):
-        return x
-    return np.concatenate([x[:nz.start], clean, x[nz.stop:]])
-
-
 def _transported(x: np.ndarray, bar: Bar, distance: float, dt: float, dispersion: bool) -> np.ndarray:
     return transport(
         x,
@@ -199,7 +189,7 @@ def _input_bar_waves(record: Record, span: int, dispersion: bool,
     ib, n, dt, fs = record.apparatus.input_bar, record.n_samples, record.sample_interval, record.sample_rate
     x = record.strain("input_bar")
     noise_in, arr_inc = _incident_arrival(record, x, span)
-    y = despiked_baseline(x, noise_in) - noise_in.offset
+    y = baseline_free(x, noise_in)
     sep = arr_inc + 2.0 * ib.gauge_delay * fs  # reflected wave's front at the gauge
     margin = _margin(record)
     echo = arr_inc + 2.0 * ib.length / ib.wave_speed * fs  # far-end echo of the reflected wave
@@ -226,7 +216,7 @@ def _transmitted_wave(record: Record, name: str, span: int, incident_at_cell: fl
     margin = _margin(record)
     nz, arr, found = _noise_and_arrival(x, earliest=incident_at_cell + d, span=span, polarity=+1)
     echo = arr + 2.0 * (bar.length - bar.gauge_distance) / bar.wave_speed * fs
-    y = np.where(window_mask(n, nz.start, echo - margin), despiked_baseline(x, nz) - nz.offset, 0.0)
+    y = np.where(window_mask(n, nz.start, echo - margin), baseline_free(x, nz), 0.0)
     eps = _transported(y, bar, -bar.gauge_distance, record.sample_interval, dispersion)
     valid_until = min(echo, n) - d - margin  # its far-end echo, or the record's end, brought back by d
     info[name] = ChannelInfo(name, nz, arr - d, valid_until, found)
@@ -239,4 +229,4 @@ def _hoop_strain(record: Record, span: int, incident_at_cell: float, info: dict[
     x = record.strain("tube_hoop")
     nz, arr, found = _noise_and_arrival(x, earliest=incident_at_cell, span=span, polarity=-1)
     info["tube_hoop"] = ChannelInfo("tube_hoop", nz, arr, float(record.n_samples), found)
-    return np.where(np.arange(record.n_samples) >= nz.start, despiked_baseline(x, nz) - nz.offset, 0.0)
+    return baseline_free(x, nz)

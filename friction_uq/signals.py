@@ -277,6 +277,17 @@ def prepulse_noise(
     return est, arrival
 
 
+def baseline_free(x: np.ndarray, noise: NoiseEstimate) -> np.ndarray:
+    """``x`` less its offset, the spikes of its pre-pulse segment left out as they are of its noise (a spike before a
+    front is no wave) and zero before the segment's start (an unfilled pre-trigger is no wave either)."""
+    x = np.asarray(x, dtype=float)
+    seg = x[noise.start:noise.stop]
+    clean = despiked(seg)
+    if clean is not seg and not np.array_equal(clean, seg):
+        x = np.concatenate([x[:noise.start], clean, x[noise.stop:]])
+    return np.where(np.arange(x.size) >= noise.start, x - noise.offset, 0.0)
+
+
 def window_mask(n: int, start: float, stop: float) -> np.ndarray:
     """Boolean mask of the samples with start <= index < stop (fractional bounds allowed)."""
     i = np.arange(n)

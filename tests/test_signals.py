@@ -6,8 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from friction_uq.errors import ShortPreTrigger, SignalError
-from friction_uq.signals import (SPIKE_FILTER, SPIKE_SIGMAS, noise_estimate, padding, prepulse_noise, pulse_arrival,
-                                 transport)
+from friction_uq.signals import (SPIKE_FILTER, SPIKE_SIGMAS, baseline_free, noise_estimate, padding, prepulse_noise,
+                                 pulse_arrival, transport)
 from friction_uq.stats.robust import despiked
 from friction_uq.noise import white_and_ar1_noise
 
@@ -296,3 +296,21 @@ def test_a_short_pre_trigger_before_a_quantised_plateau_is_found(pre):
         e, a = prepulse_noise(x, polarity=1)
         bad += e.stop > pre or abs(a - pre) > 2
     assert bad == 0
+
+
+def test_the_baseline_free_signal_has_no_padding_no_spike_and_no_offset():
+    """One signal for every reader of a channel's waves (the forces, the measured loading, the whole-record check, the
+    two-bar record): zero over an unfilled pre-trigger, a pre-pulse spike left out, the offset taken off, and the
+    samples from the segment's start otherwise the record's less the offset, to the bit."""
+    rng = np.random.default_rng(9)
+    n, foot, pad = 6000, 1200.0, 100
+    x = 2e-5 + ramp_pulse(n, foot) + white_and_ar1_noise(n, sd=3e-6, rho=0.5, white_fraction=0.3, rng=rng)
+    x[:pad] = 0.0
+    x[1000] += 5e-4  # a spike 200 samples before the front
+    e, _ = prepulse_noise(x)
+    y = baseline_free(x, e)
+    assert np.all(y[:pad] == 0.0)
+    assert abs(y[1000]) < 5 * e.sd
+    keep = np.ones(n, bool)
+    keep[:pad] = keep[1000] = False
+    assert np.array_equal(y[keep], (x - e.offset)[keep])

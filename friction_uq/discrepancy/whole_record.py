@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis import Prepared
+from ..signals import baseline_free
 from ..stats.ar1 import ar1_mean_sd
 
 #: Channels compared and their labels in reports.
@@ -225,7 +226,7 @@ def compare_whole_record(prep: Prepared, predicted: dict[str, np.ndarray]) -> Wh
     t = rec.time
     measured, figures, noise, spans = {}, [], {}, {}
     for ch in chans:
-        meas = rec.strain(ch) - prep.forces.channels[ch].noise.offset
+        meas = baseline_free(rec.strain(ch), prep.forces.channels[ch].noise)  # as the forces read it
         measured[ch] = meas
         noise[ch] = channel_noise(prep, ch)
         resid = meas - predicted[ch].mean(axis=0)

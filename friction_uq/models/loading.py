@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..forces import Forces, despiked_baseline
+from ..forces import Forces
 from ..record import Record
-from ..signals import transport, window_mask
+from ..signals import baseline_free, transport, window_mask
 from ..simulate.loading import Loading
 
 
@@ -23,8 +23,8 @@ def measured_loading(record: Record, forces: Forces, *, dispersion: bool = False
     n = record.n_samples
     info = forces.channels["input_bar"]
     sep = info.arrival + 2.0 * ib.gauge_delay * fs - 0.02 * record.apparatus.pulse_duration * fs
-    x = despiked_baseline(record.strain("input_bar"), info.noise)  # as the forces read it: no spike, no padding
-    at_gauge = np.where(window_mask(n, info.noise.start, sep), x - info.noise.offset, 0.0)
+    x = baseline_free(record.strain("input_bar"), info.noise)  # as the forces read it: no spike, no padding
+    at_gauge = np.where(window_mask(n, info.noise.start, sep), x, 0.0)
     at_cell = transport(at_gauge, sample_interval=1.0 / fs, distance=ib.gauge_distance, wave_speed=ib.wave_speed,
                         diameter=ib.outer_diameter, inner_diameter=ib.inner_diameter,
                         poisson_ratio=ib.poisson_ratio, dispersion=dispersion)

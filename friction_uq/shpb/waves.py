@@ -15,7 +15,7 @@ from types import MappingProxyType
 import numpy as np
 
 from ..errors import SignalError
-from ..signals import NoiseEstimate, prepulse_noise, pulse_arrival, window_mask
+from ..signals import NoiseEstimate, baseline_free, prepulse_noise, pulse_arrival, window_mask
 from .record import BarProperties, TwoBarRecord
 
 #: Fraction of its peak below which a wave has ended (after its peak): where its window stops.
@@ -97,10 +97,10 @@ def gauge_waves(
     span = int(2.0 * ib.gauge_distance / reflection_speed / dt)
     x_in = ib.strain(record.input_volts, gain=g_in)
     noise_in, arr_inc = prepulse_noise(x_in, polarity=+1, span=span)
-    y_in = x_in - noise_in.offset
+    y_in = baseline_free(x_in, noise_in)
     x_tr = tb.strain(record.transmitted_volts, gain=float(gain))
     noise_tr, arr_tr = prepulse_noise(x_tr, polarity=+1, span=span)
-    y_tr = x_tr - noise_tr.offset
+    y_tr = baseline_free(x_tr, noise_tr)
 
     sep = arr_inc + 2.0 * ib.gauge_distance / reflection_speed / dt  # reflected front at the input gauge
     margin = max(8.0, 0.01 * (sep - arr_inc))
@@ -111,9 +111,9 @@ def gauge_waves(
     end_ref = pulse_end(-y_in, start=arr_ref)
     end_tra = pulse_end(y_tr, start=arr_tr)
     spans = {
-        "incident": (0.0, min(end_inc + margin, sep - margin)),
+        "incident": (float(noise_in.start), min(end_inc + margin, sep - margin)),  # not an unfilled pre-trigger
         "reflected": (sep - margin, end_ref + margin),
-        "transmitted": (0.0, end_tra + margin),
+        "transmitted": (float(noise_tr.start), end_tra + margin),
     }
     waves = {k: np.where(window_mask(n, *s), y, 0.0) for (k, s), y in zip(spans.items(), (y_in, y_in, y_tr))}
     for a in waves.values():
