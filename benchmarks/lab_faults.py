@@ -111,6 +111,15 @@ def coloured_noise(rho: float, level: float, seed: int) -> Callable[[Channels, d
     return edit
 
 
+def one_code_spike(ch: Channels, attrs: dict) -> None:
+    """The internal bar read at 8 bits with its peak at 8 % of the range (its pre-trigger on one code), and a 2-sample
+    spike of 40 codes 50 samples in."""
+    x = quantised(ch["internal_output_bar"], 0.08)
+    step = 2.0 * np.abs(ch["internal_output_bar"]).max() / 0.08 / 2**8
+    x[50:52] += 40 * step * np.sign(np.min(x) or -1.0)
+    ch["internal_output_bar"] = x
+
+
 def step_before(ch: Channels, attrs: dict) -> None:
     """A baseline step of 10 % of the external bar's peak 20 us before its wave (about sample 1830)."""
     x = ch["external_output_bar"]
@@ -139,6 +148,10 @@ FAULTS: dict[str, tuple[str, Callable[[Channels, dict], None]]] = {
     "striker_6_for_9.9": ("the light gate read 6 m/s for a 9.9 m/s shot", striker(6.0)),
     "zero_padded_external": ("the external bar's first 100 samples exactly 0 (an unfilled pre-trigger)",
                              with_channel("external_output_bar", zero_padded(100))),
+    "one_code": ("internal bar at 8 bits, peak at 8 % of the range (its pre-trigger on one code)",
+                 with_channel("internal_output_bar", lambda x: quantised(x, 0.08))),
+    "one_code_spike": ("internal bar at 8 bits, peak at 8 % of the range (pre-trigger on one code), a 2-sample spike "
+                       "of 40 codes on it", one_code_spike),
     "coloured_noise": ("lag-1 0.99 noise of 3 % of each channel's peak on every channel (seed 9)",
                        coloured_noise(0.99, 0.03, 9)),
     # known gaps (docs/laboratory-faults.md): f moves, and nothing but the record's usual warning says so

@@ -34,6 +34,7 @@ from .dispersion import propagate
 from .errors import ShortPreTrigger, SignalError
 from .stats.ar1 import ar1_mean_sd
 from .record.contract import HEAD_FRACTION
+from .record.saturation import digitiser_step
 from .stats.robust import SPIKE_FILTER, SPIKE_SIGMAS, despiked, median_and_sd, padding, running_median
 
 #: Threshold, in noise standard deviations, for the first crossing that starts an arrival search.
@@ -92,7 +93,8 @@ class NoiseEstimate:
 
 def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate:
     """Offset, standard deviation and lag-1 autocorrelation of ``x[start:stop]``, its spikes left out
-    (:func:`friction_uq.stats.robust.despiked`).
+    (:func:`friction_uq.stats.robust.despiked`); the standard deviation at least a quantised channel's rounding,
+    step / sqrt(12) (:func:`friction_uq.record.saturation.digitiser_step`).
 
     >>> rng = np.random.default_rng(1)
     >>> e = noise_estimate(3.0 + rng.normal(0, 2.0, 20000), stop=20000)
@@ -105,11 +107,13 @@ def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate
             f"the pre-pulse segment has {seg.size} samples, at least {MIN_BASELINE_SAMPLES} are needed "
             "to estimate the baseline and noise"
         )
-    seg = despiked(seg, width=SPIKE_FILTER, sigmas=SPIKE_SIGMAS)
+    step = digitiser_step(x)
+    seg = despiked(seg, width=SPIKE_FILTER, sigmas=SPIKE_SIGMAS, step=step)
     offset = float(seg.mean())
     d = seg - offset
     var = float(np.mean(d * d))
-    sd = float(np.sqrt(var * seg.size / (seg.size - 1)))
+    # a baseline on one code has no spread of its own, but a wave read through many codes carries the rounding
+    sd = max(float(np.sqrt(var * seg.size / (seg.size - 1))), step / math.sqrt(12.0))
     rho = float(np.sum(d[1:] * d[:-1]) / (var * seg.size)) if var > 0 else 0.0
     rho = float(np.clip(rho, -0.99, 0.99))
     tau = integrated_autocorrelation(d)
@@ -282,7 +286,7 @@ def baseline_free(x: np.ndarray, noise: NoiseEstimate) -> np.ndarray:
     front is no wave) and zero before the segment's start (an unfilled pre-trigger is no wave either)."""
     x = np.asarray(x, dtype=float)
     seg = x[noise.start:noise.stop]
-    clean = despiked(seg)
+    clean = despiked(seg, step=digitiser_step(x))
     if clean is not seg and not np.array_equal(clean, seg):
         x = np.concatenate([x[:noise.start], clean, x[noise.stop:]])
     return np.where(np.arange(x.size) >= noise.start, x - noise.offset, 0.0)

@@ -151,3 +151,21 @@ def test_a_rail_behind_an_unfilled_pre_trigger_is_still_refused(tmp_path: Path) 
     path = a03_with(tmp_path, "external_output_bar", clipped_and_padded)
     with pytest.raises(RecordError, match=r"/signals/external_output_bar: is clipped"):
         read_record(path)
+
+
+def test_a_pre_trigger_on_one_code_is_read(tmp_path: Path) -> None:
+    """A-03's internal bar read at 8 bits with its peak at 8 % of the range: its pre-trigger sits on one code, a noise
+    sd of 0 that the likelihood refused ("noise sd_io must be a positive number, got 0.0"). The noise is now at least
+    the rounding's, step / sqrt(12), and the record is analysed; a 2-sample spike of 40 codes on that pre-trigger
+    changes nothing."""
+    path = a03_with(tmp_path, "internal_output_bar", lambda x: quantised(x, 0.08))
+    rec = read_record(path)
+    strain = rec.strain("internal_output_bar")
+    noise = prepare(rec).forces.channels["internal_output_bar"].noise
+    assert np.ptp(strain[noise.start:noise.stop]) == 0.0  # one code
+    assert noise.sd == pytest.approx(digitiser_step(strain) / math.sqrt(12.0), rel=1e-9)
+    raw_step = digitiser_step(h5py.File(path)["signals"]["internal_output_bar"][()].astype(float))
+    (tmp_path / "spiked").mkdir()
+    spiked = a03_with(tmp_path / "spiked", "internal_output_bar",
+                      lambda v: quantised(v, 0.08) + np.where(np.isin(np.arange(v.size), [50, 51]), 40 * raw_step, 0.0))
+    assert prepare(read_record(spiked)).forces.channels["internal_output_bar"].noise == noise

@@ -109,7 +109,7 @@ def pre_trigger(x: np.ndarray) -> np.ndarray:
     swing = float(np.max(np.abs(x - med)))
     off = np.flatnonzero(np.abs(x[:n0] - med) > 0.1 * swing)
     head = x[: max(MIN_HEAD_SAMPLES, int(off[0]) if off.size else n0)]
-    return despiked(head)
+    return despiked(head, step=digitiser_step(x))
 
 
 def flat_run(x: np.ndarray) -> FlatRun | None:

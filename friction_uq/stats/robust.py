@@ -36,9 +36,16 @@ def running_median(x: np.ndarray, width: int) -> np.ndarray:
     return median_filter(x, width, mode="nearest") if x.size >= width else x
 
 
-def despiked(seg: np.ndarray, *, width: int = SPIKE_FILTER, sigmas: float = SPIKE_SIGMAS) -> np.ndarray:
+def despiked(seg: np.ndarray, *, width: int = SPIKE_FILTER, sigmas: float = SPIKE_SIGMAS,
+             step: float = 0.0) -> np.ndarray:
     """``seg`` with its spikes (samples more than ``sigmas`` robust sd from their running median of ``width``)
-    replaced by that median; ``seg`` itself when it has none."""
+    replaced by that median; ``seg`` itself when it has none.
+
+    ``step``: the digitiser's step when the channel is quantised (0: not known). A baseline quantised more coarsely
+    than its noise sits on one code but for a few samples; when fewer than ``2 width`` samples leave their running
+    median, they may all be a spike's, and the scale is then at most one step (a sample one code off its neighbours is
+    noise, one 12 codes off is not), not the spike's own size.
+    """
     seg = np.asarray(seg, dtype=float)
     if seg.size < width:
         return seg
@@ -47,7 +54,10 @@ def despiked(seg: np.ndarray, *, width: int = SPIKE_FILTER, sigmas: float = SPIK
     moved = np.abs(r[r != 0.0])
     if moved.size == 0:
         return seg
-    spikes = np.abs(r) > sigmas * MAD_SD * float(np.median(moved))
+    scale = float(np.median(moved))
+    if step > 0.0 and moved.size < 2 * width:
+        scale = min(scale, step)
+    spikes = np.abs(r) > sigmas * MAD_SD * scale
     return np.where(spikes, running, seg) if spikes.any() else seg
 
 
