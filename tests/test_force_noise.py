@@ -102,26 +102,26 @@ def test_coloured_noise_is_not_a_gauge_fault(tmp_path: Path) -> None:
     assert equilibrium_warning(lab, f) is None
 
 
-def test_a_gain_beyond_the_noise_is_still_blamed(tmp_path: Path) -> None:
-    """A-03's internal bar read 0.85 times what it carried, its noise as recorded: a gauge blamed, as before."""
-    path = tmp_path / "low.h5"
+def a03_scaled(tmp_path: Path, channel: str, factor: float) -> Path:
+    """A-03 with ``channel`` read ``factor`` times what it carried (its noise as recorded, nearly white)."""
+    path = tmp_path / "scaled.h5"
     shutil.copyfile(A03, path)
     with h5py.File(path, "r+") as fh:
-        ds = fh["signals"]["internal_output_bar"]
-        ds[...] = 0.85 * ds[()]
-    prep = prepare(read_record(path))
+        ds = fh["signals"][channel]
+        ds[...] = factor * ds[()]
+    return path
+
+
+def test_a_gain_beyond_the_noise_is_still_blamed(tmp_path: Path) -> None:
+    """A-03's internal bar read 0.85 times what it carried: a gauge blamed, as before."""
+    prep = prepare(read_record(a03_scaled(tmp_path, "internal_output_bar", 0.85)))
     assert prep.gauge_notes and "is off by about" in prep.gauge_notes[0]
     f = VariableSummary(mean=0.048, sd=0.002, q05=0.045, q50=0.048, q95=0.051, r_hat=1.0, ess_bulk=4000.0)
     assert gauge_warning(prep.gauge_notes, f).startswith("A gauge disagrees with the others")
 
 
 def test_a_gauge_off_by_a_factor_is_still_named_under_white_noise(tmp_path: Path) -> None:
-    """A-03's external bar read 10 times what it carried (its noise as recorded, nearly white): named, as before."""
-    path = tmp_path / "low.h5"
-    shutil.copyfile(A03, path)
-    with h5py.File(path, "r+") as fh:
-        ds = fh["signals"]["external_output_bar"]
-        ds[...] = 10.0 * ds[()]
-    faults, _ = record_gauge_check(read_record(path))
+    """A-03's external bar read 10 times what it carried: named, as before."""
+    faults, _ = record_gauge_check(read_record(a03_scaled(tmp_path, "external_output_bar", 10.0)))
     assert [(g.channel, g.kind) for g in faults] == [("external_output_bar", "scale")]
     assert "9.04 times too large" in faults[0].sentence
