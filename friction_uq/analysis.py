@@ -6,20 +6,19 @@ starting point of the Bayesian one.
 
 from __future__ import annotations
 
-import math
-
 from dataclasses import dataclass
 
 import numpy as np
 
-from .force_noise import mean_forces
+from .force_noise import MeanForces, mean_forces
 from .forces import Forces, compute_forces
 from .physics import cell
 from .errors import NoStationaryPhase, SignalError
-from .gauge_check import flat_run_notes, gauge_and_speed, gauge_findings, scale_findings
+from .gauge_balance import NOISE_CANNOT_TELL, NOISE_SIGMAS, gauge_findings
+from .gauge_check import flat_run_notes
+from .gauge_scale import gauge_and_speed, scale_findings
 from .record import Record
 from .signals import moving_average
-from .stats.ar1 import ar1_mean_sd
 from .window import (
     StationaryData,
     Window,
@@ -71,8 +70,12 @@ def prepare(
         forces, record.apparatus, win, test_id=record.test_id, campaign=record.campaign,
         striker_velocity=record.striker_velocity,
     )
-    _check_polarity(record, data)
+    _check_polarity(record, forces, win)
     return Prepared(record, forces, win, data, notes, flat_run_notes(record), tuple(g.sentence for g in speed))
+
+
+#: The note said when the window was found from the force ratio alone (the warnings tell it from a gauge's finding).
+RATIO_WINDOW_NOTE = "the window was found from the force ratio alone: the sample's ends do not move together by the gauges (eq. 6)"
 
 
 def _automatic_window(record: Record, forces, criterion: WindowCriterion,
@@ -88,23 +91,21 @@ def _automatic_window(record: Record, forces, criterion: WindowCriterion,
             win = find_stationary_window(forces, record.apparatus, criterion, velocity=False)
         except NoStationaryPhase:
             raise NoStationaryPhase(f"{record.path}: {notes[0]}; no stationary phase either way: {exc}") from None
-    return win, notes + ("the window was found from the force ratio alone: the sample's ends do not move together by "
-                         "the gauges (eq. 6), as the suspect gauge makes them",)
+    suspect = "" if all(n.endswith(NOISE_CANNOT_TELL) for n in notes) else ", as the suspect gauge makes them"
+    return win, notes + (RATIO_WINDOW_NOTE + suspect,)
 
 
-def _check_polarity(record: Record, data: StationaryData) -> None:
-    """Refuse an output force that is negative (tensile) over the window beyond 3 standard errors.
+def _check_polarity(record: Record, forces: Forces, win: Window) -> None:
+    """Refuse an output force that is negative (tensile) over the window beyond :data:`NOISE_SIGMAS` of its noise
+    (:func:`friction_uq.force_noise.mean_forces`, as the gauge check over the loading weighs it).
 
     Friction and the transmitted load can only push: a negative stationary force means a gauge
     wired or converted with the wrong sign.
     """
-    for name, channel, F, sd, rho, off in (
-        ("F_eo", "external_output_bar", data.F_eo, data.sd_eo, data.rho_eo, data.sd_offset_eo),
-        ("F_io", "internal_output_bar", data.F_io, data.sd_io, data.rho_io, data.sd_offset_io),
-    ):
-        se = math.hypot(ar1_mean_sd(sd, rho, len(F)), off)
-        mean = float(np.mean(F))
-        if mean < -3.0 * se:
+    means = mean_forces(forces, record.apparatus, win.slice)
+    for name, channel, mean, se in (("F_eo", "external_output_bar", means.F_eo, means.sd_eo),
+                                    ("F_io", "internal_output_bar", means.F_io, means.sd_io)):
+        if mean < -NOISE_SIGMAS * se:
             raise SignalError(
                 f"{record.path}: /signals/{channel}: {name} is tensile over the stationary window (mean "
                 f"{mean:.0f} N, standard error {se:.0f} N): the gauge looks reversed; check its wiring, "
@@ -134,6 +135,7 @@ class Identification:
     time: np.ndarray
     f_series: np.ndarray
     equilibrium_sd: float = 0.0  # the gauges' noise in equilibrium_error
+    means: MeanForces | None = None  # the forces' means over the window and their noise (the equilibrium's check)
 
     def series_json(self, *, points: int = 50) -> dict:
         """f(t) over the window, decimated to about ``points`` values (it is smoothed over 10 us)."""
@@ -206,7 +208,8 @@ def identify(prepared: Prepared, *, nu: float) -> Identification:
         F_io=F_io,
         F_eo=F_eo,
         equilibrium_error=1.0 - means.balance,
-        equilibrium_sd=means.balance * means.balance_log_sd,
+        equilibrium_sd=means.balance_sd,
+        means=means,
         stationarity_error=1.0 - float(np.mean(fo.V_io[seg])) / float(np.mean(fo.V_i[seg])),
         time=np.array(fo.time[seg]),
         f_series=np.asarray(cell.friction_from_ratio(np.clip(r_t, -0.999, None), nu, radius=R, length=L)),

@@ -1,5 +1,5 @@
 """What the gauges' electrical noise alone leaves in the bar forces' means over a span (eq. 2-4), for the checks
-that compare those means: the force balance (eq. 5) and a channel's scale (:mod:`friction_uq.gauge_check`), the
+that compare those means: the force balance (eq. 5) and a channel's scale (:mod:`friction_uq.gauge_balance`, :mod:`friction_uq.gauge_scale`), the
 equilibrium over the window (:func:`friction_uq.analysis.identify`).
 
 A mean over ``n`` samples of an offset-corrected wave carries the noise of its samples and the error of the offset
@@ -65,13 +65,21 @@ class MeanForces:
 
     @property
     def balance(self) -> float:
-        """S = (F_io + F_eo) / F_i (eq. 5: 1)."""
-        return (self.F_io + self.F_eo) / self.F_i
+        """S = (F_io + F_eo) / F_i (eq. 5: 1); nan when F_i is 0."""
+        return (self.F_io + self.F_eo) / self.F_i if self.F_i != 0.0 else math.nan
 
     @property
     def balance_log_sd(self) -> float:
-        """Noise standard deviation of log S (first order)."""
-        return math.sqrt((self.sd_io ** 2 + self.sd_eo ** 2) / (self.F_io + self.F_eo) ** 2 + (self.sd_i / self.F_i) ** 2)
+        """Noise standard deviation of log S (first order); inf when either side is 0."""
+        out = self.F_io + self.F_eo
+        if out == 0.0 or self.F_i == 0.0:
+            return math.inf
+        return math.sqrt((self.sd_io ** 2 + self.sd_eo ** 2) / out ** 2 + (self.sd_i / self.F_i) ** 2)
+
+    @property
+    def balance_sd(self) -> float:
+        """Noise standard deviation of S itself, |S| times :attr:`balance_log_sd` (inf when that is)."""
+        return abs(self.balance) * self.balance_log_sd if math.isfinite(self.balance_log_sd) else math.inf
 
     def rescaled_log_sd(self, channel: str) -> float:
         """Noise standard deviation of the log of the factor that makes ``channel`` balance the others: F_i / (F_io +

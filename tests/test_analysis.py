@@ -173,7 +173,7 @@ def test_a_record_ending_before_the_reflected_wave_has_passed_keeps_its_force_ba
     import h5py
 
     from friction_uq.forces import compute_forces
-    from friction_uq.gauge_check import force_balance
+    from friction_uq.gauge_balance import force_balance
 
     src = Path(__file__).parents[1] / "data" / "A" / "A-03.h5"
     path = tmp_path / "late.h5"

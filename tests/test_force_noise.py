@@ -9,12 +9,14 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import pytest
 from scipy.signal import lfilter
 
-from friction_uq.analysis import identify, prepare
-from friction_uq.force_noise import COLOUR_CEILING, colour_upper, wave_mean_sd
+from friction_uq.analysis import RATIO_WINDOW_NOTE, identify, prepare
+from friction_uq.force_noise import COLOUR_CEILING, MeanForces, colour_upper, wave_mean_sd
 from friction_uq.diagnostics import VariableSummary
-from friction_uq.gauge_check import NOISE_CANNOT_TELL, NOISE_SIGMAS, record_gauge_check
+from friction_uq.gauge_balance import NOISE_CANNOT_TELL, NOISE_SIGMAS, balance_departure
+from friction_uq.gauge_check import record_gauge_check
 from friction_uq.record_run.warnings import equilibrium_warning, gauge_warning
 from friction_uq.record import read_record
 from friction_uq.signals import noise_estimate
@@ -53,9 +55,9 @@ def test_colour_upper_bounds_the_estimate() -> None:
 
 
 def test_a_short_coloured_pretrigger_offset_error_within_the_upper_colour() -> None:
-    """330 pre-pulse samples of lag-1 0.99 noise (a correlation time of 100 samples): the offset's error beyond 3 sd
-    of the point estimate's colour in 24 % of 400 draws, of the upper bound's in 0.25 % (limits: 15 % and 2.5 %,
-    each about 4 binomial sd from what was measured)."""
+    """330 pre-pulse samples of lag-1 0.99 noise (an integrated correlation time of 199 samples): the offset's error
+    beyond 3 sd of the point estimate's colour in 24 % of draws, of the upper bound's in 1.1 % (3000 draws). Limits
+    for these 400: 15 % (4 binomial sd below 24 %) and 3.5 % (4.6 binomial sd above 1.1 %)."""
     rng = np.random.default_rng(3)
     n, z_point, z_upper = 330, [], []
     for _ in range(400):
@@ -63,7 +65,7 @@ def test_a_short_coloured_pretrigger_offset_error_within_the_upper_colour() -> N
         z_point.append(abs(est.offset) / ar1_mean_sd(est.sd, est.rho_eff, n))
         z_upper.append(abs(est.offset) / ar1_mean_sd(est.sd, colour_upper(est), n))
     assert np.mean(np.array(z_point) > 3.0) > 0.15  # why the checks take the upper bound
-    assert np.mean(np.array(z_upper) > 3.0) < 0.025
+    assert np.mean(np.array(z_upper) > 3.0) < 0.035
 
 
 def a03_coloured(tmp_path: Path, *, rho: float, level: float, seed: int) -> Path:
@@ -94,12 +96,63 @@ def test_coloured_noise_is_not_a_gauge_fault(tmp_path: Path) -> None:
     assert faults == []
     assert [n.kind for n in notes] == ["balance"] and notes[0].sentence.endswith(NOISE_CANNOT_TELL)
     prep = prepare(rec)
-    assert prep.gauge_notes and all(n.endswith(NOISE_CANNOT_TELL) for n in prep.gauge_notes[:1])
+    assert prep.gauge_notes and prep.gauge_notes[0].endswith(NOISE_CANNOT_TELL)
     lab = identify(prep, nu=0.4)
     assert abs(lab.equilibrium_error) < NOISE_SIGMAS * lab.equilibrium_sd
     f = VariableSummary(mean=0.048, sd=0.002, q05=0.045, q50=0.048, q95=0.051, r_hat=1.0, ess_bulk=4000.0)
-    assert gauge_warning(prep.gauge_notes[:1], f).startswith("The force balance cannot check the gauges on this record")
+    assert gauge_warning(prep.gauge_notes, f).startswith("The force balance cannot check the gauges on this record")
     assert equilibrium_warning(lab, f) is None
+    # nor is the recorded speed told from the input gauge's scale by such a balance: a note, neither blamed
+    with h5py.File(rec.path, "r+") as fh:
+        fh.attrs["striker_velocity"] = 6.0
+    faults, notes = record_gauge_check(read_record(rec.path))
+    assert faults == [] and [n.kind for n in notes if n.kind == "striker"] == ["striker"]
+    assert "cannot be told from this record" in [n for n in notes if n.kind == "striker"][0].sentence
+
+
+def test_a_window_found_from_the_ratio_alone_blames_no_gauge_when_none_is() -> None:
+    """The note that the window was found from the force ratio alone follows the balance's; with a balance the noise
+    could make, it names no suspect gauge, and the warning stays the noise's (it once read "A gauge disagrees")."""
+    noise_note = f"the output forces sum to 74 % ...: a gain off by 26 % {NOISE_CANNOT_TELL}"
+    f = VariableSummary(mean=0.048, sd=0.002, q05=0.045, q50=0.048, q95=0.051, r_hat=1.0, ess_bulk=4000.0)
+    notes = (noise_note, RATIO_WINDOW_NOTE)
+    assert gauge_warning(notes, f).startswith("The force balance cannot check the gauges on this record")
+    assert gauge_warning(("a gauge's gain ... is off by about 15 %", RATIO_WINDOW_NOTE + ", as the suspect gauge makes "
+                          "them"), f).startswith("A gauge disagrees with the others")
+
+
+@pytest.mark.parametrize(("means", "said"), [
+    (MeanForces(1000.0, 300.0, 0.0, 450.0, 10.0, 10.0), "noise"),  # S = 0.3, log sd 0.45: within 3 sd
+    (MeanForces(1000.0, 3000.0, 0.0, 10.0, 1000.0, 10.0), "gauge"),  # S = 3, log sd 0.33: beyond
+    (MeanForces(1000.0, 980.0, 0.0, 10.0, 10.0, 10.0), ""),  # within 5 %
+    (MeanForces(1000.0, -20.0, 10.0, 50.0, 30.0, 30.0), "gauge"),  # outputs read nothing against a load beyond noise
+    (MeanForces(1000.0, -20.0, 10.0, 500.0, 30.0, 30.0), "noise"),  # ... against a load within its noise
+    (MeanForces(-100.0, 500.0, 50.0, 1000.0, 30.0, 30.0), "noise"),  # F_i within its noise of zero
+    (MeanForces(-5000.0, 500.0, 50.0, 1000.0, 30.0, 30.0), ""),  # F_i tensile beyond noise: the reversed check's
+    (MeanForces(0.0, 0.0, 0.0, 1.0, 1.0, 1.0), "noise"),
+])
+def test_balance_departure(means: MeanForces, said: str) -> None:
+    """One rule for the loading (gauge check) and the window (equilibrium warning): symmetric in log S, and defined
+    for every sign and zero (no division by zero)."""
+    assert balance_departure(means) == said
+    assert means.balance_sd >= 0.0 or math.isnan(means.balance_sd)
+
+
+def test_dead_output_gauges_are_not_a_sound_balance(tmp_path: Path) -> None:
+    """Both output channels only their pre-trigger noise: the outputs sum to about 0 % of the input force. Said as a
+    gauge's fault (a reviewer found it said as "signs agree" once the balance was weighed in logs)."""
+    path = tmp_path / "dead.h5"
+    shutil.copyfile(A03, path)
+    rng = np.random.default_rng(0)
+    with h5py.File(path, "r+") as fh:
+        for name in ("internal_output_bar", "external_output_bar"):
+            ds = fh["signals"][name]
+            x = ds[()].astype(float)
+            ds[...] = np.median(x[:200]) + np.std(x[:200]) * rng.normal(size=x.size)
+    faults, notes = record_gauge_check(read_record(path))
+    said = faults + notes
+    assert not any(n.kind == "ok" for n in said)
+    assert any(n.kind == "balance" and "is off by about" in n.sentence for n in said)
 
 
 def a03_scaled(tmp_path: Path, channel: str, factor: float) -> Path:

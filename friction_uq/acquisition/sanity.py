@@ -9,7 +9,8 @@ a warning.
 
 from __future__ import annotations
 
-from ..gauge_check import GaugeFinding, record_gauge_check
+from ..gauge_balance import GaugeFinding
+from ..gauge_check import record_gauge_check
 from ..record import Record
 from .setup_file import Setup
 

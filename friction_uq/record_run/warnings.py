@@ -14,9 +14,8 @@ Checks and their limits (``docs/trust.md`` gives the calibration):
   gauge f depends on, or anywhere else (a cause such as a plug friction shows outside that phase
   and biases f inside it);
 * a gauge's peak sits on one value for a run its noise cannot tell from a saturated digitiser;
-* a gauge disagrees over the loading (:mod:`friction_uq.gauge_check`), or the output forces do not
-  sum to the input force within :data:`EQUILIBRIUM_TOL` over the window (eq. 5), nor within
-  :data:`~friction_uq.gauge_check.NOISE_SIGMAS` times what the gauges' noise makes of it;
+* a gauge disagrees over the loading (:mod:`friction_uq.gauge_balance`, :mod:`friction_uq.gauge_scale`), or the
+  output forces do not sum to the input force over the window (eq. 5) within the same tolerance and noise;
 * convergence of the sampler; the prior-data check;
 * with ``diagnose``: the named model's normal approximation against its exact posterior (Pareto k).
 """
@@ -27,8 +26,8 @@ from collections.abc import Sequence
 
 from scipy import stats
 
-from ..analysis import Identification
-from ..gauge_check import NOISE_CANNOT_TELL, NOISE_SIGMAS
+from ..analysis import RATIO_WINDOW_NOTE, Identification
+from ..gauge_balance import BALANCE_TOL, NOISE_CANNOT_TELL, balance_departure
 from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
@@ -41,8 +40,6 @@ from ..stats.exact import ess_floor
 PPC_COVERAGE_MIN = 0.5
 #: Tail probability of the batch-means spread test (chi-square with batches - 1 degrees of freedom).
 SPREAD_ALPHA = 1e-3
-#: Largest |1 - (F_io + F_eo) / F_i| over the window (eq. 5) before a gauge is suspected.
-EQUILIBRIUM_TOL = 0.05
 #: Channels whose stationary-phase misfit bears on f.
 F_CHANNELS = ("internal_output_bar", "external_output_bar", "tube_hoop")
 
@@ -136,22 +133,24 @@ def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary, diagnosis
 
 
 def equilibrium_warning(lab: Identification, f: VariableSummary) -> str | None:
-    """The output forces do not balance the input force (eq. 5): a gauge's gain, sign or place is off."""
-    e = lab.equilibrium_error
-    if abs(e) <= max(EQUILIBRIUM_TOL, NOISE_SIGMAS * lab.equilibrium_sd):
+    """The output forces do not balance the input force over the window (eq. 5), beyond the tolerance and the gauges'
+    noise (:func:`friction_uq.gauge_balance.balance_departure`, as the gauge check over the loading): a gauge's gain,
+    sign or place is off."""
+    if lab.means is None or balance_departure(lab.means) != "gauge":
         return None
-    return (f"The output forces sum to {(1.0 - e) * 100:.0f} % of the input force over the window (eq. 5 wants "
-            f"100 % within {EQUILIBRIUM_TOL * 100:.0f} %): a gauge's gain, sign or distance is off, and "
+    return (f"The output forces sum to {(1.0 - lab.equilibrium_error) * 100:.0f} % of the input force over the window "
+            f"(eq. 5 wants 100 % within {BALANCE_TOL * 100:.0f} %): a gauge's gain, sign or distance is off, and "
             f"{_f_text(f)} rests on the output gauges' ratio, off by as much as their gains are; check the "
             "gauges' calibration (`friction-uq inspect`).")
 
 
 def gauge_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
-    """What the gauge check found over the loading (:mod:`friction_uq.gauge_check`): a gauge that disagrees, or a
+    """What the gauge check found over the loading (:mod:`friction_uq.gauge_balance`): a gauge that disagrees, or a
     balance off by more than its tolerance that the gauges' noise could make (no gauge blamed)."""
     if not notes:
         return None
-    if all(n.endswith(NOISE_CANNOT_TELL) for n in notes):
+    found = [n for n in notes if not n.startswith(RATIO_WINDOW_NOTE)]
+    if found and all(n.endswith(NOISE_CANNOT_TELL) for n in found):
         return (f"The force balance cannot check the gauges on this record: {'; '.join(notes)}. {_f_text(f)} rests "
                 "on the output gauges' ratio, whose gains it then leaves unchecked.")
     return (f"A gauge disagrees with the others: {'; '.join(notes)}. {_f_text(f)} rests on the output gauges' "
@@ -168,7 +167,7 @@ def flat_run_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
 
 def speed_warning(notes: Sequence[str]) -> str | None:
     """The incident wave at odds with the striker's recorded speed while the gauges agree with each other
-    (:func:`friction_uq.gauge_check.scale_findings`, kind "striker")."""
+    (:func:`friction_uq.gauge_scale.scale_findings`, kind "striker")."""
     if not notes:
         return None
     return (f"{'; '.join(notes)[:1].upper()}{'; '.join(notes)[1:]}. f reads the output forces' ratio and does not "

@@ -1,0 +1,148 @@
+"""Which gauge disagrees: sign and balance of the bar forces over the loading, before any window.
+
+A gauge wired the other way round, a gain off by some percent or two channels swapped shows in
+the forces at the cell before anything else is fitted:
+
+* swapped: the output forces balance the input force only with the two output channels exchanged;
+
+* sign: over the loading (where the input force F_i exceeds half its peak) the transmitted forces
+  F_io and F_eo push (compression, positive): a mean beyond 3 noise standard errors below zero is a
+  reversed gauge (or an inverted bridge);
+* balance (eq. 5): the output forces sum to the input force. Their ratio
+  S = mean(F_io + F_eo) / mean(F_i) over the loading departs from 1 by a gauge's gain error; the
+  plug's inertia and the waves' transit make it differ by a few percent at most on a sound record
+  (:data:`BALANCE_TOL`). A departure is a gauge's only when the gauges' noise cannot make it: beyond
+  :data:`NOISE_SIGMAS` of its noise standard deviation (:mod:`friction_uq.force_noise`). A short
+  pre-trigger with strongly coloured noise leaves the input force's offset uncertain by tens of
+  percent of F_i (a difference of two large waves); its balance then says nothing of a gain.
+
+The findings name the gauge and the evidence; :func:`friction_uq.analysis.prepare` refuses a
+reversed output gauge with them, and says them instead of "no stationary phase" when a gauge fault
+is what stops the window.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .force_noise import MeanForces, mean_forces
+from .forces import Forces
+from .record import Apparatus
+
+#: Largest |S - 1| of a sound record's force balance over the loading.
+BALANCE_TOL = 0.05
+#: Input force fraction of its peak that marks the loading.
+LOADED_FRACTION = 0.5
+#: A mean force below zero, a balance or a channel's factor off, is the gauges' only beyond this many noise sd.
+NOISE_SIGMAS = 3.0
+#: How a balance note ends when the gauges' noise could make the imbalance (the warnings tell it by this).
+NOISE_CANNOT_TELL = "cannot be told from the gauges' noise"
+
+
+@dataclass(frozen=True)
+class GaugeFinding:
+    """One finding: the channel suspected (or "" when the evidence cannot say which), the kind ("reversed",
+    "swapped", "balance", "scale", "hoop", "signal"; notes: "striker" for a striker speed at odds with gauges
+    that agree, "flat" for a peak on one value, "ok" for the checks passed) and a sentence with the evidence."""
+
+    channel: str
+    kind: str
+    sentence: str
+
+
+def loading_mask(forces: Forces) -> np.ndarray:
+    """Where every force is valid and the input force exceeds half its peak."""
+    ok = np.isfinite(forces.F_i) & np.isfinite(forces.F_io) & np.isfinite(forces.F_eo)
+    if not ok.any():
+        return ok
+    peak = float(np.max(np.abs(forces.F_i[ok])))
+    return ok & (np.abs(forces.F_i) >= LOADED_FRACTION * peak)
+
+
+def force_balance(forces: Forces) -> float:
+    """S = mean(F_io + F_eo) / mean(F_i) over the loading (eq. 5: 1); nan without a loading."""
+    m = loading_mask(forces)
+    if m.sum() < 8:
+        return float("nan")
+    return float(np.mean(forces.F_io[m] + forces.F_eo[m]) / np.mean(forces.F_i[m]))
+
+
+def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
+    """Reversed output or input gauges and a force balance off by more than :data:`BALANCE_TOL`."""
+    m = loading_mask(forces)
+    n = int(m.sum())
+    if n < 8:
+        return []
+    out = []
+    mf = mean_forces(forces, apparatus, m)
+    for name, channel, mean, se in (("F_io", "internal_output_bar", mf.F_io, mf.sd_io),
+                                    ("F_eo", "external_output_bar", mf.F_eo, mf.sd_eo)):
+        if mean < -NOISE_SIGMAS * se:
+            out.append(GaugeFinding(channel, "reversed", (
+                f"/signals/{channel} reads tension through the loading ({name} mean {mean:.0f} N while the input "
+                f"force pushes with {mf.F_i:.0f} N): the gauge looks reversed (its wiring, "
+                "its bridge or the sign convention, elongation positive)")))
+    if mf.F_i < -NOISE_SIGMAS * mf.sd_i:
+        out.append(GaugeFinding("input_bar", "reversed", (
+            "/signals/input_bar: the input force is tensile through the loading: the input bar's gauge looks "
+            "reversed (the incident wave is a compression, negative strain in the record)")))
+    if out:
+        return out
+    off = balance_departure(mf)
+    s = mf.balance
+    if off == "noise" and not mf.F_i > 0.0:
+        return [GaugeFinding("", "balance", (
+            f"the input force over the loading, {mf.F_i:.0f} N, is within its noise of zero (1 sd: {mf.sd_i:.0f} N, the "
+            f"pre-pulse noise's colour at its upper bound): the output forces' sum against it (eq. 5) "
+            f"{NOISE_CANNOT_TELL}"))]
+    if off == "noise":  # beyond the tolerance, within what the noise makes of it: said, no gauge blamed
+        return [GaugeFinding("", "balance", (
+            f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
+            f"{BALANCE_TOL * 100:.0f} %), but the gauges' noise alone makes that sum uncertain by "
+            f"{percent_text(mf.balance_log_sd)} % (1 sd, the pre-pulse noise's colour at its upper bound): a gain off by "
+            f"{abs(s - 1.0) * 100:.0f} % {NOISE_CANNOT_TELL}"))]
+    if off != "gauge":
+        return out
+    swapped = _swapped_balance(forces, apparatus, m)
+    if abs(swapped - 1.0) <= BALANCE_TOL:
+        return [GaugeFinding("internal_output_bar", "swapped", (
+            f"the output forces sum to {s * 100:.0f} % of the input force over the loading, and to "
+            f"{swapped * 100:.0f} % with /signals/internal_output_bar and /signals/external_output_bar exchanged: the two output channels "
+            "look swapped"))]
+    out.append(GaugeFinding("", "balance", (
+        f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
+        f"{BALANCE_TOL * 100:.0f} %; the gauges' noise, 1 sd: {percent_text(mf.balance_log_sd)} %): a gauge's gain, its "
+        f"strain_per_volt or a bar's modulus is off by about {abs(s - 1.0) * 100:.0f} %")))
+    return out
+
+
+def percent_text(x: float) -> str:
+    """A fraction as a percentage: whole numbers from 10 %, one decimal below."""
+    return f"{x * 100:.0f}" if x >= 0.1 else f"{x * 100:.1f}"
+
+
+def balance_departure(mf: MeanForces) -> str:
+    """How the output forces' sum departs from the input force (eq. 5): "" within :data:`BALANCE_TOL`; "noise" beyond
+    it but within :data:`NOISE_SIGMAS` times what the gauges' noise makes of log S (or with an input force not
+    positive, within its noise of zero); "gauge" beyond both (an output sum not positive against an input force
+    beyond its noise is a gauge's: off by 100 % or more)."""
+    if not mf.F_i > 0.0:
+        return "noise" if mf.F_i >= -NOISE_SIGMAS * mf.sd_i else ""  # below that, the input gauge is reversed
+    s = mf.balance
+    if abs(s - 1.0) <= BALANCE_TOL:
+        return ""
+    if s <= 0.0:
+        return "gauge" if mf.F_i > NOISE_SIGMAS * mf.sd_i else "noise"
+    return "gauge" if abs(math.log(s)) > NOISE_SIGMAS * mf.balance_log_sd else "noise"
+
+
+def _swapped_balance(forces: Forces, apparatus: Apparatus, m: np.ndarray) -> float:
+    """The force balance with the two output gauges' strains exchanged (each read on the other bar)."""
+    io, eo = apparatus.internal_output_bar, apparatus.external_output_bar
+    k_io, k_eo = io.area * io.young_modulus, eo.area * eo.young_modulus
+    F_io = forces.F_eo[m] / k_eo * k_io
+    F_eo = forces.F_io[m] / k_io * k_eo
+    return float(np.mean(F_io + F_eo) / np.mean(forces.F_i[m]))
