@@ -70,16 +70,24 @@ class MeanForces:
 
     @property
     def balance_log_sd(self) -> float:
-        """Noise standard deviation of log S (first order); inf when either side is 0."""
+        """Noise standard deviation of log S (first order); inf when either side is 0. For a channel's factor
+        (:meth:`rescaled_log_sd`), not for the balance's own test (:attr:`balance_sd`)."""
         out = self.F_io + self.F_eo
         if out == 0.0 or self.F_i == 0.0:
             return math.inf
         return math.sqrt((self.sd_io ** 2 + self.sd_eo ** 2) / out ** 2 + (self.sd_i / self.F_i) ** 2)
 
     @property
+    def imbalance_sd(self) -> float:
+        """Noise standard deviation (N) of F_io + F_eo - F_i (the three gauges' noises independent)."""
+        return math.sqrt(self.sd_i ** 2 + self.sd_io ** 2 + self.sd_eo ** 2)
+
+    @property
     def balance_sd(self) -> float:
-        """Noise standard deviation of S itself, |S| times :attr:`balance_log_sd` (inf when that is)."""
-        return abs(self.balance) * self.balance_log_sd if math.isfinite(self.balance_log_sd) else math.inf
+        """Noise standard deviation of S where eq. 5 holds: :attr:`imbalance_sd` over |F_i| (inf when F_i is 0). The
+        balance is weighed under the hypothesis it tests, so that an output sum near zero (dead output gauges) does
+        not take the huge relative noise of a small number, and S - 1 is judged the same on either side of 1."""
+        return self.imbalance_sd / abs(self.F_i) if self.F_i != 0.0 else math.inf
 
     def rescaled_log_sd(self, channel: str) -> float:
         """Noise standard deviation of the log of the factor that makes ``channel`` balance the others: F_i / (F_io +

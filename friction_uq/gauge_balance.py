@@ -23,7 +23,6 @@ is what stops the window.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -102,7 +101,7 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
         return [GaugeFinding("", "balance", (
             f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
             f"{BALANCE_TOL * 100:.0f} %), but the gauges' noise alone makes that sum uncertain by "
-            f"{percent_text(mf.balance_log_sd)} % (1 sd, the pre-pulse noise's colour at its upper bound): a gain off by "
+            f"{percent_text(mf.balance_sd)} % (1 sd, the pre-pulse noise's colour at its upper bound): a gain off by "
             f"{abs(s - 1.0) * 100:.0f} % {NOISE_CANNOT_TELL}"))]
     if off != "gauge":
         return out
@@ -114,7 +113,7 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
             "look swapped"))]
     out.append(GaugeFinding("", "balance", (
         f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
-        f"{BALANCE_TOL * 100:.0f} %; the gauges' noise, 1 sd: {percent_text(mf.balance_log_sd)} %): a gauge's gain, its "
+        f"{BALANCE_TOL * 100:.0f} %; the gauges' noise, 1 sd: {percent_text(mf.balance_sd)} %): a gauge's gain, its "
         f"strain_per_volt or a bar's modulus is off by about {abs(s - 1.0) * 100:.0f} %")))
     return out
 
@@ -126,17 +125,15 @@ def percent_text(x: float) -> str:
 
 def balance_departure(mf: MeanForces) -> str:
     """How the output forces' sum departs from the input force (eq. 5): "" within :data:`BALANCE_TOL`; "noise" beyond
-    it but within :data:`NOISE_SIGMAS` times what the gauges' noise makes of log S (or with an input force not
-    positive, within its noise of zero); "gauge" beyond both (an output sum not positive against an input force
-    beyond its noise is a gauge's: off by 100 % or more)."""
+    it but within :data:`NOISE_SIGMAS` times what the gauges' noise makes of S where eq. 5 holds
+    (:attr:`~friction_uq.force_noise.MeanForces.balance_sd`), or with an input force not positive but within its noise
+    of zero; "gauge" beyond both."""
     if not mf.F_i > 0.0:
         return "noise" if mf.F_i >= -NOISE_SIGMAS * mf.sd_i else ""  # below that, the input gauge is reversed
     s = mf.balance
     if abs(s - 1.0) <= BALANCE_TOL:
         return ""
-    if s <= 0.0:
-        return "gauge" if mf.F_i > NOISE_SIGMAS * mf.sd_i else "noise"
-    return "gauge" if abs(math.log(s)) > NOISE_SIGMAS * mf.balance_log_sd else "noise"
+    return "gauge" if abs(s - 1.0) > NOISE_SIGMAS * mf.balance_sd else "noise"
 
 
 def _swapped_balance(forces: Forces, apparatus: Apparatus, m: np.ndarray) -> float:

@@ -11,7 +11,7 @@ import numpy as np
 
 from .force_noise import mean_forces
 from .forces import Forces
-from .gauge_balance import GaugeFinding, force_balance, gauge_findings, loading_mask, percent_text
+from .gauge_balance import NOISE_SIGMAS, GaugeFinding, force_balance, gauge_findings, loading_mask, percent_text
 from .gauge_scale import gauge_and_speed, scale_findings
 from .record import Apparatus, Record
 
@@ -69,7 +69,7 @@ def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFi
         return [], [GaugeFinding("", "ok", (
             "not checked: neither the gauges' signs nor the output forces against the input force (no loading "
             "above half the input force's peak for 8 samples: a spike on the input bar?)"))] + found
-    noise = mean_forces(forces, record.apparatus, loading_mask(forces)).balance_log_sd
+    noise = mean_forces(forces, record.apparatus, loading_mask(forces)).balance_sd
     return [], [GaugeFinding("", "ok", (
         f"signs agree and the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5; the "
         f"gauges' noise, 1 sd: {percent_text(noise)} %)"))] + found
@@ -106,10 +106,11 @@ def hoop_findings(forces: Forces, apparatus: Apparatus, hoop_noise_sd: float) ->
             "compression-positive while the sample is pushed): the gauge looks reversed (a swelling tube reads "
             "positive, elongation positive)"))]
     s = apparatus.sample
-    sigma = float(np.mean(forces.F_io[m] + 0.5 * forces.F_eo[m])) / s.area
+    means = mean_forces(forces, apparatus, m)
+    sigma = (means.F_io + 0.5 * means.F_eo) / s.area
     lame = apparatus.tube.lame_hoop_strain_per_pressure
-    if sigma <= 0:
-        return []
+    if sigma <= NOISE_SIGMAS * math.hypot(means.sd_io, 0.5 * means.sd_eo) / s.area:
+        return []  # no axial stress beyond the output gauges' noise (dead output gauges): nothing to weigh it against
     k = -h / (lame * HOOP_KERNEL_MAX * sigma)
     if k > HOOP_K_MAX:
         return [GaugeFinding("tube_hoop", "scale", (

@@ -34,8 +34,8 @@ from .dispersion import propagate
 from .errors import ShortPreTrigger, SignalError
 from .stats.ar1 import ar1_mean_sd
 from .record.contract import HEAD_FRACTION
-from .record.saturation import digitiser_step
-from .stats.robust import SPIKE_FILTER, SPIKE_SIGMAS, despiked, median_and_sd, padding, running_median
+from .stats.robust import (SPIKE_FILTER, SPIKE_SIGMAS, despiked, median_and_sd, padding, quantisation_step,
+                           running_median)
 
 #: Threshold, in noise standard deviations, for the first crossing that starts an arrival search.
 ARRIVAL_SIGMAS = 8.0
@@ -93,8 +93,9 @@ class NoiseEstimate:
 
 def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate:
     """Offset, standard deviation and lag-1 autocorrelation of ``x[start:stop]``, its spikes left out
-    (:func:`friction_uq.stats.robust.despiked`); the standard deviation at least a quantised channel's rounding,
-    step / sqrt(12) (:func:`friction_uq.record.saturation.digitiser_step`).
+    (:func:`friction_uq.stats.robust.despiked`). When the channel is quantised
+    (:func:`~friction_uq.stats.robust.quantisation_step`) and the segment holds two values or fewer (its noise not
+    resolved), the standard deviation is at least the rounding's, step / sqrt(12).
 
     >>> rng = np.random.default_rng(1)
     >>> e = noise_estimate(3.0 + rng.normal(0, 2.0, 20000), stop=20000)
@@ -107,13 +108,14 @@ def noise_estimate(x: np.ndarray, *, start: int = 0, stop: int) -> NoiseEstimate
             f"the pre-pulse segment has {seg.size} samples, at least {MIN_BASELINE_SAMPLES} are needed "
             "to estimate the baseline and noise"
         )
-    step = digitiser_step(x)
+    step = quantisation_step(x)
     seg = despiked(seg, width=SPIKE_FILTER, sigmas=SPIKE_SIGMAS, step=step)
     offset = float(seg.mean())
     d = seg - offset
     var = float(np.mean(d * d))
-    # a baseline on one code has no spread of its own, but a wave read through many codes carries the rounding
-    sd = max(float(np.sqrt(var * seg.size / (seg.size - 1))), step / math.sqrt(12.0))
+    sd = float(np.sqrt(var * seg.size / (seg.size - 1)))
+    if step > 0.0 and np.unique(seg).size <= 2:  # noise not resolved: a wave read through many codes carries the rounding
+        sd = max(sd, step / math.sqrt(12.0))
     rho = float(np.sum(d[1:] * d[:-1]) / (var * seg.size)) if var > 0 else 0.0
     rho = float(np.clip(rho, -0.99, 0.99))
     tau = integrated_autocorrelation(d)
@@ -286,7 +288,7 @@ def baseline_free(x: np.ndarray, noise: NoiseEstimate) -> np.ndarray:
     front is no wave) and zero before the segment's start (an unfilled pre-trigger is no wave either)."""
     x = np.asarray(x, dtype=float)
     seg = x[noise.start:noise.stop]
-    clean = despiked(seg, step=digitiser_step(x))
+    clean = despiked(seg, step=quantisation_step(x))
     if clean is not seg and not np.array_equal(clean, seg):
         x = np.concatenate([x[:noise.start], clean, x[noise.stop:]])
     return np.where(np.arange(x.size) >= noise.start, x - noise.offset, 0.0)

@@ -13,9 +13,9 @@ import pytest
 from scipy.signal import lfilter
 
 from friction_uq.analysis import RATIO_WINDOW_NOTE, identify, prepare
-from friction_uq.force_noise import COLOUR_CEILING, MeanForces, colour_upper, wave_mean_sd
+from friction_uq.force_noise import COLOUR_CEILING, MeanForces, colour_upper, mean_forces, wave_mean_sd
 from friction_uq.diagnostics import VariableSummary
-from friction_uq.gauge_balance import NOISE_CANNOT_TELL, NOISE_SIGMAS, balance_departure
+from friction_uq.gauge_balance import NOISE_CANNOT_TELL, NOISE_SIGMAS, balance_departure, loading_mask
 from friction_uq.gauge_check import record_gauge_check
 from friction_uq.record_run.warnings import equilibrium_warning, gauge_warning
 from friction_uq.record import read_record
@@ -122,8 +122,12 @@ def test_a_window_found_from_the_ratio_alone_blames_no_gauge_when_none_is() -> N
 
 
 @pytest.mark.parametrize(("means", "said"), [
-    (MeanForces(1000.0, 300.0, 0.0, 450.0, 10.0, 10.0), "noise"),  # S = 0.3, log sd 0.45: within 3 sd
-    (MeanForces(1000.0, 3000.0, 0.0, 10.0, 1000.0, 10.0), "gauge"),  # S = 3, log sd 0.33: beyond
+    (MeanForces(1000.0, 300.0, 0.0, 450.0, 10.0, 10.0), "noise"),  # S = 0.3, its sd 0.45: within 3 sd
+    (MeanForces(1000.0, 3000.0, 0.0, 10.0, 500.0, 10.0), "gauge"),  # S = 3, its sd 0.5: beyond
+    (MeanForces(1000.0, 700.0, 0.0, 90.0, 40.0, 10.0), "gauge"),  # S = 0.7 and 1.3, sd 0.099: the same either side
+    (MeanForces(1000.0, 1300.0, 0.0, 90.0, 40.0, 10.0), "gauge"),
+    (MeanForces(1000.0, 700.0, 0.0, 100.0, 40.0, 10.0), "noise"),  # ... and sd 0.108
+    (MeanForces(1000.0, 1300.0, 0.0, 100.0, 40.0, 10.0), "noise"),
     (MeanForces(1000.0, 980.0, 0.0, 10.0, 10.0, 10.0), ""),  # within 5 %
     (MeanForces(1000.0, -20.0, 10.0, 50.0, 30.0, 30.0), "gauge"),  # outputs read nothing against a load beyond noise
     (MeanForces(1000.0, -20.0, 10.0, 500.0, 30.0, 30.0), "noise"),  # ... against a load within its noise
@@ -138,43 +142,34 @@ def test_balance_departure(means: MeanForces, said: str) -> None:
     assert means.balance_sd >= 0.0 or math.isnan(means.balance_sd)
 
 
-def test_dead_output_gauges_are_not_a_sound_balance(tmp_path: Path) -> None:
+@pytest.mark.parametrize("seed", range(6))
+def test_dead_output_gauges_are_not_a_sound_balance(tmp_path: Path, seed: int) -> None:
     """Both output channels only their pre-trigger noise: the outputs sum to about 0 % of the input force. Said as a
-    gauge's fault (a reviewer found it said as "signs agree" once the balance was weighed in logs)."""
+    gauge's fault whatever the noise draws (weighed in log S, a sum slightly above 0 took a huge relative noise and
+    was said "cannot be told from the gauges' noise" on 19 of 40 draws), and the hoop gauge, with no axial stress
+    beyond the output gauges' noise to weigh it against, not blamed."""
     path = tmp_path / "dead.h5"
     shutil.copyfile(A03, path)
-    rng = np.random.default_rng(0)
+    rng = np.random.default_rng(seed)
     with h5py.File(path, "r+") as fh:
         for name in ("internal_output_bar", "external_output_bar"):
             ds = fh["signals"][name]
             x = ds[()].astype(float)
             ds[...] = np.median(x[:200]) + np.std(x[:200]) * rng.normal(size=x.size)
     faults, notes = record_gauge_check(read_record(path))
-    said = faults + notes
-    assert not any(n.kind == "ok" for n in said)
-    assert any(n.kind == "balance" and "is off by about" in n.sentence for n in said)
+    assert faults == []
+    assert any(n.kind == "balance" and "is off by about" in n.sentence for n in notes)
 
 
-def a03_scaled(tmp_path: Path, channel: str, factor: float) -> Path:
-    """A-03 with ``channel`` read ``factor`` times what it carried (its noise as recorded, nearly white)."""
-    path = tmp_path / "scaled.h5"
-    shutil.copyfile(A03, path)
-    with h5py.File(path, "r+") as fh:
-        ds = fh["signals"][channel]
-        ds[...] = factor * ds[()]
-    return path
-
-
-def test_a_gain_beyond_the_noise_is_still_blamed(tmp_path: Path) -> None:
-    """A-03's internal bar read 0.85 times what it carried: a gauge blamed, as before."""
-    prep = prepare(read_record(a03_scaled(tmp_path, "internal_output_bar", 0.85)))
-    assert prep.gauge_notes and "is off by about" in prep.gauge_notes[0]
-    f = VariableSummary(mean=0.048, sd=0.002, q05=0.045, q50=0.048, q95=0.051, r_hat=1.0, ess_bulk=4000.0)
-    assert gauge_warning(prep.gauge_notes, f).startswith("A gauge disagrees with the others")
-
-
-def test_a_gauge_off_by_a_factor_is_still_named_under_white_noise(tmp_path: Path) -> None:
-    """A-03's external bar read 10 times what it carried: named, as before."""
-    faults, _ = record_gauge_check(read_record(a03_scaled(tmp_path, "external_output_bar", 10.0)))
-    assert [(g.channel, g.kind) for g in faults] == [("external_output_bar", "scale")]
-    assert "9.04 times too large" in faults[0].sentence
+def test_the_input_force_takes_its_gauges_offset_twice() -> None:
+    """F_i = E A (eps_i + eps_r): its mean's noise is the input gauge's for two waves and twice its offset's error (the
+    pins on the wiring; the formula itself is tested on simulated noise above)."""
+    rec = read_record(A03)
+    forces = prepare(rec).forces
+    m = loading_mask(forces)
+    means = mean_forces(forces, rec.apparatus, m)
+    noise, bar = forces.channels["incident"].noise, rec.apparatus.input_bar
+    two = bar.area * bar.young_modulus * wave_mean_sd(noise.sd, colour_upper(noise), int(m.sum()), noise.n, waves=2)
+    assert means.sd_i == pytest.approx(two, rel=1e-12)
+    assert means.sd_i > 1.5 * bar.area * bar.young_modulus * wave_mean_sd(noise.sd, colour_upper(noise), int(m.sum()),
+                                                                           noise.n)

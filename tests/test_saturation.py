@@ -17,6 +17,7 @@ from friction_uq.analysis import prepare
 from friction_uq.errors import RecordError
 from friction_uq.record import CLIP_RUN, read_record
 from friction_uq.record.saturation import digitiser_step, flat_run, noise_sd, run_needed
+from friction_uq.stats.robust import quantisation_step
 
 A03 = Path(__file__).parents[1] / "data" / "A" / "A-03.h5"
 
@@ -163,7 +164,7 @@ def test_a_pre_trigger_on_one_code_is_read(tmp_path: Path) -> None:
     strain = rec.strain("internal_output_bar")
     noise = prepare(rec).forces.channels["internal_output_bar"].noise
     assert np.ptp(strain[noise.start:noise.stop]) == 0.0  # one code
-    assert noise.sd == pytest.approx(digitiser_step(strain) / math.sqrt(12.0), rel=1e-9)
+    assert noise.sd == pytest.approx(quantisation_step(strain) / math.sqrt(12.0), rel=1e-9)
     raw_step = digitiser_step(h5py.File(path)["signals"]["internal_output_bar"][()].astype(float))
     (tmp_path / "spiked").mkdir()
     spiked = a03_with(tmp_path / "spiked", "internal_output_bar",

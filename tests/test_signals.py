@@ -1,5 +1,7 @@
 """Generic signal code: noise, arrivals, transport. Closed forms and property tests."""
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -8,7 +10,7 @@ from hypothesis import strategies as st
 from friction_uq.errors import ShortPreTrigger, SignalError
 from friction_uq.signals import (SPIKE_FILTER, SPIKE_SIGMAS, baseline_free, noise_estimate, padding, prepulse_noise,
                                  pulse_arrival, transport)
-from friction_uq.stats.robust import despiked
+from friction_uq.stats.robust import despiked, quantisation_step
 from friction_uq.noise import white_and_ar1_noise
 
 FS = 5e6
@@ -336,8 +338,32 @@ def test_a_spike_on_a_baseline_on_one_code_is_left_out(coarse):
 
 
 def test_flickers_of_one_code_are_noise_not_spikes():
-    """Noise of a tenth of a step on one code flickers to the next code now and then: kept, bit for bit."""
-    rng = np.random.default_rng(6)
-    x = np.round(0.2 + rng.normal(0.0, 0.1, 4000))  # 3 sd below the next code: a flicker in ~700 samples
-    assert 0 < np.count_nonzero(x != np.median(x)) < 2 * SPIKE_FILTER
-    assert np.array_equal(despiked(x, step=1.0), x)
+    """A baseline on one code but for two flickers to the next code and a 2-sample spike of 13 codes: the spike's
+    samples are half of those that leave their running median, so without the one-step cap on the scale they set it
+    and stay; with a cap below a step's 1 / 11.9 the flickers would go too. The spike goes, the flickers stay."""
+    x = np.zeros(4000)
+    x[[700, 2900]] = 1.0  # flickers
+    x[1500:1502] = 13.0  # the spike
+    out = despiked(x, step=1.0)
+    assert np.all(out[1500:1502] == 0.0)
+    assert out[700] == 1.0 and out[2900] == 1.0
+    assert np.array_equal(despiked(x), x)  # without the step, nothing tells the spike from the noise
+
+
+@pytest.mark.parametrize(("bits", "codes"), [(8, 0.3), (12, 1.0), (14, 2.0), (16, 3.0)])
+@pytest.mark.parametrize("offset", [0.0, 0.37])
+def test_the_quantisation_step_is_the_lattice_s(bits, codes, offset):
+    """A wave read at 8-16 bits with noise of 0.3-3 codes, stored in float32 after a scale and an offset: the step is
+    the code's, within float32's rounding (the median gap between distinct values, 9-120 codes on such records, once
+    set a noise floor 3-30 times the noise); continuous data sit on no lattice."""
+    rng = np.random.default_rng(bits)
+    t = np.arange(20000)
+    wave = np.convolve(np.where((t > 5000) & (t < 12000), 0.8, 0.0), np.ones(200) / 200, mode="same")
+    step = 2.0 / 2**bits
+    x = np.round((wave + rng.normal(0.0, codes * step, t.size)) / step) * step
+    stored = ((x + offset) * 1.234e-4).astype(np.float32).astype(float)
+    assert quantisation_step(stored) == pytest.approx(step * 1.234e-4, rel=2e-4)
+    assert quantisation_step(wave + rng.normal(0.0, 1e-3, t.size)) == 0.0
+    e = noise_estimate(stored, stop=4000)  # the noise as it is, rounding and all: no floor on resolved noise
+    unit = step * 1.234e-4
+    assert 0.8 * codes * unit < e.sd < 1.25 * math.sqrt(codes ** 2 + 1.0 / 12.0) * unit

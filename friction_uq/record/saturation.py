@@ -30,7 +30,7 @@ import numpy as np
 from scipy import stats
 from scipy.special import erf
 
-from ..stats.robust import despiked, longest_true_run, median_and_sd, padding
+from ..stats.robust import despiked, longest_true_run, median_and_sd, padding, quantisation_step
 from .contract import CLIP_RUN, HEAD_FRACTION, MIN_HEAD_SAMPLES
 
 #: Chance, at most, that the noise alone leaves a run of equal samples as long as one called saturated.
@@ -109,7 +109,7 @@ def pre_trigger(x: np.ndarray) -> np.ndarray:
     swing = float(np.max(np.abs(x - med)))
     off = np.flatnonzero(np.abs(x[:n0] - med) > 0.1 * swing)
     head = x[: max(MIN_HEAD_SAMPLES, int(off[0]) if off.size else n0)]
-    return despiked(head, step=digitiser_step(x))
+    return despiked(head, step=quantisation_step(x))
 
 
 def flat_run(x: np.ndarray) -> FlatRun | None:

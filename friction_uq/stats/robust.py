@@ -61,6 +61,34 @@ def despiked(seg: np.ndarray, *, width: int = SPIKE_FILTER, sigmas: float = SPIK
     return np.where(spikes, running, seg) if spikes.any() else seg
 
 
+#: Share of a channel's gaps between neighbouring distinct values that must be whole multiples of the smallest for
+#: the channel to be read as quantised (continuous data: about a tenth by chance).
+LATTICE_SHARE = 0.9
+#: How far from a whole multiple a gap may be (in steps): float32 storage rounds a value 2**15 steps from 0 by 0.002.
+LATTICE_SLACK = 0.02
+
+
+def quantisation_step(x: np.ndarray) -> float:
+    """The step of the lattice a channel's values sit on (a digitiser's code, scaled to strain), or 0 when they sit on
+    none (continuous, resampled or filtered data).
+
+    The step is the mean of the gaps between neighbouring distinct values that are within :data:`LATTICE_SLACK` of
+    the smallest gap, and the values are on a lattice when :data:`LATTICE_SHARE` of all gaps are whole multiples of it.
+    The median gap overstates the step of a resolved channel several times: a wave crosses many codes in few samples,
+    and most distinct values are its.
+    """
+    v = np.unique(np.asarray(x, dtype=float))
+    v = v[np.isfinite(v)]
+    if v.size < 3:
+        return 0.0
+    gaps = np.diff(v)
+    unit = gaps[gaps <= gaps.min() * (1.0 + LATTICE_SLACK)]
+    step = float(unit.mean())
+    k = gaps / step
+    on = np.abs(k - np.round(k)) <= LATTICE_SLACK
+    return step if float(on.mean()) >= LATTICE_SHARE else 0.0
+
+
 #: Fewest leading samples, all equal to the first, that can be padding rather than a baseline on one code.
 PADDING_MIN = 8
 #: Samples after the padding that must look like noise.
