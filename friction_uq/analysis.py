@@ -75,7 +75,8 @@ def prepare(
 
 
 #: The note said when the window was found from the force ratio alone (the warnings tell it from a gauge's finding).
-RATIO_WINDOW_NOTE = "the window was found from the force ratio alone: the sample's ends do not move together by the gauges (eq. 6)"
+RATIO_WINDOW_NOTE = ("the window was found from the force ratio alone: the sample's ends do not move together by "
+                     "the gauges (eq. 6)")
 
 
 def _automatic_window(record: Record, forces, criterion: WindowCriterion,

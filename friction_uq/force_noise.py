@@ -1,6 +1,6 @@
 """What the gauges' electrical noise alone leaves in the bar forces' means over a span (eq. 2-4), for the checks
-that compare those means: the force balance (eq. 5) and a channel's scale (:mod:`friction_uq.gauge_balance`, :mod:`friction_uq.gauge_scale`), the
-equilibrium over the window (:func:`friction_uq.analysis.identify`).
+that compare those means: the force balance (eq. 5) and a channel's scale (:mod:`friction_uq.gauge_balance`,
+:mod:`friction_uq.gauge_scale`), the equilibrium over the window (:func:`friction_uq.analysis.identify`).
 
 A mean over ``n`` samples of an offset-corrected wave carries the noise of its samples and the error of the offset
 removed from its channel, constant over the span. The input force F_i = E A (eps_i + eps_r) holds two waves of the

@@ -94,8 +94,8 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
     s = mf.balance
     if off == "noise" and not mf.F_i > 0.0:
         return [GaugeFinding("", "balance", (
-            f"the input force over the loading, {mf.F_i:.0f} N, is within its noise of zero (1 sd: {mf.sd_i:.0f} N, the "
-            f"pre-pulse noise's colour at its upper bound): the output forces' sum against it (eq. 5) "
+            f"the input force over the loading, {mf.F_i:.0f} N, is within its noise of zero (1 sd: {mf.sd_i:.0f} N, "
+            f"the pre-pulse noise's colour at its upper bound): the output forces' sum against it (eq. 5) "
             f"{NOISE_CANNOT_TELL}"))]
     if off == "noise":  # beyond the tolerance, within what the noise makes of it: said, no gauge blamed
         return [GaugeFinding("", "balance", (
@@ -109,7 +109,8 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
     if abs(swapped - 1.0) <= BALANCE_TOL:
         return [GaugeFinding("internal_output_bar", "swapped", (
             f"the output forces sum to {s * 100:.0f} % of the input force over the loading, and to "
-            f"{swapped * 100:.0f} % with /signals/internal_output_bar and /signals/external_output_bar exchanged: the two output channels "
+            f"{swapped * 100:.0f} % with /signals/internal_output_bar and /signals/external_output_bar exchanged: the "
+            "two output channels "
             "look swapped"))]
     out.append(GaugeFinding("", "balance", (
         f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "

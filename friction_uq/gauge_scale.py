@@ -97,7 +97,7 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *,
         own, own_sd = {"input_bar": (Fi, mf.sd_i), "internal_output_bar": (Fio, mf.sd_io),
                        "external_output_bar": (Feo, mf.sd_eo)}[channel]
         if own <= NOISE_SIGMAS * own_sd:
-            return False  # a channel that reads nothing beyond its noise is dead, not off by a factor: the balance says so
+            return False  # a channel reading nothing beyond its noise is dead, not off by a factor: the balance says so
         return abs(math.log(ok[channel])) > max(math.log(SCALE_FACTOR), NOISE_SIGMAS * mf.rescaled_log_sd(channel))
 
     if set(ok) == {"input_bar", "internal_output_bar"} and all(beyond(c) for c in ok):
