@@ -70,7 +70,9 @@ def force_balance(forces: Forces) -> float:
 
 
 def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
-    """Reversed output or input gauges and a force balance off by more than :data:`BALANCE_TOL`."""
+    """Reversed output or input gauges (a mean force beyond :data:`NOISE_SIGMAS` of its noise on the wrong side of zero),
+    swapped output channels, and a force balance off by more than :data:`BALANCE_TOL`: blamed on a gauge beyond the
+    gauges' noise, said as a balance the record cannot check within it (:func:`balance_departure`)."""
     m = loading_mask(forces)
     n = int(m.sum())
     if n < 8:
@@ -110,8 +112,7 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
         return [GaugeFinding("internal_output_bar", "swapped", (
             f"the output forces sum to {s * 100:.0f} % of the input force over the loading, and to "
             f"{swapped * 100:.0f} % with /signals/internal_output_bar and /signals/external_output_bar exchanged: the "
-            "two output channels "
-            "look swapped"))]
+            "two output channels look swapped"))]
     out.append(GaugeFinding("", "balance", (
         f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
         f"{BALANCE_TOL * 100:.0f} %; the gauges' noise, 1 sd: {percent_text(mf.balance_sd)} %): a gauge's gain, its "
