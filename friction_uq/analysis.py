@@ -135,8 +135,12 @@ class Identification:
     stationarity_error: float
     time: np.ndarray
     f_series: np.ndarray
-    equilibrium_sd: float = 0.0  # the gauges' noise in equilibrium_error
     means: MeanForces | None = None  # the forces' means over the window and their noise (the equilibrium's check)
+
+    @property
+    def equilibrium_sd(self) -> float:
+        """The gauges' noise in :attr:`equilibrium_error` (:attr:`MeanForces.balance_sd`); 0 without the means."""
+        return self.means.balance_sd if self.means is not None else 0.0
 
     def series_json(self, *, points: int = 50) -> dict:
         """f(t) over the window, decimated to about ``points`` values (it is smoothed over 10 us)."""
@@ -209,7 +213,6 @@ def identify(prepared: Prepared, *, nu: float) -> Identification:
         F_io=F_io,
         F_eo=F_eo,
         equilibrium_error=1.0 - means.balance,
-        equilibrium_sd=means.balance_sd,
         means=means,
         stationarity_error=1.0 - float(np.mean(fo.V_io[seg])) / float(np.mean(fo.V_i[seg])),
         time=np.array(fo.time[seg]),

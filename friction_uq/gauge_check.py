@@ -11,7 +11,7 @@ import numpy as np
 
 from .force_noise import mean_forces
 from .forces import Forces
-from .gauge_balance import NOISE_SIGMAS, GaugeFinding, force_balance, gauge_findings, loading_mask, percent_text
+from .gauge_balance import NOISE_SIGMAS, GaugeFinding, gauge_findings, loading_mask, percent_text
 from .gauge_scale import gauge_and_speed, scale_findings
 from .record import Apparatus, Record
 
@@ -64,12 +64,13 @@ def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFi
     found += [GaugeFinding("", "flat", note) for note in flat_run_notes(record)]
     if any(g.kind == "balance" for g in found):  # the balance said with its finding
         return [], found
-    s = force_balance(forces)
-    if not np.isfinite(s):  # no loading to weigh (a spike as the input bar's peak): nothing was checked
+    m = loading_mask(forces)
+    if m.sum() < 8:  # no loading to weigh (a spike as the input bar's peak): nothing was checked
         return [], [GaugeFinding("", "ok", (
             "not checked: neither the gauges' signs nor the output forces against the input force (no loading "
             "above half the input force's peak for 8 samples: a spike on the input bar?)"))] + found
-    noise = mean_forces(forces, record.apparatus, loading_mask(forces)).balance_sd
+    means = mean_forces(forces, record.apparatus, m)
+    s, noise = means.balance, means.balance_sd
     return [], [GaugeFinding("", "ok", (
         f"signs agree and the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5; the "
         f"gauges' noise, 1 sd: {percent_text(noise)} %)"))] + found
