@@ -14,8 +14,8 @@ from .force_noise import MeanForces, mean_forces
 from .forces import Forces, compute_forces
 from .physics import cell
 from .errors import NoStationaryPhase, SignalError
-from .gauge_balance import NOISE_CANNOT_TELL, NOISE_SIGMAS, gauge_findings
-from .gauge_check import flat_run_notes
+from .gauge_balance import NOISE_SIGMAS, GaugeFinding, gauge_findings
+from .gauge_check import flat_run_findings
 from .gauge_scale import gauge_and_speed, scale_findings
 from .record import Record
 from .signals import moving_average
@@ -37,9 +37,28 @@ class Prepared:
     forces: Forces
     window: Window
     data: StationaryData
-    gauge_notes: tuple[str, ...] = ()  # what the gauge check found (friction_uq.gauge_check), for the warnings
-    flat_runs: tuple[str, ...] = ()  # peaks on one value that may be a saturated digitiser (gauge_check.flat_run_notes)
-    speed_notes: tuple[str, ...] = ()  # an incident wave at odds with striker_velocity while the gauges agree
+    #: What the gauge checks found, each with its kind (:class:`~friction_uq.gauge_balance.GaugeFinding`): a gauge's
+    #: balance or scale, a balance the noise leaves unchecked, the window found from the ratio alone ("window"), a
+    #: peak on one value that may be a saturated digitiser ("flat"), the striker's recorded speed ("striker").
+    findings: tuple[GaugeFinding, ...] = ()
+
+    def _said(self, keep) -> tuple[str, ...]:
+        return tuple(g.sentence for g in self.findings if keep(g.kind))
+
+    @property
+    def gauge_notes(self) -> tuple[str, ...]:
+        """The sentences of the gauges' balance and scale, and of the window they left (not "flat" nor "striker")."""
+        return self._said(lambda kind: kind not in ("flat", "striker"))
+
+    @property
+    def flat_runs(self) -> tuple[str, ...]:
+        """The sentences of peaks on one value that may be a saturated digitiser."""
+        return self._said(lambda kind: kind == "flat")
+
+    @property
+    def speed_notes(self) -> tuple[str, ...]:
+        """The sentence of an incident wave at odds with striker_velocity while the gauges agree."""
+        return self._said(lambda kind: kind == "striker")
 
 
 def prepare(
@@ -58,7 +77,7 @@ def prepare(
     # a channel's scale off by a factor (a gauge factor, a unit: eq. 5, 6 and 14) leaves f's ratio as it is when every
     # channel shares it, but not the forces, the pressure and the velocity: said, as the balance's notes are
     scaled, speed = gauge_and_speed(scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity))
-    notes = tuple(g.sentence for g in findings + scaled)
+    notes = tuple(findings + scaled)
     if window is None:
         win, notes = _automatic_window(record, forces, criterion, notes)
     else:
@@ -71,16 +90,16 @@ def prepare(
         striker_velocity=record.striker_velocity,
     )
     _check_polarity(record, forces, win)
-    return Prepared(record, forces, win, data, notes, flat_run_notes(record), tuple(g.sentence for g in speed))
+    return Prepared(record, forces, win, data, notes + flat_run_findings(record) + tuple(speed))
 
 
-#: The note said when the window was found from the force ratio alone (the warnings tell it from a gauge's finding).
+#: The note said when the window was found from the force ratio alone (a finding of kind "window").
 RATIO_WINDOW_NOTE = ("the window was found from the force ratio alone: the sample's ends do not move together by "
                      "the gauges (eq. 6)")
 
 
 def _automatic_window(record: Record, forces, criterion: WindowCriterion,
-                      notes: tuple[str, ...]) -> tuple[Window, tuple[str, ...]]:
+                      notes: tuple[GaugeFinding, ...]) -> tuple[Window, tuple[GaugeFinding, ...]]:
     """The automatic window; when a gauge's balance is off, found without the ends' velocities (which
     the suspect gauge enters) rather than refused as "no stationary phase"; every refusal names the file."""
     try:
@@ -91,9 +110,10 @@ def _automatic_window(record: Record, forces, criterion: WindowCriterion,
         try:
             win = find_stationary_window(forces, record.apparatus, criterion, velocity=False)
         except NoStationaryPhase:
-            raise NoStationaryPhase(f"{record.path}: {notes[0]}; no stationary phase either way: {exc}") from None
-    suspect = "" if all(n.endswith(NOISE_CANNOT_TELL) for n in notes) else ", as the suspect gauge makes them"
-    return win, notes + (RATIO_WINDOW_NOTE + suspect,)
+            raise NoStationaryPhase(
+                f"{record.path}: {notes[0].sentence}; no stationary phase either way: {exc}") from None
+    suspect = "" if all(g.kind == "unchecked" for g in notes) else ", as the suspect gauge makes them"
+    return win, notes + (GaugeFinding("", "window", RATIO_WINDOW_NOTE + suspect),)
 
 
 def _check_polarity(record: Record, forces: Forces, win: Window) -> None:

@@ -37,15 +37,17 @@ BALANCE_TOL = 0.05
 LOADED_FRACTION = 0.5
 #: A mean force below zero, a balance or a channel's factor off, is the gauges' only beyond this many noise sd.
 NOISE_SIGMAS = 3.0
-#: How a balance note ends when the gauges' noise could make the imbalance (the warnings tell it by this).
+#: How a balance note ends when the gauges' noise could make the imbalance (its finding's kind: "unchecked").
 NOISE_CANNOT_TELL = "cannot be told from the gauges' noise"
 
 
 @dataclass(frozen=True)
 class GaugeFinding:
-    """One finding: the channel suspected (or "" when the evidence cannot say which), the kind ("reversed",
-    "swapped", "balance", "scale", "hoop", "signal"; notes: "striker" for a striker speed at odds with gauges
-    that agree, "flat" for a peak on one value, "ok" for the checks passed) and a sentence with the evidence."""
+    """One finding: the channel suspected (or "" when the evidence cannot say which), the kind and a sentence with
+    the evidence. Kinds that blame a gauge: "reversed", "swapped", "balance" (a gain off beyond the gauges' noise),
+    "scale", "hoop", "signal". Kinds that blame none: "unchecked" (a balance off by more than its tolerance that the
+    gauges' noise could make), "window" (the window found from the force ratio alone), "striker" (a striker speed
+    at odds with gauges that agree), "flat" (a peak on one value), "ok" (the checks passed)."""
 
     channel: str
     kind: str
@@ -95,12 +97,12 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
     off = balance_departure(mf)
     s = mf.balance
     if off == "noise" and not mf.F_i > 0.0:
-        return [GaugeFinding("", "balance", (
+        return [GaugeFinding("", "unchecked", (
             f"the input force over the loading, {mf.F_i:.0f} N, is within its noise of zero (1 sd: {mf.sd_i:.0f} N, "
             f"the pre-pulse noise's colour at its upper bound): the output forces' sum against it (eq. 5) "
             f"{NOISE_CANNOT_TELL}"))]
     if off == "noise":  # beyond the tolerance, within what the noise makes of it: said, no gauge blamed
-        return [GaugeFinding("", "balance", (
+        return [GaugeFinding("", "unchecked", (
             f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
             f"{BALANCE_TOL * 100:.0f} %), but the gauges' noise alone makes that sum uncertain by "
             f"{percent_text(mf.balance_sd)} % (1 sd, the pre-pulse noise's colour at its upper bound): a gain off by "

@@ -16,9 +16,10 @@ from .gauge_scale import gauge_and_speed, scale_findings
 from .record import Apparatus, Record
 
 
-def flat_run_notes(record: Record) -> tuple[str, ...]:
+def flat_run_findings(record: Record) -> tuple[GaugeFinding, ...]:
     """Channels whose peak sits on one value for a run their pre-trigger noise cannot tell from a saturated digitiser
-    (:mod:`friction_uq.record.saturation`; the reader refuses the runs it can tell): one sentence each."""
+    (:mod:`friction_uq.record.saturation`; the reader refuses the runs it can tell): one finding of kind "flat"
+    each."""
     from .record.saturation import flat_run
 
     notes = []
@@ -29,9 +30,10 @@ def flat_run_notes(record: Record) -> tuple[str, ...]:
         noise = ("is not resolved (its pre-trigger holds two values or fewer)" if math.isinf(run.needed) else
                  f"({run.noise_steps:.1f} digitiser steps) leaves runs that long on one code by chance (one "
                  f"of {run.needed:.0f} would not be)")
-        notes.append(f"/signals/{name} sits on one value for {run.run} consecutive samples at its peak, and its noise "
-                     f"{noise}: a plateau on one digitiser code cannot be told from a saturated digitiser there; if "
-                     "the scope's range ends at that value, the channel is clipped")
+        notes.append(GaugeFinding(name, "flat", (
+            f"/signals/{name} sits on one value for {run.run} consecutive samples at its peak, and its noise {noise}: "
+            "a plateau on one digitiser code cannot be told from a saturated digitiser there; if the scope's range "
+            "ends at that value, the channel is clipped")))
     return tuple(notes)
 
 
@@ -61,8 +63,8 @@ def record_gauge_check(record: Record) -> tuple[list[GaugeFinding], list[GaugeFi
         faults += hoop_findings(forces, record.apparatus, forces.channels["tube_hoop"].noise.sd)
     if faults:
         return faults, []
-    found += [GaugeFinding("", "flat", note) for note in flat_run_notes(record)]
-    if any(g.kind == "balance" for g in found):  # the balance said with its finding
+    found += flat_run_findings(record)
+    if any(g.kind in ("balance", "unchecked") for g in found):  # the balance said with its finding
         return [], found
     m = loading_mask(forces)
     if m.sum() < 8:  # no loading to weigh (a spike as the input bar's peak): nothing was checked

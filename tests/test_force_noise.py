@@ -3,6 +3,7 @@ balance against it: strongly coloured noise on a short pre-trigger is not a gaug
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import shutil
 from pathlib import Path
@@ -15,7 +16,7 @@ from scipy.signal import lfilter
 from friction_uq.analysis import RATIO_WINDOW_NOTE, identify, prepare
 from friction_uq.force_noise import COLOUR_CEILING, MeanForces, colour_upper, mean_forces, wave_mean_sd
 from friction_uq.diagnostics import VariableSummary
-from friction_uq.gauge_balance import NOISE_CANNOT_TELL, NOISE_SIGMAS, balance_departure, loading_mask
+from friction_uq.gauge_balance import NOISE_CANNOT_TELL, NOISE_SIGMAS, GaugeFinding, balance_departure, loading_mask
 from friction_uq.gauge_check import record_gauge_check
 from friction_uq.record_run.warnings import equilibrium_warning, gauge_warning
 from friction_uq.record import read_record
@@ -94,13 +95,13 @@ def test_coloured_noise_is_not_a_gauge_fault(tmp_path: Path) -> None:
     rec = read_record(a03_coloured(tmp_path, rho=0.99, level=0.03, seed=9))
     faults, notes = record_gauge_check(rec)
     assert faults == []
-    assert [n.kind for n in notes] == ["balance"] and notes[0].sentence.endswith(NOISE_CANNOT_TELL)
+    assert [n.kind for n in notes] == ["unchecked"] and notes[0].sentence.endswith(NOISE_CANNOT_TELL)
     prep = prepare(rec)
-    assert prep.gauge_notes and prep.gauge_notes[0].endswith(NOISE_CANNOT_TELL)
+    assert [g.kind for g in prep.findings] == ["unchecked"] and prep.gauge_notes[0].endswith(NOISE_CANNOT_TELL)
     lab = identify(prep, nu=0.4)
     assert abs(lab.equilibrium_error) < NOISE_SIGMAS * lab.equilibrium_sd
     f = VariableSummary(mean=0.048, sd=0.002, q05=0.045, q50=0.048, q95=0.051, r_hat=1.0, ess_bulk=4000.0)
-    assert gauge_warning(prep.gauge_notes, f).startswith("The force balance cannot check the gauges on this record")
+    assert gauge_warning(prep.findings, f).startswith("The force balance cannot check the gauges on this record")
     assert equilibrium_warning(lab, f) is None
     # nor is the recorded speed told from the input gauge's scale by such a balance: a note, neither blamed
     with h5py.File(rec.path, "r+") as fh:
@@ -112,13 +113,20 @@ def test_coloured_noise_is_not_a_gauge_fault(tmp_path: Path) -> None:
 
 def test_a_window_found_from_the_ratio_alone_blames_no_gauge_when_none_is() -> None:
     """The note that the window was found from the force ratio alone follows the balance's; with a balance the noise
-    could make, it names no suspect gauge, and the warning stays the noise's (it once read "A gauge disagrees")."""
-    noise_note = f"the output forces sum to 74 % ...: a gain off by 26 % {NOISE_CANNOT_TELL}"
+    could make, it names no suspect gauge, and the warning stays the noise's (it once read "A gauge disagrees"). The
+    warning reads the findings' kinds, not their words: a gauge blamed in a sentence that happens to end like the
+    noise's is still a gauge blamed."""
+    unchecked = GaugeFinding("", "unchecked", f"the output forces sum to 74 % ...: a gain off by 26 % "
+                                              f"{NOISE_CANNOT_TELL}")
+    window = GaugeFinding("", "window", RATIO_WINDOW_NOTE)
     f = VariableSummary(mean=0.048, sd=0.002, q05=0.045, q50=0.048, q95=0.051, r_hat=1.0, ess_bulk=4000.0)
-    notes = (noise_note, RATIO_WINDOW_NOTE)
-    assert gauge_warning(notes, f).startswith("The force balance cannot check the gauges on this record")
-    assert gauge_warning(("a gauge's gain ... is off by about 15 %", RATIO_WINDOW_NOTE + ", as the suspect gauge makes "
-                          "them"), f).startswith("A gauge disagrees with the others")
+    assert gauge_warning((unchecked, window), f).startswith("The force balance cannot check the gauges on this record")
+    blamed = GaugeFinding("", "balance", "a gauge's gain ... is off by about 15 %")
+    suspect = GaugeFinding("", "window", RATIO_WINDOW_NOTE + ", as the suspect gauge makes them")
+    assert gauge_warning((blamed, suspect), f).startswith("A gauge disagrees with the others")
+    assert gauge_warning((dataclasses.replace(unchecked, kind="balance"), window), f).startswith("A gauge disagrees")
+    assert gauge_warning((window,), f).startswith("A gauge disagrees")  # as before: the window's note alone
+    assert gauge_warning((), f) is None
 
 
 @pytest.mark.parametrize(("means", "said"), [

@@ -18,7 +18,7 @@ n p^(L - 1). A run is **saturated** when that chance is below :data:`RUN_ALPHA` 
 least :data:`~friction_uq.record.contract.CLIP_RUN` long; a shorter one at least ``CLIP_RUN``
 long is **undecided** (a plateau or a rail, the noise cannot tell), and so is every run of a
 channel whose pre-trigger holds two values or fewer (its noise not resolved): the reader refuses
-the first, the analysis warns of the second (:func:`friction_uq.gauge_check.flat_run_notes`).
+the first, the analysis warns of the second (:func:`friction_uq.gauge_check.flat_run_findings`).
 """
 
 from __future__ import annotations

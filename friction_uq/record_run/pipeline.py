@@ -209,8 +209,7 @@ def _warnings(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck | No
     levels = lik.force if isinstance(lik.force, LevelForceTerm) else LevelForceTerm(s.prepared.data)
     return run_warnings(ppc=post.ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=post.summary["f"],
                         lab=s.lab, conv=post.convergence, conflict=post.conflict, check=wrc,
-                        gauge_notes=s.prepared.gauge_notes, diagnosis=diag, flat_runs=s.prepared.flat_runs,
-                        speed_notes=s.prepared.speed_notes)
+                        findings=s.prepared.findings, diagnosis=diag)
 
 
 def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck, *, diagnose: bool, seed: int,

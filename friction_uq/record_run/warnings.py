@@ -26,8 +26,8 @@ from collections.abc import Sequence
 
 from scipy import stats
 
-from ..analysis import RATIO_WINDOW_NOTE, Identification
-from ..gauge_balance import BALANCE_TOL, NOISE_CANNOT_TELL, balance_departure
+from ..analysis import Identification
+from ..gauge_balance import BALANCE_TOL, GaugeFinding, balance_departure
 from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
@@ -144,13 +144,15 @@ def equilibrium_warning(lab: Identification, f: VariableSummary) -> str | None:
             "gauges' calibration (`friction-uq inspect`).")
 
 
-def gauge_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
+def gauge_warning(findings: Sequence[GaugeFinding], f: VariableSummary) -> str | None:
     """What the gauge check found over the loading (:mod:`friction_uq.gauge_balance`): a gauge that disagrees, or a
-    balance off by more than its tolerance that the gauges' noise could make (no gauge blamed)."""
+    balance off by more than its tolerance that the gauges' noise could make (kind "unchecked": no gauge blamed);
+    the window found from the ratio alone (kind "window") is said with either."""
+    notes = [g.sentence for g in findings]
     if not notes:
         return None
-    found = [n for n in notes if not n.startswith(RATIO_WINDOW_NOTE)]
-    if found and all(n.endswith(NOISE_CANNOT_TELL) for n in found):
+    found = [g for g in findings if g.kind != "window"]
+    if found and all(g.kind == "unchecked" for g in found):
         return (f"The force balance cannot check the gauges on this record: {'; '.join(notes)}. {_f_text(f)} rests "
                 "on the output gauges' ratio, whose gains it then leaves unchecked.")
     return (f"A gauge disagrees with the others: {'; '.join(notes)}. {_f_text(f)} rests on the output gauges' "
@@ -158,7 +160,7 @@ def gauge_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
 
 
 def flat_run_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
-    """A gauge's peak on one value that may be a saturated digitiser (:func:`friction_uq.gauge_check.flat_run_notes`)."""
+    """A gauge's peak on one value that may be a saturated digitiser (:func:`friction_uq.gauge_check.flat_run_findings`)."""
     if not notes:
         return None
     return (f"{'; '.join(notes)}. A clipped gauge reads less than it carried, and {_f_text(f)} with it: check the "
@@ -204,12 +206,16 @@ def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
 
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
                  conv: Convergence, conflict: PriorDataConflict | None,
-                 check: WholeRecordCheck | None, gauge_notes: Sequence[str] = (),
-                 diagnosis=None, flat_runs: Sequence[str] = (), speed_notes: Sequence[str] = ()) -> list[str]:
-    """Every check's warning, in the order a reader should see them; empty when all pass."""
+                 check: WholeRecordCheck | None, findings: Sequence[GaugeFinding] = (),
+                 diagnosis=None) -> list[str]:
+    """Every check's warning, in the order a reader should see them; empty when all pass. ``findings``: the gauge
+    checks' (:attr:`friction_uq.analysis.Prepared.findings`), told apart by kind."""
+    flat = [g.sentence for g in findings if g.kind == "flat"]
+    speed = [g.sentence for g in findings if g.kind == "striker"]
+    gauges = [g for g in findings if g.kind not in ("flat", "striker")]
     found: Sequence[str | None] = (
-        flat_run_warning(flat_runs, f), gauge_warning(gauge_notes, f) or equilibrium_warning(lab, f),
-        speed_warning(speed_notes), stationarity_warning(ppc, excess_spread, dof, f, lab),
+        flat_run_warning(flat, f), gauge_warning(gauges, f) or equilibrium_warning(lab, f),
+        speed_warning(speed), stationarity_warning(ppc, excess_spread, dof, f, lab),
         misfit_warning(check, f, diagnosis),
         convergence_warning(conv), exact_posterior_warning(diagnosis), conflict_warning(conflict),
     )
