@@ -147,15 +147,16 @@ def integrated_autocorrelation(d: np.ndarray) -> float:
 
 
 def first_crossing(y: np.ndarray, level: float, *, start: int = 0) -> float | None:
-    """Fractional index where ``y`` first rises through ``level`` at or after ``start`` (None if never)."""
+    """Fractional index where ``y`` first rises through ``level`` at or after ``start`` (None if never); ``start``
+    itself when ``y`` is already at the level there (nothing to interpolate: the sample before may be above it too)."""
     above = np.flatnonzero(y[start:] >= level)
     if above.size == 0:
         return None
     i = start + int(above[0])
-    if i == 0:
-        return 0.0
+    if i == 0 or not y[i - 1] < level:
+        return float(i)
     y0, y1 = y[i - 1], y[i]
-    return (i - 1) + float((level - y0) / (y1 - y0)) if y1 != y0 else float(i)
+    return (i - 1) + float((level - y0) / (y1 - y0))
 
 
 def pulse_arrival(

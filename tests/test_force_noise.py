@@ -111,6 +111,15 @@ def test_coloured_noise_is_not_a_gauge_fault(tmp_path: Path) -> None:
     assert "cannot be told from this record" in [n for n in notes if n.kind == "striker"][0].sentence
 
 
+def test_a_front_whose_search_starts_above_its_half_level_is_read(tmp_path: Path) -> None:
+    """A-03 with lag-1 0.99 noise of 3 % of each peak (seed 1024, one of 60 such draws): a channel's 50 % crossing
+    was searched from a sample already above it and interpolated with the one before, also above it, which put the
+    crossing 16000 samples beyond the record's end (an internal error, IndexError). Now the record is read."""
+    prep = prepare(read_record(a03_coloured(tmp_path, rho=0.99, level=0.03, seed=1024)))
+    for info in prep.forces.channels.values():
+        assert 0.0 <= info.arrival < prep.record.n_samples
+
+
 def test_a_window_found_from_the_ratio_alone_blames_no_gauge_when_none_is() -> None:
     """The note that the window was found from the force ratio alone follows the balance's; with a balance the noise
     could make, it names no suspect gauge, and the warning stays the noise's (it once read "A gauge disagrees"). The

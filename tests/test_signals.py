@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from friction_uq.errors import ShortPreTrigger, SignalError
-from friction_uq.signals import (SPIKE_FILTER, SPIKE_SIGMAS, baseline_free, noise_estimate, padding, prepulse_noise,
-                                 pulse_arrival, transport)
+from friction_uq.signals import (SPIKE_FILTER, SPIKE_SIGMAS, baseline_free, first_crossing, noise_estimate, padding,
+                                 prepulse_noise, pulse_arrival, pulse_front, transport)
 from friction_uq.stats.robust import despiked, quantisation_step
 from friction_uq.noise import white_and_ar1_noise
 
@@ -131,6 +131,35 @@ def test_arrival_detection_is_shift_invariant(x, shift):
     a0 = pulse_arrival(x, offset=0.0, sd=1e-12)
     y = transport(x, sample_interval=DT, distance=shift * DT * C, wave_speed=C)
     assert pulse_arrival(y, offset=0.0, sd=1e-12) - a0 == pytest.approx(shift, abs=0.1)
+
+
+@settings(max_examples=200, deadline=None)
+@given(y=st.lists(st.floats(-1.0, 1.0), min_size=1, max_size=40), level=st.floats(-1.0, 1.0),
+       start=st.integers(0, 39))
+def test_a_crossing_lies_where_the_signal_reaches_the_level(y, level, start):
+    """The crossing is at or after ``start`` less one sample, never beyond the first sample at the level: a search
+    that starts where the signal is already above the level once interpolated with the sample before it, also above,
+    and put the crossing millions of samples away (an IndexError in the front's walk back, on a coloured record)."""
+    y = np.asarray(y)
+    start = min(start, y.size - 1)
+    t = first_crossing(y, level, start=start)
+    at = np.flatnonzero(y[start:] >= level)
+    if at.size == 0:
+        assert t is None
+        return
+    i = start + int(at[0])
+    assert max(start - 1, 0) <= t <= i and (t == i or y[int(math.floor(t))] < level)
+
+
+@settings(max_examples=50, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), rho=st.floats(0.9, 0.999), level=st.floats(0.02, 0.12))
+def test_a_front_is_found_inside_the_record_whatever_the_noise(seed, rho, level):
+    """A pulse under strongly coloured noise (noise of up to an eighth of the pulse, so that it rises above 8 sd):
+    the foot and the 10 % and 50 % crossings lie inside the record, in order."""
+    x = ramp_pulse(2048, 700.0, rise=60, plateau=600) + level * 1e-3 * white_and_ar1_noise(
+        2048, sd=1.0, rho=rho, white_fraction=0.0, rng=np.random.default_rng(seed))
+    foot, t10, t50 = pulse_front(x, offset=0.0, sd=level * 1e-3, start=0, polarity=+1)
+    assert -0.25 * x.size <= foot <= t10 <= t50 < x.size
 
 
 @settings(max_examples=25, deadline=None)
