@@ -146,6 +146,14 @@ def test_the_written_record_follows_the_contract(tmp_path: Path) -> None:
         ("[apparatus.input_bar]\ngauge_distance = 3.0\n", "key 'apparatus.input_bar.gauge_distance' is 3.0 m, "
                                                          "not inside the bar"),
         ("[record]\ndate = \"yesterday\"\n", "key 'record.date' is 'yesterday', not an ISO 8601 date"),
+        # what the reader refuses is refused before simulating (it once was written, or failed after the simulation)
+        ("[record]\ndate = \"2024-05-02garbage\"\n", "key 'record.date' is '2024-05-02garbage', not an ISO 8601"),
+        ("[record]\ntest_id = \"A\\u000001\"\n", "key 'record.test_id' holds a NUL character at position 1"),
+        ("[record]\ndescription = \"x\\u0000y\"\n", "key 'record.description' holds a NUL character"),
+        ("[record]\ntest_id = \"A\\n01\"\n", "key 'record.test_id' holds the control character '\\n'"),
+        ("[record]\ncampaign = \"A\\u202e1\"\n", "key 'record.campaign' holds the control character '\\u202e'"),
+        ("[apparatus.sample]\nmaterial = \"/etc/passwd\"\n", "key 'apparatus.sample.material' is '/etc/passwd', "
+                                                            "not a material name"),
         ("[loading\nx = 1\n", "is not valid TOML"),
     ],
 )
@@ -157,6 +165,14 @@ def test_bad_configs_are_refused_with_one_sentence_naming_file_and_key(tmp_path:
     text = str(info.value)
     assert text.startswith(str(path) + ": ")
     assert "\n" not in text
+
+
+def test_a_sample_diameter_and_a_multi_line_description_are_simulated(tmp_path: Path) -> None:
+    """The sample's ``diameter`` is its class's own (a bar's is renamed outer_diameter; the sample's once was too, an
+    internal error); free text may span lines, as the reader takes it."""
+    path = write(tmp_path, '[apparatus.sample]\ndiameter = 0.0099\n[record]\ndescription = "two\\nlines"\n', "ok.toml")
+    cfg = load_config(path)
+    assert cfg.apparatus.sample.diameter == 0.0099 and cfg.description == "two\nlines"
 
 
 def test_a_missing_config_file_is_a_config_error(tmp_path: Path) -> None:

@@ -8,7 +8,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ..errors import ConfigError
-from ..plausible import text_bytes
+from ..plausible import text_bytes, unprintable
 
 
 class Section:
@@ -73,13 +73,19 @@ class Section:
         return value
 
     def string(self, key: str, default: str | None, *, choices: Sequence[str] | None = None,
-               max_chars: int | None = None, max_bytes: int | None = None) -> str | None:
-        """``key``'s text; ``max_chars`` and ``max_bytes`` (UTF-8): the longest the record reader takes."""
+               max_chars: int | None = None, max_bytes: int | None = None, free_text: bool = False) -> str | None:
+        """``key``'s text; ``max_chars`` and ``max_bytes`` (UTF-8): the longest the record reader takes. No NUL (no
+        record attribute holds one); no control, format or line-separator character unless ``free_text`` (the reader
+        refuses them in ids and names: what is simulated can be read back)."""
         if key not in self.table:
             return default
         value = self.table[key]
         if not isinstance(value, str):
             raise self.fail(key, f"must be a string, got {_show(value)}")
+        if "\x00" in value:
+            raise self.fail(key, f"holds a NUL character at position {value.index(chr(0))}, which no record can store")
+        if not free_text and (bad := unprintable(value)):
+            raise self.fail(key, f"{bad}: it is printed on terminals and names files")
         if max_chars is not None and len(value) > max_chars:
             raise self.fail(key, f"is {len(value)} characters long, more than the {max_chars} a record takes")
         if max_bytes is not None and text_bytes(value) > max_bytes:

@@ -12,9 +12,12 @@ from dataclasses import fields, replace
 from typing import Any
 
 from ..errors import ConfigError
+from ..plausible import is_name
 from ..record import Apparatus, Bar, Plug, Sample, Tube
 from ._checks import Section
 
+#: Parts that are bars: their contract attribute ``diameter`` is :class:`~friction_uq.record.Bar`'s outer_diameter.
+_BARS = ("striker", "input_bar", "internal_output_bar")
 _BAR_KEYS = ("young_modulus", "wave_speed", "diameter", "length", "gauge_distance", "poisson_ratio")
 _PARTS: dict[str, tuple[str, ...]] = {
     "striker": ("young_modulus", "wave_speed", "diameter", "length", "poisson_ratio"),
@@ -40,13 +43,15 @@ def parse_apparatus(source: str, table: Any, app: Apparatus) -> Apparatus:
         for key in sub:
             if key == "material":
                 new[key] = s.string(key, None)
+                if not is_name(new[key]):  # the prior file is looked up by it (friction_uq.prior_loader)
+                    raise s.fail(key, f"is {new[key]!r}, not a material name (letters, digits, '-' and '_' only)")
             elif key == "poisson_ratio":
                 new[key] = s.number(key, None, low=-1.0, high=0.499)
             elif key == "gauge_offset":
                 new[key] = s.number(key, None, low=-1.0, high=1.0)
             else:
                 new[key] = s.number(key, None, low=0.0, high=1e12, low_open=True)
-        if "diameter" in new:
+        if "diameter" in new and part in _BARS:  # a bar's diameter is the contract's; its class has outer_diameter
             new["outer_diameter"] = new.pop("diameter")
         app = replace(app, **{part: replace(getattr(app, part), **new)})
     return app

@@ -81,7 +81,7 @@ import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
-from datetime import date as _date
+from datetime import datetime as _datetime
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -197,11 +197,11 @@ def parse_config(data: Mapping[str, Any], *, source: str = "<config>") -> Simula
                 ("test_id", "campaign", "description", "date", "dtype", "seed"))
     kw["test_id"] = s.string("test_id", d.test_id, max_chars=MAX_ID_CHARS)  # what the reader takes back
     kw["campaign"] = s.string("campaign", d.campaign, max_chars=MAX_ID_CHARS)
-    kw["description"] = s.string("description", None, max_bytes=MAX_ATTRIBUTE_BYTES)
+    kw["description"] = s.string("description", None, max_bytes=MAX_ATTRIBUTE_BYTES, free_text=True)
     kw["date"] = s.string("date", None)
     if kw["date"] is not None:
         try:
-            _date.fromisoformat(kw["date"][:10])
+            _datetime.fromisoformat(kw["date"])  # as the record reader reads it back
         except ValueError:
             raise s.fail("date", f"is {kw['date']!r}, not an ISO 8601 date such as '2024-05-02'") from None
     kw["dtype"] = s.string("dtype", d.dtype, choices=("float32", "float64"))
