@@ -8,6 +8,7 @@ strain_per_volt, and back.
 
 from __future__ import annotations
 
+import math
 import re
 import tomllib
 from pathlib import Path
@@ -610,3 +611,69 @@ def test_a_non_finite_time_is_named_by_its_line(tmp_path, scope_csv, capsys):
 def test_an_implausible_time_base_names_the_setup_key(tmp_path, scope_csv, capsys, time, words):
     err = _refused(tmp_path, [scope_csv], setup_doc(time=time), capsys)
     assert words in err, err
+
+
+def _scope_files(tmp_path: Path, writer, suffix: str, **kw) -> list[Path]:
+    strains, rate, t0 = gauge_signals(RECORD)
+    return [writer(tmp_path / f"CH{i + 1}{suffix}", eps / SPV[g], 1.0 / rate, t0, **kw)
+            for i, (g, eps) in enumerate(strains.items())]
+
+
+def _one_per_channel(files: list[Path]) -> dict:
+    doc = setup_doc(files={g: f.name for g, f in zip(COLUMNS, files)})
+    del doc["time"]
+    for c in doc["channels"].values():
+        c["column"] = 1
+    return doc
+
+
+@pytest.mark.parametrize("dt", [0.0, -2e-7, float("nan"), float("inf")])
+def test_a_binary_files_sample_interval_that_is_no_time_base_is_named(tmp_path, capsys, dt):
+    """A damaged header's 0, negative, NaN or infinite sample interval: once an internal error (a division by zero in
+    the rate's rounding), or listed by --show as if sound."""
+    pytest.importorskip("lecroyparser")
+    pytest.importorskip("RigolWFM")
+    trc = _scope_files(tmp_path, _trc, ".trc")
+    trc[1] = _trc(trc[1], np.ones(100), dt, 0.0)
+    err = _refused(tmp_path, trc, _one_per_channel(trc), capsys)
+    assert "CH2.trc: the descriptor's HORIZ_INTERVAL: the sample interval is" in err and "positive number" in err
+    if math.isfinite(dt):  # the ISF preamble prints the interval as text; a non-finite one is not written
+        isf = tmp_path / "isf"
+        isf.mkdir()
+        files = _scope_files(isf, _isf, ".isf", name="Ch")
+        files[1] = _isf(files[1], np.linspace(0, 1, 100), dt, 0.0, "Ch2")
+        assert main(["import", str(files[1]), "--show"]) == 2
+        assert "CH2.isf: channel" in capsys.readouterr().err
+        err = _refused(isf, files, _one_per_channel(files), capsys)
+        assert "the sample interval is" in err
+
+
+def test_a_setup_file_with_a_key_of_50000_dotted_parts_is_refused_before_parsing(tmp_path, scope_csv, capsys):
+    """Such a file of 100 kB took the TOML parser about a minute and 10 GB; the depth is checked first."""
+    setup = tmp_path / "deep.toml"
+    setup.write_text(".".join(["a"] * 50_000) + "=1\n")
+    assert main(["import", str(scope_csv), "--setup", str(setup), "-o", str(tmp_path / "out.h5")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "has a dotted key of more than" in err and not (tmp_path / "out.h5").exists()
+
+
+def test_a_damaged_tdms_file_is_said_in_one_sentence(tmp_path, capfd):
+    """npTDMS's own warnings on a truncated file (printed to stderr before the refusal) are not printed; the refusal
+    names the first of them."""
+    nptdms = pytest.importorskip("nptdms")
+    strains, rate, t0 = gauge_signals(RECORD)
+    chans = [nptdms.ChannelObject("scope", COLUMNS[g], eps / SPV[g],
+                                  properties={"wf_increment": 1.0 / rate, "wf_start_offset": t0})
+             for g, eps in strains.items()]
+    path = tmp_path / "shot.tdms"
+    with nptdms.TdmsWriter(str(path)) as w:
+        w.write_segment([nptdms.RootObject(), nptdms.GroupObject("scope"), *chans])
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    doc = setup_doc()
+    del doc["time"]
+    for g, c in COLUMNS.items():
+        doc["channels"][g]["column"] = f"scope/{c}"
+    setup = write_setup(tmp_path / "SETUP.toml", doc)
+    assert main(["import", str(path), "--setup", str(setup), "-o", str(tmp_path / "r.h5")]) == 2
+    err = capfd.readouterr().err
+    assert err.count("\n") == 1 and "npTDMS found the file damaged (" in err

@@ -45,6 +45,15 @@ RIGOLWFM_SUFFIXES = (".wfm", ".isf", ".bin")
 BINARY_SUFFIXES = TDMS_SUFFIXES + LECROY_SUFFIXES + RIGOLWFM_SUFFIXES
 
 
+def _sample_interval(path: Path, dt: float, where: str) -> float:
+    """``dt`` if it is a positive finite interval, else :class:`ScopeFileError` naming the file and ``where`` the file
+    keeps it (a damaged header's 0, NaN or negative step is no time base)."""
+    if not (math.isfinite(dt) and dt > 0.0):
+        raise ScopeFileError(f"{path}: {where}: the sample interval is {dt!r} s; it must be a positive number (a "
+                             "damaged header?)")
+    return dt
+
+
 def _rate_digits(dt: float, digits: int = 7) -> float:
     """A sample interval stored in single precision, rounded to the rate it stands for (1/dt to 7 digits)."""
     rate = 1.0 / dt
@@ -61,11 +70,12 @@ def read_lecroy(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
             raise ScopeFileError(f"{path}: a LeCroy .trc file holds one trace: give column = 1, not {col!r}")
     lecroy_declared(path)  # the descriptor's counts, before lecroyparser decodes the samples
     try:
-        d = lecroyparser.ScopeData(str(path))  # type: ignore[attr-defined]
+        with np.errstate(all="ignore"):  # a damaged descriptor's inf or NaN is said below, not as numpy's warning
+            d = lecroyparser.ScopeData(str(path))  # type: ignore[attr-defined]
     except Exception as exc:
         raise ScopeFileError(f"{path}: not a readable LeCroy trace ({type(exc).__name__}: {exc})") from None
     # the sample interval and start from the descriptor (the parser's x spans n intervals over n - 1 steps)
-    dt = _rate_digits(float(d.horizInterval))
+    dt = _rate_digits(_sample_interval(path, float(d.horizInterval), "the descriptor's HORIZ_INTERVAL"))
     tr = Trace(np.asarray(d.y, dtype=np.float64), f"trace of {d.waveSource}", float(d.horizOffset), dt)
     return {col: tr for col in columns}
 
@@ -108,9 +118,19 @@ def read_rigolwfm(path: Path, columns: list[str | int]) -> dict[str | int, Trace
     out: dict[str | int, Trace] = {}
     for col, c in picked.items():
         t = np.asarray(c.times, dtype=np.float64)
-        dt = _rate_digits((t[-1] - t[0]) / (len(t) - 1), 9) if len(t) > 1 else None
+        step = _channel_interval(path, c)
+        dt = _rate_digits(step, 9) if step is not None else None
         out[col] = Trace(np.asarray(c.volts, dtype=np.float64), c.name, float(t[0]), dt)
     return out
+
+
+def _channel_interval(path: Path, channel: Any) -> float | None:
+    """A RigolWFM channel's sample interval from its times (None for a single sample), checked positive."""
+    t = np.asarray(channel.times, dtype=np.float64)
+    if len(t) < 2:
+        return None
+    return _sample_interval(path, float((t[-1] - t[0]) / (len(t) - 1)),
+                            f"channel {channel.name}'s time base (its header's sample interval)")
 
 
 def read_binary(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
@@ -137,5 +157,7 @@ def describe_binary(path: Path) -> list[str]:
     out = [f"{path}: {w.header_name} waveform; column = the channel number"]
     for c in w.channels:
         if getattr(c, "volts", None) is not None and len(c.volts):
-            out.append(f"  {c.channel_number} ({c.name}): {len(c.volts)} samples")
+            dt = _channel_interval(path, c)
+            base = f" every {dt:.6g} s from {float(np.asarray(c.times)[0]):.6g} s" if dt is not None else ""
+            out.append(f"  {c.channel_number} ({c.name}): {len(c.volts)} samples{base}")
     return out

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SetupError
-from ..plausible import MAX_TEXT_BYTES, NotText, text_of
+from ..plausible import MAX_TEXT_BYTES, NotText, text_of, toml_shape_problem
 from ..record.contract import CHANNELS, REQUIRED_CHANNELS
 
 #: Largest set-up file read (bytes): every text input's (docs/limits.md)
@@ -309,6 +309,9 @@ def load_setup(path: str | Path) -> Setup:
         text = text_of(p, "set-up file", MAX_SETUP_BYTES, encoding="utf-8-sig")  # a BOM: Windows' editors
     except NotText as why:
         raise _fail(p, "file", str(why)) from None
+    shape = toml_shape_problem(text)  # before the parser, whose time and memory grow with the depth
+    if shape:
+        raise _fail(p, "file", f"{shape}, too deep for a set-up file")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -10,6 +10,7 @@ Only then are the channels asked for read, one at a time, scaled as the file say
 
 from __future__ import annotations
 
+import logging
 import math
 import numbers
 from collections.abc import Iterator
@@ -28,19 +29,55 @@ _KINDS = {"b": "booleans", "c": "complex numbers", "M": "timestamps", "m": "time
           "U": "text", "S": "text"}
 
 
+class _Said(logging.Handler):
+    """npTDMS's log records about a file (a damaged segment, undecodable text), kept to be said in one sentence."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.said: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.said.append(record.getMessage())
+
+
 @contextmanager
 def _open(path: Path) -> Iterator[Any]:
-    """The TDMS file with its metadata read and its data left on disk."""
+    """The TDMS file with its metadata read and its data left on disk. npTDMS's warnings on a damaged file are not
+    printed (the command says one sentence); a refusal while the file is open names the first of them."""
     check_size(path)
     nptdms = need("nptdms", path)
+    log, said = logging.getLogger("nptdms"), _Said()  # npTDMS's module loggers propagate to it
+    console = getattr(getattr(getattr(nptdms, "log", None), "log_manager", None), "console_handler", None)
+    level = console.level if console is not None else None
+    if console is not None:  # the handler npTDMS puts on each of its loggers, printing to stderr
+        console.setLevel(logging.CRITICAL + 1)
+    log.addHandler(said)
     try:
-        f = nptdms.TdmsFile.open(str(path))  # type: ignore[attr-defined]
-    except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error on damaged files
-        raise ScopeFileError(f"{path}: not a readable TDMS file ({type(exc).__name__}: {exc})") from None
-    try:
-        yield f
+        try:
+            with np.errstate(all="ignore"):
+                f = nptdms.TdmsFile.open(str(path))  # type: ignore[attr-defined]
+        except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error on damaged files
+            raise ScopeFileError(f"{path}: not a readable TDMS file ({type(exc).__name__}: {exc})") from None
+        try:
+            yield f
+        except ScopeFileError as exc:
+            if said.said:
+                raise ScopeFileError(f"{exc}; npTDMS found the file damaged ({_short(said.said[0])})") from None
+            raise
+        finally:
+            f.close()
     finally:
-        f.close()
+        log.removeHandler(said)
+        if console is not None:
+            console.setLevel(level)
+
+
+def _short(text: str, limit: int = 120) -> str:
+    """``text`` on one line, at most ``limit`` characters, its control characters escaped (npTDMS quotes raw bytes)."""
+    from ..plausible import escaped
+
+    one = escaped(" ".join(text.split()))
+    return one if len(one) <= limit else one[:limit - 3] + "..."
 
 
 def _channels(f: Any) -> list[tuple[str, Any]]:
