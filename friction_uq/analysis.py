@@ -74,8 +74,9 @@ def prepare(
     wired = [g for g in findings if g.kind in ("reversed", "swapped")]
     if wired:  # a wiring fault: the record is to be mended at its source, not analysed
         raise SignalError(f"{record.path}: {wired[0].sentence}")
-    # a channel's scale off by a factor (a gauge factor, a unit: eq. 5, 6 and 14) leaves f's ratio as it is when every
-    # channel shares it, but not the forces, the pressure and the velocity: said, as the balance's notes are
+    # a channel's scale off by a factor (a gauge factor, a unit: eq. 5, 6 and 14): an output channel's moves f itself
+    # (refused, as inspect refuses it); the input bar's, or one every channel shares, leaves f's ratio as it is but not
+    # the forces, the pressure and the velocity: said, as the balance's notes are
     scaled, speed = gauge_and_speed(scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity))
     notes = tuple(findings + scaled)
     if window is None:
@@ -85,12 +86,23 @@ def prepare(
             win = window_from_times(forces, *window)
         except SignalError as exc:
             raise SignalError(f"{record.path}: the window given by hand (--window) {exc}") from None
+    _refuse_an_output_scale(record, scaled)
     data = stationary_data(
         forces, record.apparatus, win, test_id=record.test_id, campaign=record.campaign,
         striker_velocity=record.striker_velocity,
     )
     _check_polarity(record, forces, win)
     return Prepared(record, forces, win, data, notes + flat_run_findings(record) + tuple(speed))
+
+
+def _refuse_an_output_scale(record: Record, scaled: list[GaugeFinding]) -> None:
+    """An output channel off by a factor (:func:`~friction_uq.gauge_scale.scale_findings`) moves eq. 17's ratio, f's
+    own, by that factor: refused, naming the channel and the fix (checked once the window is found, so that a record
+    without a stationary phase is refused for that)."""
+    off = [g for g in scaled if g.kind == "scale" and g.channel in ("internal_output_bar", "external_output_bar")]
+    if off:
+        raise SignalError(f"{record.path}: {off[0].sentence}; f reads the output forces' ratio, which that channel's "
+                          "scale moves by the same factor")
 
 
 #: The note said when the window was found from the force ratio alone (a finding of kind "window").

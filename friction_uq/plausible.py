@@ -25,6 +25,7 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
     "bar.young_modulus": (1e9, 1e12, "Pa", "polymer (PMMA 3 GPa) to tungsten carbide (700 GPa) bars"),
     "bar.wave_speed": (500.0, 15000.0, "m/s", "polymer to beryllium bars"),
     "bar.diameter": (1e-3, 0.2, "m", "1 mm micro-bars to 200 mm bars"),
+    "bar.density": (300.0, 25000.0, "kg/m^3", "polymer to tungsten bars: E / c^2, the two declared together"),
     "bar.length": (0.01, 20.0, "m", "1 cm strikers to 20 m bars"),
     "bar.gauge_distance": (1e-3, 20.0, "m", "a gauge on the bar"),
     "tube.young_modulus": (1e9, 1e12, "Pa", "polymer to carbide confining tubes"),
@@ -184,6 +185,14 @@ def apparatus_problem(app) -> tuple[str, str, str] | None:
             return part, attr, problem
     if t.gauge_width >= t.length:
         return "tube", "gauge_width", f"is {t.gauge_width!r} m, not narrower than the tube's length {t.length!r} m"
+    for part in ("striker", "input_bar", "internal_output_bar", "external_output_bar"):
+        bar = getattr(app, part)  # E and c each plausible, yet together a bar of no material (E = rho c^2)
+        density = bar.young_modulus / bar.wave_speed**2
+        if out_of_range("bar.density", density):
+            low, high = RANGES["bar.density"][:2]
+            return part, "young_modulus", (f"is {bar.young_modulus:.3g} Pa with wave_speed {bar.wave_speed:.4g} m/s: a "
+                                           f"density E / c^2 of {density:.3g} kg/m^3, outside [{low:g}, {high:g}] "
+                                           "kg/m^3 (polymer to tungsten bars): one of the two is off")
     return None
 
 

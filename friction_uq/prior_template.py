@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import json
 
-from .plausible import unprintable
+from .plausible import out_of_range, unprintable
 
 NU_MIN, NU_MAX = 0.01, 0.49
 
@@ -51,6 +51,8 @@ MIN_NU_SD = 0.005
 def _check(nu: float, sd: float) -> None:
     if not 0.0 < nu < 0.5:
         raise ValueError(f"--nu must lie in (0, 0.5), the Poisson ratio of an elastic solid, got {nu:g}")
+    if odd := out_of_range("sample.poisson_ratio", nu):  # the range a record's sample and `analyze --nu` take
+        raise ValueError(f"--nu {odd}")
     if not MIN_NU_SD <= sd <= 0.25:
         raise ValueError(f"--nu-sd must lie in [{MIN_NU_SD:g}, 0.25] (a measurement of nu knows it to {MIN_NU_SD:g} at "
                          f"best), got {sd:g}")

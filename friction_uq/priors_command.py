@@ -19,6 +19,10 @@ DESCRIPTION = (
 )
 
 
+#: Longest material name: MATERIAL-nu-tight.toml and a writer's temporary name stay within a file system's 255 bytes.
+MAX_MATERIAL_CHARS = 200
+
+
 def _material(text: str) -> str:
     """The rule ``run`` looks a record's material up by (:func:`~friction_uq.plausible.is_name`), so that every file
     written here can be found."""
@@ -27,6 +31,9 @@ def _material(text: str) -> str:
     if not is_name(text) or "-nu-" in text:
         raise argparse.ArgumentTypeError(f"material {text!r} must be a name of letters, digits, '_' and '-' "
                                          "(as in the record's /apparatus/sample@material), without '-nu-'")
+    if len(text) > MAX_MATERIAL_CHARS:
+        raise argparse.ArgumentTypeError(f"material {text[:20]!r}... is {len(text)} characters long, more than the "
+                                         f"{MAX_MATERIAL_CHARS} a prior file's name leaves room for")
     return text
 
 
@@ -74,10 +81,12 @@ def run(args: argparse.Namespace) -> int:
     paths = {args.out / name: text for name, text in texts.items()}
     if args.out.exists() and not args.out.is_dir():
         raise OutputError(f"{args.out}: --out must be a folder, and this is a file")
-    if not args.force:
-        for p in paths:
-            if p.exists():
-                raise OutputError(f"{p}: exists; choose another --out or give --force to replace it")
+    for p in paths:  # every refusal before the first file is written
+        if p.exists() and not p.is_file():
+            raise OutputError(f"{p}: exists and is not a file (a folder?), which --force does not replace; choose "
+                              "another --out")
+        if p.exists() and not args.force:
+            raise OutputError(f"{p}: exists; choose another --out or give --force to replace it")
     import tomllib
 
     for p, text in paths.items():

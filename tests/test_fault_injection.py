@@ -353,6 +353,9 @@ def _scaled_channel(fh):
     (_set("/apparatus/striker", diameter=1e200), "/apparatus/striker@diameter", "outside the plausible range"),
     (_set("/apparatus/input_bar", young_modulus=1e20), "/apparatus/input_bar@young_modulus", "[1e+09, 1e+12] Pa"),
     (_set("/apparatus/sample", density=1e6), "/apparatus/sample@density", "outside the plausible range"),
+    # each in range, together a bar of 39 kg/m^3 (E = rho c^2): once analysed to f = 0.87 for a true 0.045
+    (_set("/apparatus/internal_output_bar", young_modulus=1e9), "/apparatus/internal_output_bar@young_modulus",
+     "a density E / c^2 of 38.6 kg/m^3"),
     (_set(SIG, sample_rate=1.0), "/signals@sample_rate", "outside the plausible range"),
     (_set(SIG, t0=-1e9), "/signals@t0", "outside the plausible range"),
     (_set(SIG, t0=1e12), "/signals@t0", "outside the plausible range"),
@@ -432,6 +435,13 @@ def _result_json(**change) -> str:
     (_result_json(V={"mean": -1e300, "sd": 1, "q05": 0, "q50": 0, "q95": 0}), "key 'V': mean is -1e+300, outside"),
     (_result_json(nu={"mean": 0.7, "sd": 0.01, "q05": 0.69, "q50": 0.7, "q95": 0.71}), "key 'nu': mean is 0.7"),
     (_result_json(campaign="A\nfriction-uq: error: fake"), "key 'campaign' is"),
+    # quantiles out of order once drew error bars of negative length (an internal error after the table)
+    (_result_json(f_stationary={"mean": 0.5, "sd": 0.1, "q05": 0.9, "q50": 0.5, "q95": 0.1}),
+     "key 'f_stationary': its quantiles q05 0.9, q50 0.5, q95 0.1 are not in order"),
+    # the speed of light and a pressure of 1e30 Pa were compared and plotted
+    (_result_json(V={"mean": 3e8, "sd": 1, "q05": 3e8, "q50": 3e8, "q95": 3e8}), "key 'V': mean is 300000000.0, "
+                                                                               "outside [0, 200]"),
+    (_result_json(p_mean={"mean": 1e30, "sd": 1, "q05": 1e30, "q50": 1e30, "q95": 1e30}), "key 'p_mean': mean is"),
 ])
 def test_compare_refuses_malformed_results(tmp_path, capsys, text, words):
     path = tmp_path / "r.json"
@@ -728,3 +738,38 @@ def test_a_pipe_as_setup_file_is_refused(tmp_path, capsys):
     (tmp_path / "s.csv").write_text("1,2\n")
     assert _code(["import", tmp_path / "s.csv", "--setup", fifo, "-o", tmp_path / "o.h5"]) == 2
     assert "SETUP.toml: file: is not a regular file (a device or a pipe), not a set-up file" in _one_sentence(capsys)
+
+
+def test_a_named_file_that_is_not_hdf5_is_refused_before_a_campaign_starts(tmp_path, capsys):
+    """A run's JSON named as a record once started Dask and left a campaign folder saying "nothing to pool"."""
+    other = tmp_path / "A_A-01.json"
+    other.write_text(_result_json())
+    assert _code(["campaign", other, "--out", tmp_path / "c", "--no-pdf", "--quiet"]) == 2
+    assert "not an HDF5 file, so not a test record" in _one_sentence(capsys)
+    assert not (tmp_path / "c").exists()
+
+
+def test_priors_refuse_before_writing_any_file(tmp_path, capsys):
+    """A folder where one of the three files goes, with --force: once two were written before the refusal; a
+    material name too long for a file name once left an empty folder; a nu the analysis refuses once was written."""
+    (tmp_path / "o" / "PMMA-nu-wide.toml").mkdir(parents=True)
+    assert _code(["priors", "PMMA", "--nu", "0.35", "--nu-sd", "0.03", "--out", tmp_path / "o", "--force"]) == 2
+    assert "PMMA-nu-wide.toml: exists and is not a file" in _one_sentence(capsys)
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["PMMA-nu-wide.toml"]
+    assert _code(["priors", "A" * 300, "--nu", "0.35", "--nu-sd", "0.03", "--out", tmp_path / "long"]) == 2
+    assert "300 characters long" in capsys.readouterr().err and not (tmp_path / "long").exists()
+    assert _code(["priors", "TINY", "--nu", "1e-9", "--nu-sd", "0.005", "--out", tmp_path / "tiny"]) == 2
+    assert "outside the plausible range [0.01, 0.4999]" in _one_sentence(capsys) and not (tmp_path / "tiny").exists()
+
+
+def test_an_output_channel_off_by_a_factor_gets_no_f(record_copy, capsys):
+    """The internal bar's units written as microstrain for strain: analyze gave f = 4.40 (gauge notes beside it) and
+    run stopped at its sampler's start, blaming the prior file; the scale's finding refuses both, naming the
+    channel."""
+    path = _edit(record_copy(), _set(f"{SIG}/internal_output_bar", units="microstrain"))
+    for command in (["analyze", path], ["run", path, "--no-pdf", "--quiet", "--out", path.parent / "out"]):
+        assert _code(command) == 2
+        msg = _one_sentence(capsys)
+        assert "/signals/internal_output_bar looks 1" in msg and "times too small" in msg
+        assert "f reads the output forces' ratio" in msg
+    assert not (path.parent / "out").exists()

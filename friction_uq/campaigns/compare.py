@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionUQError
+from ..plausible import RANGES
 
 REQUIRED = ("f", "kappa", "nu", "V", "p_mean", "test_id", "campaign")
 SUMMARIES = ("f", "kappa", "nu", "V", "p_mean")
@@ -62,9 +63,11 @@ class TrendFit:
 
 
 #: Where a run's summaries lie (a friction coefficient, a Poisson ratio, a sliding speed and a pressure are not
-#: negative; nu is below 0.5): a result file outside is not what a run wrote.
-SUMMARY_RANGES = {"f": (0.0, math.inf), "kappa": (0.0, math.inf), "nu": (0.0, 0.5), "V": (0.0, math.inf),
-                  "p_mean": (0.0, math.inf)}
+#: negative; nu is below 0.5; the sample slides no faster than the fastest striker a record may declare,
+#: friction_uq.plausible's 200 m/s; the wall's pressure is below 10 GPa, beyond what any bar transmits elastically):
+#: a result file outside is not what a run wrote.
+SUMMARY_RANGES = {"f": (0.0, math.inf), "kappa": (0.0, math.inf), "nu": (0.0, 0.5),
+                  "V": (0.0, RANGES["striker_velocity"][1]), "p_mean": (0.0, 1e10)}
 
 
 def _check_summary(p: Path, key: str, v: object, *, positive_sd: bool = False) -> None:
@@ -78,6 +81,9 @@ def _check_summary(p: Path, key: str, v: object, *, positive_sd: bool = False) -
     assert isinstance(v, dict)
     if v["sd"] < 0 or (positive_sd and v["sd"] == 0):
         raise FrictionUQError(f"{p}: key '{key}': sd is {v['sd']!r}, it must be > 0")
+    if not v["q05"] <= v["q50"] <= v["q95"]:
+        raise FrictionUQError(f"{p}: key '{key}': its quantiles q05 {v['q05']!r}, q50 {v['q50']!r}, q95 {v['q95']!r} "
+                              "are not in order")
     low, high = SUMMARY_RANGES.get(key, (-math.inf, math.inf))
     out = [s for s in ("mean", "q50") if not low <= v[s] <= high]  # the tails of a small V may cross 0
     if out:

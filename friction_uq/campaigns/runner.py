@@ -57,9 +57,23 @@ def find_records(inputs: Sequence[str | os.PathLike[str]]) -> list[Path]:
             raise FrictionUQError(f"{p}: no such file or folder")
         elif odd := not_regular(p):  # a pipe would block the checksum, a device never end it
             raise FrictionUQError(f"{p}: {odd}, not a record")
+        elif not _hdf5_signature(p):  # a file of another type named as a record (a run's JSON, a scope file)
+            raise FrictionUQError(f"{p}: not an HDF5 file, so not a test record (`friction-uq import` writes records "
+                                  "from scope files)")
         else:
-            found.append(p)  # a file that is no record is a failed record of the campaign, said in its table
+            found.append(p)  # a damaged record is a failed record of the campaign, said in its table
     return found
+
+
+def _hdf5_signature(path: Path) -> bool:
+    """Whether ``path`` begins with the HDF5 signature (a damaged record does too; the job says what is wrong)."""
+    from ..plausible import HDF5_SIGNATURE
+
+    try:
+        with open(path, "rb") as fh:
+            return fh.read(len(HDF5_SIGNATURE)) == HDF5_SIGNATURE
+    except OSError:
+        return True  # unreadable: the job's own reading says why, in the campaign's table
 
 
 def read_header(path: Path) -> RecordHeader:
