@@ -60,6 +60,11 @@ def run(args: argparse.Namespace, parser: argparse.ArgumentParser, output_check)
         parser.error(f"import needs {', '.join(missing)}: friction-uq import FILE... --setup SETUP.toml -o test.h5 "
                      "(friction-uq import --template prints a SETUP.toml to start from)")
     output_check(args.output, (".h5", ".hdf5"), "record")
+    for given in (*args.files, args.setup):  # --overwrite replaces an earlier record, never what is being read
+        if given.exists() and args.output.exists() and given.resolve() == args.output.resolve():
+            from .errors import OutputError
+
+            raise OutputError(f"{args.output}: is one of the files being imported; give the record another name")
     if args.output.exists() and not args.overwrite:  # a lab's record is not replaced by a second import unasked
         from .errors import OutputError
 

@@ -677,3 +677,36 @@ def test_a_damaged_tdms_file_is_said_in_one_sentence(tmp_path, capfd):
     assert main(["import", str(path), "--setup", str(setup), "-o", str(tmp_path / "r.h5")]) == 2
     err = capfd.readouterr().err
     assert err.count("\n") == 1 and "npTDMS found the file damaged (" in err
+
+
+def test_an_import_never_replaces_its_own_input(tmp_path, scope_csv, capsys):
+    """A scope export named shot.h5, imported with -o shot.h5 --overwrite, was replaced by the record."""
+    shot = tmp_path / "shot.h5"
+    shot.write_bytes(scope_csv.read_bytes())
+    setup = write_setup(tmp_path / "SETUP.toml", setup_doc())
+    assert main(["import", str(shot), "--setup", str(setup), "-o", str(shot), "--overwrite"]) == 2
+    assert "is one of the files being imported" in capsys.readouterr().err
+    assert shot.read_bytes() == scope_csv.read_bytes()
+
+
+def test_a_column_name_the_header_gives_twice_is_refused(tmp_path, scope_csv, capsys):
+    """A header Time,CH1,CH2,CH3,CH4,CH2: column 'CH2' was taken as the first of the two, silently."""
+    lines = scope_csv.read_text().splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("Time"))
+    lines[head] += ",CH2"
+    lines[head + 1:] = [ln + "," + ln.split(",")[3] if ln.strip() else ln for ln in lines[head + 1:]]
+    dup = tmp_path / "dup.csv"
+    dup.write_text("\n".join(lines) + "\n")
+    err = _refused(tmp_path, [dup], setup_doc(), capsys)
+    assert "dup.csv: column 'CH2' is the name of columns 3, 6 on the header line" in err
+
+
+def test_a_file_name_two_of_the_files_given_share_is_refused(tmp_path, scope_csv, capsys):
+    """a/scope.csv and b/scope.csv given, a channel's file = "scope.csv": the first was taken, silently."""
+    for d in "ab":
+        (tmp_path / d).mkdir()
+        (tmp_path / d / "scope.csv").write_bytes(scope_csv.read_bytes())
+    files = [tmp_path / "a" / "scope.csv", tmp_path / "b" / "scope.csv"]
+    doc = setup_doc(files={g: "scope.csv" for g in COLUMNS})
+    err = _refused(tmp_path, files, doc, capsys)
+    assert "file: 'scope.csv' names 2 of the files given" in err

@@ -64,9 +64,12 @@ def _file_of(setup: Setup, ch: ChannelSetup, files: Sequence[Path]) -> Path:
             return files[0]
         raise SetupError(f"{where}: several files were given; say which holds this gauge with file = \"NAME\" "
                          f"(one of {', '.join(f.name for f in files)})")
-    hits = [f for f in files if str(f) == ch.file or f.name == ch.file]
+    hits = [f for f in files if str(f) == ch.file] or [f for f in files if f.name == ch.file]
     if not hits:
         raise SetupError(f"{where} file: {ch.file!r} is not among the files given ({', '.join(str(f) for f in files)})")
+    if len({f.resolve() for f in hits}) > 1:  # one name in two folders: which one holds the gauge cannot be guessed
+        raise SetupError(f"{where} file: {ch.file!r} names {len(hits)} of the files given "
+                         f"({', '.join(str(f) for f in hits)}); write the file's path as given instead")
     return hits[0]
 
 

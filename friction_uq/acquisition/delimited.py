@@ -82,7 +82,11 @@ def _index(path: Path, key: str | int, header: list[str], header_line: int | Non
             raise ScopeFileError(f"{path}: column {key} asked for, the data rows have {ncols} columns")
         return key - 1
     low = [c.lower() for c in header]
-    i = header.index(key) if key in header else low.index(key.lower())
+    same = [j for j, c in enumerate(header) if c == key] or [j for j, c in enumerate(low) if c == key.lower()]
+    if len(same) > 1:  # two columns of one name: which is the gauge's cannot be guessed
+        raise ScopeFileError(f"{path}: column {key!r} is the name of columns {', '.join(str(j + 1) for j in same)} "
+                             f"on the header line {header_line}; give the column by its number instead")
+    i = same[0]
     if i >= ncols:
         raise ScopeFileError(f"{path}: column {key!r} (number {i + 1} on the header line {header_line}) has no "
                              f"numbers: the data rows have {ncols} columns")
