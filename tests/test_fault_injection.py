@@ -364,6 +364,7 @@ def _scaled_channel(fh):
     (lambda fh: fh[f"{SIG}/input_bar"].write_direct(fh[f"{SIG}/input_bar"][()] * 1e3), "/signals/input_bar",
      "check its units"),  # mm/m: 1000 times too large
     (_set("/", striker_velocity=1e4), "/@striker_velocity", "outside the plausible range"),
+    (_set("/", test_id=np.bytes_(b"\xff\xfe")), "/@test_id", "is not UTF-8 text"),  # once named its outputs A___
     (_same_channel, "/signals/external_output_bar", "holds the same samples as /signals/internal_output_bar"),
     (_scaled_channel, "/signals/external_output_bar", "is /signals/internal_output_bar multiplied by a constant"),
 ])
