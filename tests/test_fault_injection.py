@@ -774,3 +774,17 @@ def test_an_output_channel_off_by_a_factor_gets_no_f(record_copy, capsys):
         assert "/signals/internal_output_bar looks 1" in msg and "times too small" in msg
         assert "f reads the output forces' ratio" in msg
     assert not (path.parent / "out").exists()
+
+
+def test_a_prior_whose_support_leaves_out_the_datas_f_starts_inside_it(tmp_path, capsys):
+    """[f] uniform on [0.1, 1], a valid prior: the sampler once started at the data's f (0.049), where it has no
+    density, and refused the record naming no key; it starts at the support's nearest end, and the prior-data check
+    says the priors drive the result."""
+    text = (PRIORS_DIR / "I1.toml").read_text()
+    start, end = text.index("[f]"), text.index("[nu]")
+    prior = tmp_path / "f-uniform.toml"
+    prior.write_text(text[:start] + '[f]\ndistribution = "uniform"\nlower = 0.1\nupper = 1.0\n\n' + text[end:])
+    record = REPO / "data" / "A" / "A-01.h5"
+    assert _code(["run", record, "--priors", prior, "--no-pdf", "--quiet", "--out", tmp_path / "out"]) == 0
+    doc = json.loads((tmp_path / "out" / "A_A-01.json").read_text())
+    assert doc["f_stationary"]["q05"] >= 0.1 and any("prior-data conflict" in w for w in doc["warnings"])

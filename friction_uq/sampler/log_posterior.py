@@ -66,6 +66,9 @@ def _initial_guess(likelihood: Likelihood, priors: Priors) -> np.ndarray:
     sd_r = math.hypot(d.sd_eo, r0 * d.sd_io) / (abs(float(np.mean(d.F_io))) * math.sqrt(d.n))
     r = max(r0, 3.0 * sd_r, 1e-6)
     f = float(math.log1p(r) / cell.beta(nu, radius=d.radius, length=d.length))
+    if not np.isfinite(priors["f"].logpdf(np.array([f]))[0]):  # the data's f outside a prior's support (uniform on
+        lo, _ = priors["f"].support                             # [0.1, 1], say): start at its nearest end, inside
+        f = float(priors["f"].ppf(1e-6 if f < lo else 1.0 - 1e-6))
     values = {n: float(priors[n].ppf(0.5)) for n in likelihood.names}
     values.update(f=f, nu=nu)
     return likelihood.parameters.vector(values)
