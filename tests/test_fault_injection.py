@@ -788,3 +788,13 @@ def test_a_prior_whose_support_leaves_out_the_datas_f_starts_inside_it(tmp_path,
     assert _code(["run", record, "--priors", prior, "--no-pdf", "--quiet", "--out", tmp_path / "out"]) == 0
     doc = json.loads((tmp_path / "out" / "A_A-01.json").read_text())
     assert doc["f_stationary"]["q05"] >= 0.1 and any("prior-data conflict" in w for w in doc["warnings"])
+
+
+def test_a_prior_file_of_another_material_is_said(tmp_path, capsys):
+    """--priors with a file for PMMA on a record of I1 was used silently (campaigns refuse mixed materials)."""
+    prior = tmp_path / "PMMA.toml"
+    prior.write_text((PRIORS_DIR / "I1.toml").read_text().replace('material = "I1"', 'material = "PMMA"', 1))
+    record = REPO / "data" / "A" / "A-01.h5"
+    assert _code(["run", record, "--priors", prior, "--no-pdf", "--quiet", "--out", tmp_path / "out"]) == 0
+    notes = json.loads((tmp_path / "out" / "A_A-01.json").read_text())["notes"]
+    assert any("is for material 'PMMA', the record's sample is 'I1'" in n for n in notes)

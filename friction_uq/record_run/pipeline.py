@@ -161,6 +161,10 @@ def _announce(s: RunSetup, voice: _Voice, *, check: bool, alongside: bool) -> No
               f"{s.prepared.window.t1 * 1e6:.1f} us, hoop term {'on' if s.use_hoop else 'off'}, priors {s.prior_path}")
     if s.hoop_left_out:
         voice.note(f"the hoop gauge is left out of the likelihood: {s.hoop_left_out}")
+    sample = s.record.apparatus.sample.material
+    if s.priors.material and sample and s.priors.material != sample:  # --priors of another material: said, not refused
+        voice.note(f"the prior file {s.prior_path} is for material {s.priors.material!r}, the record's sample is "
+                   f"{sample!r}: its nu prior is another material's unless you meant it")
     if check:
         voice.say("the whole test simulated and fitted to every gauge " + ("(alongside the sampling)" if alongside
                                                                            else "(after the sampling)"))
