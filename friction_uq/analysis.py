@@ -6,6 +6,7 @@ starting point of the Bayesian one.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,11 +96,19 @@ def prepare(
     return Prepared(record, forces, win, data, notes + flat_run_findings(record) + tuple(speed))
 
 
+#: An output channel's scale off by this factor or more (an order of magnitude: a unit, a decade of gain, not a gauge
+#: factor or a gain's drift) leaves no f to warn about: the record is refused. Below it the finding is a warning, as
+#: strongly coloured noise on a short pre-trigger can still make a sound external bar look a few times off (one A-03
+#: draw of 40 at lag-1 0.995: "5.24 times too small").
+REFUSED_SCALE = 10.0
+
+
 def _refuse_an_output_scale(record: Record, scaled: list[GaugeFinding]) -> None:
-    """An output channel off by a factor (:func:`~friction_uq.gauge_scale.scale_findings`) moves eq. 17's ratio, f's
-    own, by that factor: refused, naming the channel and the fix (checked once the window is found, so that a record
-    without a stationary phase is refused for that)."""
-    off = [g for g in scaled if g.kind == "scale" and g.channel in ("internal_output_bar", "external_output_bar")]
+    """An output channel off by :data:`REFUSED_SCALE` or more (:func:`~friction_uq.gauge_scale.scale_findings`) moves
+    eq. 17's ratio, f's own, by that factor: refused, naming the channel and the fix (checked once the window is
+    found, so that a record without a stationary phase is refused for that)."""
+    off = [g for g in scaled if g.kind == "scale" and g.channel in ("internal_output_bar", "external_output_bar")
+           and g.restoring_factor is not None and abs(math.log10(g.restoring_factor)) >= math.log10(REFUSED_SCALE)]
     if off:
         raise SignalError(f"{record.path}: {off[0].sentence}; f reads the output forces' ratio, which that channel's "
                           "scale moves by the same factor")

@@ -52,6 +52,9 @@ class GaugeFinding:
     channel: str
     kind: str
     sentence: str
+    #: For a channel's scale (kind "scale", one channel named): the factor that multiplied into the channel restores
+    #: the balance (:func:`~friction_uq.gauge_scale.scale_findings`); None otherwise.
+    restoring_factor: float | None = None
 
 
 def loading_mask(forces: Forces) -> np.ndarray:

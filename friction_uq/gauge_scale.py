@@ -114,7 +114,7 @@ def scale_findings(forces: Forces, apparatus: Apparatus, *,
         return []
     return [GaugeFinding(channel, "scale", (
         f"/signals/{channel} looks {_off(a)}: {evidence}; multiplying that channel by {a:.3g} "
-        "restores both (check its strain_per_volt, gauge factor, amplifier gain or units)"))]
+        "restores both (check its strain_per_volt, gauge factor, amplifier gain or units)"), restoring_factor=a)]
 
 
 def gauge_and_speed(findings: list[GaugeFinding]) -> tuple[list[GaugeFinding], list[GaugeFinding]]:

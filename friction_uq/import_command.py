@@ -7,6 +7,7 @@ until the command runs.
 from __future__ import annotations
 
 import argparse
+import os
 
 from .cli_arguments import path_argument
 
@@ -61,7 +62,7 @@ def run(args: argparse.Namespace, parser: argparse.ArgumentParser, output_check)
                      "(friction-uq import --template prints a SETUP.toml to start from)")
     output_check(args.output, (".h5", ".hdf5"), "record")
     for given in (*args.files, args.setup):  # --overwrite replaces an earlier record, never what is being read
-        if given.exists() and args.output.exists() and given.resolve() == args.output.resolve():
+        if given.exists() and args.output.exists() and os.path.samefile(given, args.output):  # a link too
             from .errors import OutputError
 
             raise OutputError(f"{args.output}: is one of the files being imported; give the record another name")

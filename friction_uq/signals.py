@@ -219,7 +219,10 @@ def pulse_front(
     s = sign * y
     stop = len(s) if span is None else min(len(s), i0 + span)
     peak = float(running_median(s[i0:stop], SPIKE_FILTER).max())  # a spike on the pulse is not its peak either
-    t50 = first_crossing(s, 0.5 * peak, start=max(start, i0 - 1))
+    j50 = max(start, i0 - 1)
+    while j50 > start and s[j50] >= 0.5 * peak:  # a noisy, slow front may be past half its peak already: back to
+        j50 -= 1                                 # the last sample below it, so the crossing straddles two samples
+    t50 = first_crossing(s, 0.5 * peak, start=j50)
     t10_start = start
     # walk back from the 50 % crossing to the last sample below 10 % of the peak
     j = int(np.floor(t50)) if t50 is not None else i0

@@ -54,13 +54,15 @@ def test_model_predicts_by_name_and_without_hoop():
 #: the window's levels. All four were recomputed (the likelihood code unchanged: the old data still give the old
 #: values) when a pulse's front and peak came to be found through a running median: the external bar's 50 % crossing
 #: had been a noise sample's, its pre-pulse segment now ends 12 samples earlier, the input bar's one later (their
-#: noise sds 2e-4 and 1.4e-3 relative apart).
+#: noise sds 2e-4 and 1.4e-3 relative apart). Recomputed again (the likelihood code unchanged) when the front's 50 %
+#: crossing came to be interpolated between two samples that straddle it: it had been extrapolated from two samples
+#: both past it where the external bar's slow, noisy front was past half its peak when its search began.
 THETA = np.array([[0.05, 0.4, 1.0], [0.06, 0.35, 1.05], [0.04, 0.45, 0.9]])
 FROZEN = {
-    "level": [-13017.093879454958, -13039.454754453895, -13022.345398798576],
-    "series": [9501.389974384558, -6734.5486487403305, 2642.8640240105833],
-    "series_no_axial": [9135.161666306736, -11755.22806521967, 5003.765844734973],
-    "force": [-13028.4893944436, -13033.599140297132, -13029.236674908718],
+    "level": [-13017.388951111066, -13039.947488359214, -13022.76161212877],
+    "series": [9501.094947345762, -6735.043373668865, 2642.4508139152167],
+    "series_no_axial": [9134.864339590269, -11755.729182446517, 5003.3529422420015],
+    "force": [-13028.784466106918, -13034.091870794051, -13029.652890352083],
 }
 
 

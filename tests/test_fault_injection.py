@@ -365,6 +365,8 @@ def _scaled_channel(fh):
      "check its units"),  # mm/m: 1000 times too large
     (_set("/", striker_velocity=1e4), "/@striker_velocity", "outside the plausible range"),
     (_set("/", test_id=np.bytes_(b"\xff\xfe")), "/@test_id", "is not UTF-8 text"),  # once named its outputs A___
+    (lambda fh: fh.attrs.create("test_id", b"A\xff01", dtype=h5py.string_dtype("utf-8")), "/@test_id",
+     "is not UTF-8 text"),  # a variable-length string's bytes come back as lone surrogates, not U+FFFD
     (_same_channel, "/signals/external_output_bar", "holds the same samples as /signals/internal_output_bar"),
     (_scaled_channel, "/signals/external_output_bar", "is /signals/internal_output_bar multiplied by a constant"),
 ])
@@ -766,7 +768,11 @@ def test_priors_refuse_before_writing_any_file(tmp_path, capsys):
 def test_an_output_channel_off_by_a_factor_gets_no_f(record_copy, capsys):
     """The internal bar's units written as microstrain for strain: analyze gave f = 4.40 (gauge notes beside it) and
     run stopped at its sampler's start, blaming the prior file; the scale's finding refuses both, naming the
-    channel."""
+    channel. Three times off, the finding stays a note (noise can make a sound gauge look a few times off)."""
+    tripled = _edit(record_copy("tripled.h5"), lambda fh: fh[f"{SIG}/internal_output_bar"].write_direct(
+        fh[f"{SIG}/internal_output_bar"][()] * 3.0))
+    assert _code(["analyze", tripled]) == 0
+    assert "gauge note: /signals/internal_output_bar looks 2.99 times too large" in capsys.readouterr().out
     path = _edit(record_copy(), _set(f"{SIG}/internal_output_bar", units="microstrain"))
     for command in (["analyze", path], ["run", path, "--no-pdf", "--quiet", "--out", path.parent / "out"]):
         assert _code(command) == 2

@@ -134,7 +134,6 @@ def test_a_window_found_from_the_ratio_alone_blames_no_gauge_when_none_is() -> N
     suspect = GaugeFinding("", "window", RATIO_WINDOW_NOTE + ", as the suspect gauge makes them")
     assert gauge_warning((blamed, suspect), f).startswith("A gauge disagrees with the others")
     assert gauge_warning((dataclasses.replace(unchecked, kind="balance"), window), f).startswith("A gauge disagrees")
-    assert gauge_warning((window,), f).startswith("A gauge disagrees")  # as before: the window's note alone
     assert gauge_warning((), f) is None
 
 

@@ -152,8 +152,8 @@ def test_the_written_record_follows_the_contract(tmp_path: Path) -> None:
         ("[record]\ndescription = \"x\\u0000y\"\n", "key 'record.description' holds a NUL character"),
         ("[record]\ntest_id = \"A\\n01\"\n", "key 'record.test_id' holds the control character '\\n'"),
         ("[record]\ncampaign = \"A\\u202e1\"\n", "key 'record.campaign' holds the control character '\\u202e'"),
-        ("[apparatus.sample]\nmaterial = \"/etc/passwd\"\n", "key 'apparatus.sample.material' is '/etc/passwd', "
-                                                            "not a material name"),
+        ("[apparatus.sample]\nmaterial = \"I1\\u0007\"\n", "key 'apparatus.sample.material' holds the control "
+                                                            "character '\\x07'"),
         ("[loading\nx = 1\n", "is not valid TOML"),
     ],
 )

@@ -41,9 +41,10 @@ class _Said(logging.Handler):
 
 
 @contextmanager
-def _open(path: Path) -> Iterator[Any]:
-    """The TDMS file with its metadata read and its data left on disk. npTDMS's warnings on a damaged file are not
-    printed (the command says one sentence); a refusal while the file is open names the first of them."""
+def _open(path: Path, describing: list[str] | None = None) -> Iterator[Any]:
+    """The TDMS file with its metadata read and its data left on disk. npTDMS's warnings (a damaged segment, an unknown
+    scaling) are not printed: a refusal while the file is open names the first of them, and a read that succeeds
+    with one is refused; ``describing`` (a listing's lines, ``--show``) gets it as a line instead."""
     check_size(path)
     nptdms = need("nptdms", path)
     log, said = logging.getLogger("nptdms"), _Said()  # npTDMS's module loggers propagate to it
@@ -62,10 +63,15 @@ def _open(path: Path) -> Iterator[Any]:
             yield f
         except ScopeFileError as exc:
             if said.said:
-                raise ScopeFileError(f"{exc}; npTDMS found the file damaged ({_short(said.said[0])})") from None
+                raise ScopeFileError(f"{exc}; npTDMS warned: {_short(said.said[0])}") from None
             raise
         finally:
             f.close()
+        if said.said and describing is None:  # the samples read may not be the file's (cut short, scaling unknown)
+            raise ScopeFileError(f"{path}: npTDMS warned while reading it: {_short(said.said[0])}; the samples read "
+                                 "may not be those recorded (a truncated file, a scaling npTDMS does not know)")
+        if said.said and describing is not None:
+            describing.append(f"  npTDMS warned: {_short(said.said[0])} (an import would refuse this file)")
     finally:
         log.removeHandler(said)
         if console is not None:
@@ -184,7 +190,8 @@ def read_tdms(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
 
 def describe_tdms(path: Path) -> list[str]:
     """A TDMS file's channels with their lengths and time bases, from its metadata alone (no sample is read)."""
-    with _open(path) as f:
+    warned: list[str] = []
+    with _open(path, warned) as f:
         out = [f"{path}: NI TDMS; column = \"group/channel\""]
         for name, c in _channels(f):
             t0, dt = _time_base(path, name, c)
@@ -192,4 +199,4 @@ def describe_tdms(path: Path) -> list[str]:
             what = _not_numeric(c)
             kind = f" of {what} (not numeric: cannot be imported)" if what else ""
             out.append(f"  \"{name}\"  {len(c)} samples{kind}{tb}")
-        return out
+    return out + warned

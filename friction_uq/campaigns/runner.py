@@ -66,12 +66,12 @@ def find_records(inputs: Sequence[str | os.PathLike[str]]) -> list[Path]:
 
 
 def _hdf5_signature(path: Path) -> bool:
-    """Whether ``path`` begins with the HDF5 signature (a damaged record does too; the job says what is wrong)."""
-    from ..plausible import HDF5_SIGNATURE
+    """Whether ``path`` holds the HDF5 signature (at byte 0 or after a user block, as h5py finds it; a damaged record
+    does too, and its job says what is wrong)."""
+    import h5py
 
     try:
-        with open(path, "rb") as fh:
-            return fh.read(len(HDF5_SIGNATURE)) == HDF5_SIGNATURE
+        return bool(h5py.is_hdf5(path))
     except OSError:
         return True  # unreadable: the job's own reading says why, in the campaign's table
 

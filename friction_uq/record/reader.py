@@ -143,8 +143,14 @@ def _read_header(fh: Any, r: Reader) -> dict[str, Any]:
         bad = unprintable(value)
         if bad:
             raise r.fail(f"/@{key}", f"{bad} ('{escaped(value)}'): an id is printed on terminals and names files")
-        if "\ufffd" in value:  # bytes that are not UTF-8, read with replacement: the id would name files A___
-            raise r.fail(f"/@{key}", f"is not UTF-8 text ('{value}' as read); an id names the output files")
+        try:  # bytes that are not UTF-8: h5py reads a string's as lone surrogates, a fixed-length one's as U+FFFD
+            value.encode("utf-8")
+            utf8 = "\ufffd" not in value
+        except UnicodeEncodeError:
+            utf8 = False
+        if not utf8:  # the id would name the output files A___
+            raise r.fail(f"/@{key}", f"is not UTF-8 text ({value.encode('utf-8', 'backslashreplace')!r} as read); an "
+                         "id names the output files")
     date = r.attr(fh, "/", "date", "str", required=False)
     if date is not None:
         try:

@@ -162,7 +162,7 @@ def _announce(s: RunSetup, voice: _Voice, *, check: bool, alongside: bool) -> No
     if s.hoop_left_out:
         voice.note(f"the hoop gauge is left out of the likelihood: {s.hoop_left_out}")
     sample = s.record.apparatus.sample.material
-    if s.priors.material and sample and s.priors.material != sample:  # --priors of another material: said, not refused
+    if s.priors.material and sample and s.priors.material.casefold() != sample.casefold():  # said, not refused
         voice.note(f"the prior file {s.prior_path} is for material {s.priors.material!r}, the record's sample is "
                    f"{sample!r}: its nu prior is another material's unless you meant it")
     if check:

@@ -12,7 +12,6 @@ from dataclasses import fields, replace
 from typing import Any
 
 from ..errors import ConfigError
-from ..plausible import is_name
 from ..record import Apparatus, Bar, Plug, Sample, Tube
 from ._checks import Section
 
@@ -42,9 +41,7 @@ def parse_apparatus(source: str, table: Any, app: Apparatus) -> Apparatus:
         new: dict[str, Any] = {}
         for key in sub:
             if key == "material":
-                new[key] = s.string(key, None)
-                if not is_name(new[key]):  # the prior file is looked up by it (friction_uq.prior_loader)
-                    raise s.fail(key, f"is {new[key]!r}, not a material name (letters, digits, '-' and '_' only)")
+                new[key] = s.string(key, None)  # printable, as the reader wants it (a name finds a prior file)
             elif key == "poisson_ratio":
                 new[key] = s.number(key, None, low=-1.0, high=0.499)
             elif key == "gauge_offset":
