@@ -127,7 +127,8 @@ def test_one_file_per_channel_semicolons_and_decimal_commas(tmp_path):
     assert_same_analysis(RECORD, tmp_path / "r.h5")
 
 
-def test_tdms_with_its_own_time_base(tmp_path):
+def _tdms_shot(tmp_path: Path) -> tuple[Path, dict]:
+    """A-03's gauges in one TDMS file with its own time base, and the set-up that reads it."""
     nptdms = pytest.importorskip("nptdms")
     strains, rate, t0 = gauge_signals(RECORD)
     chans = [nptdms.ChannelObject("scope", COLUMNS[g], eps / SPV[g],
@@ -140,6 +141,11 @@ def test_tdms_with_its_own_time_base(tmp_path):
     del doc["time"]  # TDMS carries its time base
     for g, c in COLUMNS.items():
         doc["channels"][g]["column"] = f"scope/{c}"
+    return path, doc
+
+
+def test_tdms_with_its_own_time_base(tmp_path):
+    path, doc = _tdms_shot(tmp_path)
     import_scope_files([path], parse_setup(doc, path=tmp_path / "SETUP.toml"), tmp_path / "r.h5")
     assert_same_analysis(RECORD, tmp_path / "r.h5")
 
@@ -662,19 +668,8 @@ def test_a_damaged_tdms_file_is_said_in_one_sentence(tmp_path, capfd, keep):
     """npTDMS's own warnings on a truncated file (printed to stderr before the refusal) are not printed; the refusal
     names the first of them. A file cut near its end reads without an error but with a warning: refused too (its
     samples are not all those recorded; they were imported silently)."""
-    nptdms = pytest.importorskip("nptdms")
-    strains, rate, t0 = gauge_signals(RECORD)
-    chans = [nptdms.ChannelObject("scope", COLUMNS[g], eps / SPV[g],
-                                  properties={"wf_increment": 1.0 / rate, "wf_start_offset": t0})
-             for g, eps in strains.items()]
-    path = tmp_path / "shot.tdms"
-    with nptdms.TdmsWriter(str(path)) as w:
-        w.write_segment([nptdms.RootObject(), nptdms.GroupObject("scope"), *chans])
+    path, doc = _tdms_shot(tmp_path)
     path.write_bytes(path.read_bytes()[: int(path.stat().st_size * keep)])
-    doc = setup_doc()
-    del doc["time"]
-    for g, c in COLUMNS.items():
-        doc["channels"][g]["column"] = f"scope/{c}"
     setup = write_setup(tmp_path / "SETUP.toml", doc)
     assert main(["import", str(path), "--setup", str(setup), "-o", str(tmp_path / "r.h5")]) == 2
     err = capfd.readouterr().err
