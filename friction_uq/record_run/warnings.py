@@ -160,7 +160,8 @@ def gauge_warning(findings: Sequence[GaugeFinding], f: VariableSummary) -> str |
 
 
 def flat_run_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
-    """A gauge's peak on one value that may be a saturated digitiser (:func:`friction_uq.gauge_check.flat_run_findings`)."""
+    """A gauge's peak on one value that may be a saturated digitiser
+    (:func:`friction_uq.gauge_check.flat_run_findings`)."""
     if not notes:
         return None
     return (f"{'; '.join(notes)}. A clipped gauge reads less than it carried, and {_f_text(f)} with it: check the "
