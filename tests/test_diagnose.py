@@ -985,3 +985,25 @@ def test_a_record_without_a_hoop_gauge_is_diagnosed_without_words_of_one(tmp_pat
     text = "\n".join(page.extract_text() for page in PdfReader(js.with_suffix(".pdf")).pages)
     assert "eq. 17 + hoop" not in text and "hoop gauge gain" not in text
     assert "the hoop gauge left out" in text
+
+
+def test_a_sample_that_does_not_slide_has_an_effective_f_prior_for_every_law(tmp_path):
+    """f = 1.5: the sample sticks, the window's mean V and slip are noise around zero (-4e-4 m/s on one draw). A
+    negative speed or slip made the velocity and slip laws' f_effective fall with f, and `run --diagnose` ended in an
+    internal error; the laws read them as magnitudes, so the context holds none below zero and each law's prior of
+    f_effective is computed."""
+    from scipy import stats
+
+    from friction_uq.discrepancy.effective_prior import log_prior_f_effective
+    from friction_uq.discrepancy.extended import Diagnoser
+
+    path = tmp_path / "stuck.h5"
+    simulate_to_file(noisy_config(friction_params=MappingProxyType({"f": 1.5})), path, seed=7)
+    prep = prepare(read_record(path))
+    dg = Diagnoser(prep, lambda v: 0.0, hoop=True, seed=1)
+    assert dg.context.V >= 0.0 and dg.context.slip >= 0.0
+    for name in ("velocity_friction", "slip_friction"):
+        variant = SimpleNamespace(mechanism=MECHANISMS[name], label=name)
+        out, _ = log_prior_f_effective([variant], dg.context, stats.halfnorm(scale=0.3), np.array([0.05, 1.2]),
+                                       rng=np.random.default_rng(0))
+        assert out.shape == (2,)

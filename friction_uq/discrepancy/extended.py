@@ -124,7 +124,9 @@ class Diagnoser:
         self.block = max(1, int(round(BLOCK * rec.sample_rate)))
         d = prep.data
         tau = float(np.mean(d.F_eo)) / (2.0 * math.pi * d.radius * d.length)  # eq. 18, 20
-        self.context = Context(V=float(np.mean(d.V)), tau_mean=tau, slip=float(np.mean(d.slip)))
+        # a sample that does not slide has a window mean V and slip of either sign within the noise; the laws of the
+        # catalogue read speed and slip as magnitudes (a negative one made f_effective fall with f: an internal error)
+        self.context = Context(V=max(float(np.mean(d.V)), 0.0), tau_mean=tau, slip=max(float(np.mean(d.slip)), 0.0))
         self.base_scales = dict(base_scales or {})
         #: f and nu of the stationary analysis: with the header's modulus, a second start of every extended fit
         self.nominal = dict(nominal or {})
