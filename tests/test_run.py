@@ -316,3 +316,19 @@ def test_the_prior_data_warning_is_said_once_as_a_warning():
                                 flagged=("nu",), threshold=0.05)
     said = conflict_warning(flagged)
     assert said.startswith("The priors, not the data, drive the result - nu:") and "WARNING" not in said
+
+
+def test_a_page_title_stays_on_the_page_whatever_the_test_id():
+    """A test id of 100 letters ran off both sides of every page's title, and a Hebrew or Chinese one printed as
+    '?' (the standard fonts encode Latin-1 only): the title is written with escapes for what Latin-1 lacks, at
+    most two lines long, wrapped within the page."""
+    from friction_uq.report.style import TITLE_CHARS, TITLE_WORD, figure, title_text
+
+    hebrew = title_text("2. Record \u05d0\u05d1 \u6f22\u5b57: gauges")
+    assert hebrew == "2. Record \\u05d0\\u05d1 \\u6f22\\u5b57: gauges" and max(map(ord, hebrew)) < 256
+    long = title_text("friction-uq report: " + "M" * 100 + " " + "W" * 100 + " (sample I1)")
+    assert len(long) <= TITLE_CHARS + 10 and long.endswith("...") and max(map(len, long.split())) <= TITLE_WORD
+    fig, _ = figure("friction-uq report: " + "M" * 64 + " A (sample I1)")
+    fig.canvas.draw()
+    box = fig._suptitle.get_window_extent(fig.canvas.get_renderer())
+    assert 0 <= box.x0 and box.x1 <= fig.bbox.x1

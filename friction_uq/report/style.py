@@ -46,11 +46,31 @@ class _SameFontOtherWeight(logging.Filter):
 logging.getLogger("matplotlib.font_manager").addFilter(_SameFontOtherWeight())
 
 
+#: Longest run of characters without a space in a page title: matplotlib wraps a title at spaces only.
+TITLE_WORD = 40
+#: Longest page title, in characters: two lines of the title's font across an A4 page, above the page's text.
+TITLE_CHARS = 200
+
+
+def title_text(title: str) -> str:
+    """``title`` as the core fonts can print it and matplotlib can wrap it: characters outside Latin-1 (which the core
+    fonts print as '?': a Hebrew or Chinese test id read "???? ????") written as escapes such as \\u05d0, at most
+    :data:`TITLE_CHARS` characters, and words longer than :data:`TITLE_WORD` characters (a test id of 100 letters ran
+    off both sides of the page) broken."""
+    text = title.encode("latin-1", "backslashreplace").decode("latin-1")
+    if len(text) > TITLE_CHARS:  # at most two lines: the page's own text starts below them
+        text = text[:TITLE_CHARS - 3] + "..."
+    words = []
+    for word in text.split(" "):
+        words += [word[i:i + TITLE_WORD] for i in range(0, len(word), TITLE_WORD)] or [word]
+    return " ".join(words)
+
+
 def figure(title: str, *, nrows: int = 1, ncols: int = 1, **kw):
-    """A titled A4-landscape figure with a grid of axes."""
+    """A titled A4-landscape figure with a grid of axes; the title wrapped within the page (:func:`title_text`)."""
     with plt.rc_context(RC):
         fig, axes = plt.subplots(nrows, ncols, figsize=A4_LANDSCAPE, **kw)
-    fig.suptitle(title)
+    fig.suptitle(title_text(title), wrap=True)
     return fig, axes
 
 
