@@ -140,8 +140,10 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
 def page_extended_fit(dg: Diagnosis, *, test: str) -> Figure:
     a, b = dg.baseline_comparison, dg.final_comparison
     chans = [c for c in CHANNEL_LABELS if c in a.spans]
-    fig, axes = figure(f"{test}: residuals of the baseline and of '{dg.final.label}'", nrows=len(chans), ncols=1,
-                       sharex=False)
+    alone = not dg.final.variants  # nothing named: the baseline's residuals, not compared with themselves
+    what = ("residuals of the baseline (no cause named: no extended model to compare)" if alone else
+            f"residuals of the baseline and of '{dg.final.label}'")
+    fig, axes = figure(f"{test}: {what}", nrows=len(chans), ncols=1, sharex=False)
     axes = np.atleast_1d(axes)
     for ax, ch in zip(axes, chans):
         i0, i3 = a.spans[ch]
@@ -149,7 +151,8 @@ def page_extended_fit(dg: Diagnosis, *, test: str) -> Figure:
         t = a.time[i0:i3] * 1e6
         ax.axvspan(a.time[iw0] * 1e6, a.time[max(iw1 - 1, iw0)] * 1e6, color="0.88", zorder=0)
         ax.plot(t, a.standardised(ch)[i0:i3], color="0.5", lw=0.5, label="baseline", rasterized=True)
-        ax.plot(t, b.standardised(ch)[i0:i3], color="tab:red", lw=0.5, label=dg.final.label, rasterized=True)
+        if not alone:
+            ax.plot(t, b.standardised(ch)[i0:i3], color="tab:red", lw=0.5, label=dg.final.label, rasterized=True)
         ax.axhline(2, color="tab:blue", ls="--", lw=0.6)
         ax.axhline(-2, color="tab:blue", ls="--", lw=0.6)
         rms = dg.rms.get(ch, {})
