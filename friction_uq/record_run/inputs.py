@@ -77,6 +77,13 @@ def hoop_unusable(p: Prepared) -> str | None:
     for finding in hoop_findings(p.forces, p.record.apparatus, info.noise.sd):
         if finding.kind == "reversed":  # a reversed gauge's pulse is not "no pulse": say what it is
             return finding.sentence
+    return hoop_silence(p)
+
+
+def hoop_silence(p: Prepared) -> str | None:
+    """Why the hoop gauge reads nothing a swelling tube makes (no pulse above its noise, or no swelling over the
+    window), or None. A dead bridge and a sample that hardly swells (nu near 0) read alike."""
+    info = p.forces.channels["tube_hoop"]
     if not info.detected:
         return "tube_hoop shows no pulse above its noise (a dead or disconnected gauge?)"
     se = info.noise.window_mean_sd(p.data.n)

@@ -213,7 +213,8 @@ def _warnings(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck | No
     levels = lik.force if isinstance(lik.force, LevelForceTerm) else LevelForceTerm(s.prepared.data)
     return run_warnings(ppc=post.ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=post.summary["f"],
                         lab=s.lab, conv=post.convergence, conflict=post.conflict, check=wrc,
-                        findings=s.prepared.findings, diagnosis=diag)
+                        findings=s.prepared.findings, diagnosis=diag,
+                        hoop_silent=s.hoop_left_out if s.hoop_silent else None)
 
 
 def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck, *, diagnose: bool, seed: int,

@@ -41,7 +41,7 @@ from ..sampler import PosteriorSamples, likelihood_priors, sample_posterior, std
 from ..settings import AnalysisSettings
 from ..window_halves import WindowHalves, window_halves
 from .._atomic import check_unlocked
-from .inputs import alternative_nu_priors, hoop_unusable, sliding_velocity_summary
+from .inputs import hoop_silence, alternative_nu_priors, hoop_unusable, sliding_velocity_summary
 from .outputs import safe_stem
 
 if TYPE_CHECKING:
@@ -65,6 +65,13 @@ class RunSetup:
     names: dict[str, Path]  # "netcdf", "pdf", "json" -> the output's path
     lab: Identification  # the lab's analysis: eq. 17 at the nominal nu (the prior's median)
     halves: WindowHalves | None  # kappa's change across the window (the JSON's and the report's), or None
+
+    @property
+    def hoop_silent(self) -> bool:
+        """The hoop gauge left out because it reads nothing a swelling tube makes (:func:`.inputs.hoop_silence`): a
+        dead bridge, or a sample that hardly swells."""
+        return (self.hoop_left_out is not None and self.prepared.data.hoop is not None
+                and self.hoop_left_out == hoop_silence(self.prepared))
 
 
 def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | None, out_dir: Path, *,

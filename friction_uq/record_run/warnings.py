@@ -159,6 +159,17 @@ def gauge_warning(findings: Sequence[GaugeFinding], f: VariableSummary) -> str |
             "ratio and is off by as much as their gains are; `friction-uq diagnose` fits a gauge's gain.")
 
 
+def hoop_silence_warning(reason: str | None, f: VariableSummary) -> str | None:
+    """The hoop gauge, the record's only witness of nu, left out because it reads nothing a swelling tube makes
+    (:func:`friction_uq.record_run.inputs.hoop_silence`): nu then comes from the prior file alone, and f with it."""
+    if not reason:
+        return None
+    return (f"The hoop gauge is left out: {reason}. It is the record's only witness of nu, so nu comes from the "
+            f"prior file alone and {_f_text(f)} follows it (f = kappa (1 - nu) / nu, eq. 17); a dead bridge and a "
+            "sample that hardly swells (nu near 0) read alike: if the sample's nu may be far from the prior's, so may "
+            "f.")
+
+
 def flat_run_warning(notes: Sequence[str], f: VariableSummary) -> str | None:
     """A gauge's peak on one value that may be a saturated digitiser
     (:func:`friction_uq.gauge_check.flat_run_findings`)."""
@@ -208,7 +219,7 @@ def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
                  conv: Convergence, conflict: PriorDataConflict | None,
                  check: WholeRecordCheck | None, findings: Sequence[GaugeFinding] = (),
-                 diagnosis=None) -> list[str]:
+                 diagnosis=None, hoop_silent: str | None = None) -> list[str]:
     """Every check's warning, in the order a reader should see them; empty when all pass. ``findings``: the gauge
     checks' (:attr:`friction_uq.analysis.Prepared.findings`), told apart by kind."""
     flat = [g.sentence for g in findings if g.kind == "flat"]
@@ -216,7 +227,8 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
     gauges = [g for g in findings if g.kind not in ("flat", "striker")]
     found: Sequence[str | None] = (
         flat_run_warning(flat, f), gauge_warning(gauges, f) or equilibrium_warning(lab, f),
-        speed_warning(speed), stationarity_warning(ppc, excess_spread, dof, f, lab),
+        speed_warning(speed), hoop_silence_warning(hoop_silent, f),
+        stationarity_warning(ppc, excess_spread, dof, f, lab),
         misfit_warning(check, f, diagnosis),
         convergence_warning(conv), exact_posterior_warning(diagnosis), conflict_warning(conflict),
     )
