@@ -76,8 +76,8 @@ def prepare(
     if wired:  # a wiring fault: the record is to be mended at its source, not analysed
         raise SignalError(f"{record.path}: {wired[0].sentence}")
     # a channel's scale off by a factor (a gauge factor, a unit: eq. 5, 6 and 14): an output channel's moves f itself
-    # (refused, as inspect refuses it); the input bar's, or one every channel shares, leaves f's ratio as it is but not
-    # the forces, the pressure and the velocity: said, as the balance's notes are
+    # (refused from ten times, :func:`_refuse_an_output_scale`; a warning below); the input bar's, or one every channel
+    # shares, leaves f's ratio as it is but not the forces, the pressure and the velocity: said, as the balance's are
     scaled, speed = gauge_and_speed(scale_findings(forces, record.apparatus, striker_velocity=record.striker_velocity))
     notes = tuple(findings + scaled)
     if window is None:
