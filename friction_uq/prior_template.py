@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import json
 
-from .plausible import out_of_range, unprintable
+from .plausible import RANGES, out_of_range, unprintable
 
-NU_MIN, NU_MAX = 0.01, 0.49
+#: The starting files' alternative nu priors keep within these (the lower bound the records' own, plausible.RANGES)
+NU_MIN, NU_MAX = RANGES["sample.poisson_ratio"][0], 0.49
 
 _COMMON_F = """\
 [f]

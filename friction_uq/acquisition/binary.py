@@ -117,20 +117,19 @@ def read_rigolwfm(path: Path, columns: list[str | int]) -> dict[str | int, Trace
     picked = {col: _pick_channel(path, chans, col) for col in columns}
     out: dict[str | int, Trace] = {}
     for col, c in picked.items():
-        t = np.asarray(c.times, dtype=np.float64)
-        step = _channel_interval(path, c)
+        t0, step = _channel_time_base(path, c)
         dt = _rate_digits(step, 9) if step is not None else None
-        out[col] = Trace(np.asarray(c.volts, dtype=np.float64), c.name, float(t[0]), dt)
+        out[col] = Trace(np.asarray(c.volts, dtype=np.float64), c.name, t0, dt)
     return out
 
 
-def _channel_interval(path: Path, channel: Any) -> float | None:
-    """A RigolWFM channel's sample interval from its times (None for a single sample), checked positive."""
+def _channel_time_base(path: Path, channel: Any) -> tuple[float, float | None]:
+    """A RigolWFM channel's start and sample interval from its times (None for a single sample), checked positive."""
     t = np.asarray(channel.times, dtype=np.float64)
     if len(t) < 2:
-        return None
-    return _sample_interval(path, float((t[-1] - t[0]) / (len(t) - 1)),
-                            f"channel {channel.name}'s time base (its header's sample interval)")
+        return float(t[0]), None
+    return float(t[0]), _sample_interval(path, float((t[-1] - t[0]) / (len(t) - 1)),
+                                         f"channel {channel.name}'s time base (its header's sample interval)")
 
 
 def read_binary(path: Path, columns: list[str | int]) -> dict[str | int, Trace]:
@@ -157,7 +156,7 @@ def describe_binary(path: Path) -> list[str]:
     out = [f"{path}: {w.header_name} waveform; column = the channel number"]
     for c in w.channels:
         if getattr(c, "volts", None) is not None and len(c.volts):
-            dt = _channel_interval(path, c)
-            base = f" every {dt:.6g} s from {float(np.asarray(c.times)[0]):.6g} s" if dt is not None else ""
+            t0, dt = _channel_time_base(path, c)
+            base = f" every {dt:.6g} s from {t0:.6g} s" if dt is not None else ""
             out.append(f"  {c.channel_number} ({c.name}): {len(c.volts)} samples{base}")
     return out

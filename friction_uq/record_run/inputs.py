@@ -60,14 +60,15 @@ def alternative_nu_priors(default_path: Path, priors: Priors) -> dict[str, Prior
 
 
 def hoop_unusable(p: Prepared) -> str | None:
-    """Why the hoop gauge cannot enter the likelihood for this record, or None if it can.
+    """Why the hoop gauge cannot enter the likelihood for this record, or None if it can:
+    :func:`hoop_fault` (a reversed gauge, another tube) or :func:`hoop_silence` (no pulse, no swelling)."""
+    return hoop_fault(p) or hoop_silence(p)
 
-    * the gauge reads the tube contracting through the loading (reversed: :func:`~friction_uq.gauge_check.hoop_findings`);
-    * the channel shows no pulse above its noise (a dead or disconnected gauge);
-    * its window mean is not a swelling beyond 3 standard errors (noise of the mean and offset);
-    * the tube differs from the one the influence function was fitted to (bore 10 mm, outer
-      24 mm, nu_t 0.29; docs/physics.md section 6): the kernel would be wrong.
-    """
+
+def hoop_fault(p: Prepared) -> str | None:
+    """A hoop gauge that reads something other than this model's: the tube contracting through the loading
+    (reversed: :func:`~friction_uq.gauge_check.hoop_findings`), or a tube other than the one the influence function
+    was fitted to (bore 10 mm, outer 24 mm, nu_t 0.29; docs/physics.md section 6: the kernel would be wrong)."""
     t = p.record.apparatus.tube
     if not (abs(t.inner_diameter - 0.010) < 1e-6 and abs(t.outer_diameter - 0.024) < 1e-6
             and abs(t.poisson_ratio - 0.29) < 1e-3):
@@ -77,7 +78,7 @@ def hoop_unusable(p: Prepared) -> str | None:
     for finding in hoop_findings(p.forces, p.record.apparatus, info.noise.sd):
         if finding.kind == "reversed":  # a reversed gauge's pulse is not "no pulse": say what it is
             return finding.sentence
-    return hoop_silence(p)
+    return None
 
 
 def hoop_silence(p: Prepared) -> str | None:

@@ -41,7 +41,7 @@ from ..sampler import PosteriorSamples, likelihood_priors, sample_posterior, std
 from ..settings import AnalysisSettings
 from ..window_halves import WindowHalves, window_halves
 from .._atomic import check_unlocked
-from .inputs import hoop_silence, alternative_nu_priors, hoop_unusable, sliding_velocity_summary
+from .inputs import alternative_nu_priors, hoop_fault, hoop_silence, sliding_velocity_summary
 from .outputs import safe_stem
 
 if TYPE_CHECKING:
@@ -59,19 +59,15 @@ class RunSetup:
     settings: AnalysisSettings
     alternatives: dict[str, Priors]  # the nu priors f is also shown under (the one used: "default")
     hoop_left_out: str | None  # why the hoop gauge is left out of the likelihood, or None
+    #: left out because it reads nothing a swelling tube makes (:func:`.inputs.hoop_silence`): a dead bridge, or a
+    #: sample that hardly swells
+    hoop_silent: bool
     use_hoop: bool
     likelihood: Likelihood  # built once, passed to every stage that needs it
     stem: str
     names: dict[str, Path]  # "netcdf", "pdf", "json" -> the output's path
     lab: Identification  # the lab's analysis: eq. 17 at the nominal nu (the prior's median)
     halves: WindowHalves | None  # kappa's change across the window (the JSON's and the report's), or None
-
-    @property
-    def hoop_silent(self) -> bool:
-        """The hoop gauge left out because it reads nothing a swelling tube makes (:func:`.inputs.hoop_silence`): a
-        dead bridge, or a sample that hardly swells."""
-        return (self.hoop_left_out is not None and self.prepared.data.hoop is not None
-                and self.hoop_left_out == hoop_silence(self.prepared))
 
 
 def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | None, out_dir: Path, *,
@@ -85,8 +81,13 @@ def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | N
     prep = prepare(record, window=window, dispersion=dispersion)
     settings = AnalysisSettings(window=window, dispersion=dispersion, hoop=hoop)
     alternatives = alternative_nu_priors(p_path, priors)
-    left_out = None if not settings.hoop else (
-        hoop_unusable(prep) if prep.data.hoop is not None else "the record has no hoop gauge (/signals/tube_hoop)")
+    left_out, silent = None, False
+    if settings.hoop and prep.data.hoop is None:
+        left_out = "the record has no hoop gauge (/signals/tube_hoop)"
+    elif settings.hoop:
+        fault = hoop_fault(prep)
+        silence = None if fault else hoop_silence(prep)
+        left_out, silent = fault or silence, silence is not None
     use_hoop = bool(settings.hoop and prep.data.hoop is not None and left_out is None)
     likelihood = Likelihood(prep.data, hoop=use_hoop, axial_poisson=settings.axial_poisson,
                             hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy,
@@ -97,7 +98,7 @@ def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | N
         if p.is_dir():
             raise OutputError(f"{p}: cannot write the output, a directory has that name")
     lab = identify(prep, nu=round(float(priors["nu"].ppf(0.5)), 3))
-    return RunSetup(record, p_path, priors, prep, settings, alternatives, left_out, use_hoop, likelihood, stem,
+    return RunSetup(record, p_path, priors, prep, settings, alternatives, left_out, silent, use_hoop, likelihood, stem,
                     names, lab, window_halves(prep.data))
 
 
