@@ -335,6 +335,44 @@ def test_unknown_unit_is_named(tmp_path, scope_csv, capsys):
     assert "SETUP.toml: [channels.tube_hoop] units: is 'mv'; allowed: V, mV, strain, microstrain" in err
 
 
+def _units_row(csv: Path, row: str) -> None:
+    lines = csv.read_text().splitlines()
+    at = lines.index("s,V,V,V,V")
+    lines[at] = row
+    csv.write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize("row, key, words", [
+    ("s,V,mV,V,V", "[channels.internal_output_bar] units: is 'V', but",
+     "gives column 'CH2' (number 3) in mV by its units row (line 7); write units = \"mV\""),
+    ("(us),(V),(V),(V),(V)", "[time] units: is 's', but",
+     "gives the time column 'Time' (number 1) in us by its units row (line 7); write [time] units = \"us\""),
+    ("second,Volt,Volt,uV,Volt", "[channels.external_output_bar] units: is 'V', but",
+     "in uV by its units row (line 7); write the channel's numbers in V or mV (SETUP.toml has no uV)"),
+    ("s,s,V,V,V", "[channels.input_bar] units: is 'V', but",
+     "in s by its units row (line 7); the file gives its unit as s, a time: is it the time column?"),
+])
+def test_a_unit_the_file_writes_against_the_one_declared_is_refused(tmp_path, scope_csv, capsys, row, key, words):
+    """A units row that says otherwise than SETUP.toml: a thousand or a million times off, refused naming both."""
+    _units_row(scope_csv, row)
+    err = _refused(tmp_path, [scope_csv], setup_doc(), capsys)
+    assert key in err and words in err, err
+
+
+def test_a_unit_in_a_column_name_is_read_and_a_row_of_other_words_is_not_a_units_row(tmp_path, scope_csv, capsys):
+    _units_row(scope_csv, "Channel,probe 10:1,probe 10:1,probe 1:1,probe 1:1")  # words, not units: nothing said
+    text = scope_csv.read_text().replace("Time,CH1,CH2,CH3,CH4", "Time (s),CH1,CH2 [mV],CH3,CH4")
+    scope_csv.write_text(text)
+    doc = setup_doc(time={"column": "Time (s)"})
+    doc["channels"]["internal_output_bar"]["column"] = "CH2 [mV]"
+    err = _refused(tmp_path, [scope_csv], doc, capsys)
+    assert "gives column 'CH2 [mV]' (number 3) in mV by its name; write units = \"mV\"" in err, err
+    doc["channels"]["internal_output_bar"]["units"] = "mV"
+    doc["channels"]["internal_output_bar"]["strain_per_volt"] = SPV["internal_output_bar"] * 1e3  # (the volts written, read as mV)
+    import_scope_files([scope_csv], parse_setup(doc, path=tmp_path / "SETUP.toml"), tmp_path / "r.h5")
+    assert_same_analysis(RECORD, tmp_path / "r.h5")
+
+
 def test_a_gap_in_the_time_column_is_named(tmp_path, scope_csv, capsys):
     lines = scope_csv.read_text().splitlines()
     del lines[2000:2010]
@@ -489,7 +527,8 @@ def test_channels_already_in_strain_and_microstrain(tmp_path):
     cols = {"CH1": -strains["input_bar"], "CH2": strains["internal_output_bar"] * 1e6,
             "CH3": strains["external_output_bar"] * 1e6, "CH4": strains["tube_hoop"]}
     n = len(cols["CH1"])
-    csv = write_scope_csv(tmp_path / "strain.csv", t0 + np.arange(n) / rate, cols, preamble=("Amplifier,strain out",))
+    csv = write_scope_csv(tmp_path / "strain.csv", t0 + np.arange(n) / rate, cols, preamble=("Amplifier,strain out",),
+                          units=("strain", "microstrain", "microstrain", "strain"))
     doc = setup_doc()
     units = {"input_bar": "strain", "internal_output_bar": "microstrain", "external_output_bar": "microstrain",
              "tube_hoop": "strain"}
@@ -615,6 +654,7 @@ def test_a_non_finite_time_is_named_by_its_line(tmp_path, scope_csv, capsys):
     ({"column": "Time", "units": "ns"}, "SETUP.toml: [time] units: the sample rate from the time column 'Time' of "),
 ])
 def test_an_implausible_time_base_names_the_setup_key(tmp_path, scope_csv, capsys, time, words):
+    _units_row(scope_csv, "")  # no units row: the time base's own range is what refuses "ns"
     err = _refused(tmp_path, [scope_csv], setup_doc(time=time), capsys)
     assert words in err, err
 

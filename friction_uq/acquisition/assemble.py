@@ -25,7 +25,8 @@ from ..errors import RecordError, ScopeFileError, SetupError
 from ..plausible import not_regular
 from ..record.contract import FORMAT, FORMAT_VERSION
 from .binary import BINARY_SUFFIXES, Trace, read_binary
-from .delimited import read_delimited
+from .delimited import TextTable, read_delimited
+from .file_units import channel_unit_conflict, time_unit_conflict
 from .setup_file import ChannelSetup, Setup, load_setup
 from .timebase import time_base
 
@@ -88,6 +89,7 @@ def _read_file(setup: Setup, file: Path, chans: list[ChannelSetup]) -> list[Chan
                              "= the time column's name or number, or sample_rate (Hz) and t0 (s)")
         wanted = cols + ([time_col] if time_col is not None and time_col not in cols else [])
         table = read_delimited(file, wanted)
+        _check_units(setup, file, table, chans)
         traces = {k: Trace(v, table.labels[k]) for k, v in table.columns.items()}
         time = table.columns[time_col] if time_col is not None else None
         first = table.first_data_line
@@ -97,6 +99,23 @@ def _read_file(setup: Setup, file: Path, chans: list[ChannelSetup]) -> list[Chan
         t0, dt = time_base(setup, file, time, tr, first)
         out.append(Channel(c, file, tr.label, tr.values, t0, dt))
     return out
+
+
+def _check_units(setup: Setup, file: Path, table: TextTable, chans: list[ChannelSetup]) -> None:
+    """Refuse a channel or time column whose unit in the file (a units row, or its name's bracketed end) is not the
+    one SETUP.toml declares: the file's numbers would be read a thousand or a million times off."""
+    where = f"its units row (line {table.units_line})" if table.units_line else "its name"
+    for c in chans:
+        problem = channel_unit_conflict(table.units.get(c.column), c.units)
+        if problem:
+            raise SetupError(f"{setup.path}: [channels.{c.gauge}] units: is {c.units!r}, but {file} gives column "
+                             f"{table.labels[c.column]} in {table.units[c.column]} by {where}; {problem}")
+    ts = setup.time
+    if ts is not None and ts.column is not None:
+        problem = time_unit_conflict(table.units.get(ts.column), ts.units)
+        if problem:
+            raise SetupError(f"{setup.path}: [time] units: is {ts.units!r}, but {file} gives the time column "
+                             f"{table.labels[ts.column]} in {table.units[ts.column]} by {where}; {problem}")
 
 
 def _common_time_base(chans: list[Channel]) -> tuple[float, float, int]:

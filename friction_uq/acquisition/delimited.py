@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import io
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import ScopeFileError
 from ..plausible import MAX_SAMPLES
+from .file_units import suffix_unit, units_row
 from .text_layout import (
     DIALECT_NAMES,
     HEAD_LINES,
@@ -46,6 +47,10 @@ class TextTable:
     header_line: int | None
     delimiter: str | None
     decimal: str
+    #: the unit the file writes beside each column asked for (None: it says none this package knows), and the
+    #: line of the units row they came from (None: from the header's names, or no units at all)
+    units: dict[str | int, str | None] = field(default_factory=dict)
+    units_line: int | None = None
 
     @property
     def dialect(self) -> str:
@@ -74,6 +79,19 @@ def _header(path: Path, head: list[str], start: int, delim: str | None,
         if head[i].strip():
             return i, fields(head[i], delim)
     return None, []
+
+
+def _units(head: list[str], start: int, hline: int | None, named: bool, delim: str | None, ncols: int,
+           header: list[str], idx: list[int]) -> tuple[list[str | None], int | None]:
+    """Each asked column's unit, and the line of the units row it came from: the nearest line above the data when
+    it is a units row (:func:`.file_units.units_row`) and not the header that names the columns; else the
+    bracketed end of each column's name in the header (``Time (s)``)."""
+    above = next((i for i in range(start - 1, max(-1, start - 4), -1) if head[i].strip()), None)
+    if above is not None and not (named and above == hline):
+        row = units_row(fields(head[above], delim), ncols)
+        if row is not None:
+            return [row[i] for i in idx], above + 1
+    return [suffix_unit(header[i]) if named and i < len(header) else None for i in idx], None
 
 
 def _index(path: Path, key: str | int, header: list[str], header_line: int | None, ncols: int) -> int:
@@ -209,7 +227,9 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
         err = _locate_bad_cell(p, text.split("\n"), start, delim, dec, idx, labels, ncols)
         raise (err or ScopeFileError(f"{p}: cannot be read as a table from line {start + 1}: {exc}")) from None
     cols = {w: np.ascontiguousarray(data[:, uniq.index(i)]) for w, i in zip(wanted, idx)}
-    return TextTable(p, cols, dict(zip(wanted, labels)), start + 1, None if hline is None else hline + 1, delim, dec)
+    units, units_line = _units(head, start, hline, bool(names), delim, ncols, header, idx)
+    return TextTable(p, cols, dict(zip(wanted, labels)), start + 1, None if hline is None else hline + 1, delim, dec,
+                     dict(zip(wanted, units)), units_line)
 
 
 def describe_text(path: str | Path) -> list[str]:

@@ -9,7 +9,7 @@ channel or one file per channel.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -46,14 +46,15 @@ def _lines(columns: list[np.ndarray], fmt: str, delimiter: str, decimal: str) ->
 
 def write_scope_csv(path: str | os.PathLike[str], time: np.ndarray | None, volts: Mapping[str, np.ndarray], *,
                     delimiter: str = ",", decimal: str = ".", preamble: tuple[str, ...] = PREAMBLE,
-                    time_name: str = "Time", units_row: bool = True, fmt: str = "%.9e") -> Path:
+                    time_name: str = "Time", units_row: bool = True, fmt: str = "%.9e",
+                    units: Sequence[str] | None = None) -> Path:
     """One delimited file: preamble lines, a header (``time_name`` then the keys of ``volts``), an
-    optional units row, then the samples."""
+    optional units row (seconds, then ``units``: volts unless given), then the samples."""
     names = ([time_name] if time is not None else []) + list(volts)
     cols = ([time] if time is not None else []) + [np.asarray(v, float) for v in volts.values()]
     head = list(preamble) + [delimiter.join(names)]
     if units_row:
-        head.append(delimiter.join((["s"] if time is not None else []) + ["V"] * len(volts)))
+        head.append(delimiter.join((["s"] if time is not None else []) + list(units or ["V"] * len(volts))))
     p = Path(path)
     p.write_text("\n".join(head) + "\n" + _lines(cols, fmt, delimiter, decimal) + "\n", encoding="utf-8")
     return p
