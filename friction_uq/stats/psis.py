@@ -31,13 +31,20 @@ class PSIS:
         return 1.0 / np.sum(np.exp(2.0 * self.log_weights), axis=-1)
 
 
+#: Fewest finite log ratios whose tail a Pareto fit is asked of (below it: raw weights, k = inf). A prior
+#: alternative whose support leaves out all but a few of the draws (nu's posterior at 0.49 against a uniform
+#: prior up to 0.45) gave arviz_stats two to four, and an internal error.
+MIN_FINITE = 5
+
+
 def psis(log_ratios: np.ndarray) -> PSIS:
     """Smoothed, normalised log weights and Pareto k of log importance ratios (the last axis: draws).
 
     Non-finite ratios get weight 0. A set whose ratios are all equal needs no smoothing (k = -inf);
-    a set whose tail cannot be fitted (too few distinct values, or a quarter or more of it tied at its smallest
-    value, where arviz_stats returns k = nan) keeps its raw weights with k = inf, which every check reads as
-    unreliable (a nan would pass a ``k > threshold`` test and vanish from a ``nanmax``).
+    a set whose tail cannot be fitted (fewer than :data:`MIN_FINITE` finite ratios, too few distinct values, or
+    a quarter or more of it tied at its smallest value, where arviz_stats returns k = nan) keeps its raw weights
+    with k = inf, which every check reads as unreliable (a nan would pass a ``k > threshold`` test and vanish
+    from a ``nanmax``).
     """
     from arviz_stats.base import array_stats
 
@@ -53,6 +60,10 @@ def psis(log_ratios: np.ndarray) -> PSIS:
         x = row[ok] - np.max(row[ok])
         if np.ptp(x) <= 1e-12:
             out[i, ok] = -math.log(ok.sum())
+            continue
+        if ok.sum() < MIN_FINITE:  # arviz_stats' tail of 2-4 draws is empty: an IndexError, not a fit
+            lw, k[i] = x, math.inf
+            out[i, ok] = lw - np.logaddexp.reduce(lw)
             continue
         try:
             lw, ki = array_stats.psislw(-x, r_eff=1.0)
