@@ -162,7 +162,11 @@ class PriorDataConflict:
                     "not the priors, determine f.")
         parts = [f"{n}: {self.diagnosis[n]} (prior sensitivity {self.prior[n]:.2f}, likelihood "
                  f"{self.likelihood[n]:.2f})" for n in self.flagged]
-        return ("WARNING: the priors, not the data, drive the result - " + "; ".join(parts)
+        # a conflict is the data pulling against the prior, not a prior that leaves the data nothing to say
+        head = ("the prior file and the data disagree" if any(self.diagnosis[n] == "prior-data conflict"
+                                                              for n in self.flagged)
+                else "the priors, not the data, drive the result")
+        return (f"WARNING: {head} - " + "; ".join(parts)
                 + ". Check the prior file against the data before using these numbers.")
 
     def to_json(self) -> dict[str, object]:

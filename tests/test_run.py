@@ -318,7 +318,10 @@ def test_the_prior_data_warning_is_said_once_as_a_warning():
     flagged = PriorDataConflict(prior={"nu": 0.12}, likelihood={"nu": 0.05}, diagnosis={"nu": "prior-data conflict"},
                                 flagged=("nu",), threshold=0.05)
     said = conflict_warning(flagged)
-    assert said.startswith("The priors, not the data, drive the result - nu:") and "WARNING" not in said
+    assert said.startswith("The prior file and the data disagree - nu:") and "WARNING" not in said
+    dominated = PriorDataConflict(prior={"f": 0.3}, likelihood={"f": 0.01}, diagnosis={"f": "prior dominates the data"},
+                                  flagged=("f",), threshold=0.05)
+    assert conflict_warning(dominated).startswith("The priors, not the data, drive the result - f:")
 
 
 def test_a_page_title_stays_on_the_page_whatever_the_test_id():

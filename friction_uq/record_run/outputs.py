@@ -54,7 +54,8 @@ def reproducible(dt):
 
 
 
-#: The run's JSON: its schema name and version (9: ``discrepancy.shared_delay``, the delay on one gauge the candidates
+#: The run's JSON: its schema name and version (10: ``hoop_or_prior``, f with the hoop gauge and from nu's prior
+#: alone when the two disagree, ``f`` then the two in equal parts; 9: ``discrepancy.shared_delay``, the delay on one gauge the candidates
 #: the record does not tell apart agree on; 8: ``discrepancy.causes`` leaves out a later round's chain entry kept
 #: in the model within the whole-record check's tolerance, listed in ``discrepancy.within_tolerance``; 7: a ranking
 #: entry's ``f_from`` says whether its f is the cut posterior's or the whole-record fit's; 6: a diagnosed model's f and ``nu_extended`` are the cut posterior's,
@@ -64,11 +65,11 @@ def reproducible(dt):
 #: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
-RUN_SCHEMA_VERSION = 9
+RUN_SCHEMA_VERSION = 10
 
 
 def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],
-             diagnosis=None, *, hoop: bool = True) -> dict[str, object]:
+             diagnosis=None, *, hoop: bool = True, both: bool = False) -> dict[str, object]:
     """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`, with the output bars'
     calibration: :mod:`friction_uq.quoted`), the model it comes from, the calibration's sd (the budget, and what was
     folded in beyond what the model's likelihood carries) and the same f given
@@ -81,7 +82,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     from ..quoted import folded_sd
     from ..report.quote import f_to_quote
 
-    source, fx = f_to_quote(f_stationary, diagnosis, hoop=hoop)
+    source, fx = f_to_quote(f_stationary, diagnosis, hoop=hoop, both=both)
     named = None if diagnosis is None else headline(diagnosis)
     model = "stationary" if named is None else named[0]
     given = f_stationary_posterior if named is None else summarize_draws(f_draws_to_quote(diagnosis))

@@ -203,7 +203,7 @@ def _posterior_pages(s: RunSetup, post: StationaryPosterior) -> tuple[object, by
 
     inputs = ReportInputs(s.prepared, post.samples, post.datatree, post.summary, post.convergence, post.band,
                           post.sensitivity, post.nu_share, post.ppc, s.lab, post.V, __version__, post.conflict,
-                          likelihood=s.likelihood, halves=s.halves)
+                          likelihood=s.likelihood, halves=s.halves, hoop_or_prior=post.hoop_or_prior)
     return inputs, render_posterior_part(inputs)
 
 
@@ -211,10 +211,10 @@ def _warnings(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck | No
     """The checks that failed, one sentence each (:mod:`.warnings`)."""
     lik = s.likelihood
     levels = lik.force if isinstance(lik.force, LevelForceTerm) else LevelForceTerm(s.prepared.data)
-    return run_warnings(ppc=post.ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=post.summary["f"],
+    return run_warnings(ppc=post.ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=post.f_read,
                         lab=s.lab, conv=post.convergence, conflict=post.conflict, check=wrc,
                         findings=s.prepared.findings, diagnosis=diag,
-                        hoop_silent=s.hoop_left_out if s.hoop_silent else None)
+                        hoop_silent=s.hoop_left_out if s.hoop_silent else None, hoop_or_prior=post.hoop_or_prior)
 
 
 def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck, *, diagnose: bool, seed: int,
@@ -229,7 +229,8 @@ def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck,
     say("diagnose: fitting each mechanism of the catalogue to the whole record")
     start = {"f": post.summary["f"].q50, "nu": post.summary["nu"].q50}
     diag = run_stage.run_diagnose(s.prepared, s.priors, start, hoop=s.use_hoop, seed=seed, say=say, check=wrc,
-                                 stationary_f=post.samples.flat("f"))
+                                 stationary_f=post.samples.flat("f") if post.hoop_or_prior is None
+                                 else post.hoop_or_prior.f_draws)
     outcome.add_to_datatree(post.datatree, diag, s.priors["f"])
     return diag
 
@@ -253,7 +254,7 @@ def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck
     from ..report.pdf import first_whole_record_page
     from ..report.quote import quote_line
 
-    print(quote_line(post.f_quoted, diag, len(warns), hoop=post.samples.hoop))
+    print(quote_line(post.f_quoted, diag, len(warns), hoop=post.samples.hoop, both=post.hoop_or_prior is not None))
     for w in warns:
         print(f"WARNING: {w}")
     lines = []

@@ -24,7 +24,8 @@ def run_document(s: RunSetup, post: StationaryPosterior, *, seed: int, seconds: 
     """The run's JSON (docs/outputs.md)."""
     summary, conv = post.summary, post.convergence
     doc: dict[str, object] = {"schema": RUN_SCHEMA, "schema_version": RUN_SCHEMA_VERSION, "warnings": warns,
-                              "f": quoted_f(post.f_quoted, summary["f"].to_json(), diag, hoop=post.samples.hoop)}
+                              "f": quoted_f(post.f_quoted, post.f_read.to_json(), diag, hoop=post.samples.hoop,
+                                            both=post.hoop_or_prior is not None)}
     allv = dict(summary) | {"V": post.V}
     for name in JSON_VARIABLES:
         doc["f_stationary" if name == "f" else name] = _summary_json(allv[name])
@@ -50,6 +51,7 @@ def run_document(s: RunSetup, post: StationaryPosterior, *, seed: int, seconds: 
         "nu_variance_share_of_f": post.nu_share,
         "f_under_nu_priors": {k: x.to_json() for k, x in post.sensitivity.items()},
         "prior_data_conflict": post.conflict.to_json(),
+        "hoop_or_prior": None if post.hoop_or_prior is None else post.hoop_or_prior.to_json(),
         "ppc_ratio_coverage_90": post.ppc.coverage,
         "lab_point_estimate_nominal_nu": {"nu": lab.nu, "f": lab.f, "ratio": lab.ratio},
         "ess_per_second": conv.ess_per_second,

@@ -6,6 +6,7 @@ the writing of the outputs.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from collections.abc import Callable
@@ -31,6 +32,7 @@ from ..diagnostics import (
     summarize,
 )
 from ..errors import OutputError, SamplingError
+from ..hoop_or_prior import HOOP_OR_PRIOR_GROUP, HoopOrPrior, disagree, hoop_or_prior, worth_asking
 from ..likelihood import Likelihood
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import Priors
@@ -70,6 +72,13 @@ class RunSetup:
     halves: WindowHalves | None  # kappa's change across the window (the JSON's and the report's), or None
 
 
+def _likelihood(prep: Prepared, settings: AnalysisSettings, *, hoop: bool) -> Likelihood:
+    """The run's likelihood over the stationary data, as ``settings`` build it, with or without the hoop term."""
+    return Likelihood(prep.data, hoop=hoop, axial_poisson=settings.axial_poisson, hoop_mode=settings.hoop_mode,
+                      hoop_discrepancy=settings.hoop_discrepancy, force_mode=settings.force_mode,
+                      ratio_model_form=settings.ratio_model_form)
+
+
 def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | None, out_dir: Path, *,
            window: tuple[float, float] | None, dispersion: bool, hoop: bool) -> RunSetup:
     """Every input checked (record, priors, the output folder and names) and the signals prepared."""
@@ -89,9 +98,7 @@ def set_up(path: str | os.PathLike[str], priors_path: str | os.PathLike[str] | N
         silence = None if fault else hoop_silence(prep)
         left_out, silent = fault or silence, silence is not None
     use_hoop = bool(settings.hoop and prep.data.hoop is not None and left_out is None)
-    likelihood = Likelihood(prep.data, hoop=use_hoop, axial_poisson=settings.axial_poisson,
-                            hoop_mode=settings.hoop_mode, hoop_discrepancy=settings.hoop_discrepancy,
-                            force_mode=settings.force_mode, ratio_model_form=settings.ratio_model_form)
+    likelihood = _likelihood(prep, settings, hoop=use_hoop)
     likelihood_priors(likelihood, priors)  # the prior file holds every parameter the likelihood needs
     names = {"netcdf": out_dir / f"{stem}.nc", "pdf": out_dir / f"{stem}.pdf", "json": out_dir / f"{stem}.json"}
     for p in names.values():
@@ -117,6 +124,18 @@ class StationaryPosterior:
     ppc: RatioPPC
     V: VariableSummary  # the sliding velocity over the window (measured)
     f_quoted: dict[str, float]  # the stationary f to quote, with the output bars' calibration: mean, sd, q05, q50, q95
+    #: f with the hoop gauge and from the prior's nu alone, when the prior-data check flags the hoop term's posterior
+    #: (then ``f_quoted`` is the two in equal parts: :mod:`friction_uq.hoop_or_prior`), else None
+    hoop_or_prior: HoopOrPrior | None = None
+
+    @property
+    def f_read(self) -> VariableSummary:
+        """f's posterior summary the warnings and the JSON's ``f.given_bar_headers`` read: the run's, or where the hoop
+        gauge and nu's prior disagree, the two readings in equal parts (as ``f_quoted``)."""
+        f = self.summary["f"]
+        if self.hoop_or_prior is None:
+            return f
+        return dataclasses.replace(f, **self.hoop_or_prior.f_given_headers)
 
 
 def stationary_posterior(s: RunSetup, *, seed: int, backend: Path, progress: bool, say: Callable[[str], None],
@@ -147,12 +166,29 @@ def stationary_posterior(s: RunSetup, *, seed: int, backend: Path, progress: boo
     conflict = prior_data_conflict(dt, samples, s.priors)
     if conflict.flagged:
         note(conflict.sentence())
+    both = _hoop_or_prior(s, samples, conflict, seed=seed, say=say)
+    if both is not None:
+        dt[HOOP_OR_PRIOR_GROUP] = both.datatree_group()
     stages["sensitivity"] = time.perf_counter() - t
     t = time.perf_counter()
     band = f_given_nu(samples, np.linspace(0.15, 0.49, 69))
     share = nu_variance_share(samples)
     ppc = ratio_ppc(samples, s.prepared.data, seed=seed, likelihood=s.likelihood)
     V = sliding_velocity_summary(s.prepared)
-    f_quoted = quoted_summary(samples.flat("f"))
+    f_quoted = quoted_summary(samples.flat("f")) if both is None else both.f_quoted
     stages["analysis"] = time.perf_counter() - t
-    return StationaryPosterior(samples, dt, conv, summary, sens, conflict, band, share, ppc, V, f_quoted)
+    return StationaryPosterior(samples, dt, conv, summary, sens, conflict, band, share, ppc, V, f_quoted, both)
+
+
+def _hoop_or_prior(s: RunSetup, samples: PosteriorSamples, conflict: PriorDataConflict, *, seed: int,
+                   say: Callable[[str], None]) -> HoopOrPrior | None:
+    """When the prior-data check flags the hoop term's posterior: the posterior again with the hoop gauge left out,
+    and the two readings (:mod:`friction_uq.hoop_or_prior`); else None."""
+    if not worth_asking(conflict, s.use_hoop):
+        return None
+    say("the prior-data check flags the posterior with the hoop gauge: sampling again with nu from the prior alone")
+    alone = sample_posterior(s.prepared.data, s.priors, seed=seed, hoop=False,
+                             likelihood=_likelihood(s.prepared, s.settings, hoop=False))
+    if not disagree(conflict, samples.flat("f"), alone.flat("f")):
+        return None
+    return hoop_or_prior(samples, alone, s.priors, conflict, s.likelihood.hoop)

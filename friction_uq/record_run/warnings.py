@@ -16,7 +16,8 @@ Checks and their limits (``docs/trust.md`` gives the calibration):
 * a gauge's peak sits on one value for a run its noise cannot tell from a saturated digitiser;
 * a gauge disagrees over the loading (:mod:`friction_uq.gauge_balance`, :mod:`friction_uq.gauge_scale`), or the
   output forces do not sum to the input force over the window (eq. 5) within the same tolerance and noise;
-* convergence of the sampler; the prior-data check;
+* convergence of the sampler; the prior-data check, and the hoop gauge against nu's prior
+  (:mod:`friction_uq.hoop_or_prior`: f both ways, the f quoted from both);
 * with ``diagnose``: the named model's normal approximation against its exact posterior (Pareto k).
 """
 
@@ -32,6 +33,7 @@ from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
 from ..discrepancy.whole_record import CHANNEL_LABELS
+from ..hoop_or_prior import HoopOrPrior
 from ..prior_sensitivity import PriorDataConflict
 from ..stats.exact import ess_floor
 
@@ -208,8 +210,9 @@ def exact_posterior_warning(diagnosis) -> str | None:
             "again with another --seed and compare.")
 
 
-def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
-    if conflict is None or not conflict.flagged:
+def conflict_warning(conflict: PriorDataConflict | None, hoop_or_prior: HoopOrPrior | None = None) -> str | None:
+    """The prior-data check's flags, unless the hoop gauge's disagreement with the prior says them already."""
+    if conflict is None or not conflict.flagged or hoop_or_prior is not None:
         return None
     said = conflict.sentence().removeprefix("WARNING: ").rstrip(".")  # each warning is printed after "WARNING: " once
     return (said[:1].upper() + said[1:] + ": f then follows the prior file as much as the record; "
@@ -219,7 +222,7 @@ def conflict_warning(conflict: PriorDataConflict | None) -> str | None:
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
                  conv: Convergence, conflict: PriorDataConflict | None,
                  check: WholeRecordCheck | None, findings: Sequence[GaugeFinding] = (),
-                 diagnosis=None, hoop_silent: str | None = None) -> list[str]:
+                 diagnosis=None, hoop_silent: str | None = None, hoop_or_prior: HoopOrPrior | None = None) -> list[str]:
     """Every check's warning, in the order a reader should see them; empty when all pass. ``findings``: the gauge
     checks' (:attr:`friction_uq.analysis.Prepared.findings`), told apart by kind."""
     flat = [g.sentence for g in findings if g.kind == "flat"]
@@ -230,6 +233,7 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
         speed_warning(speed), hoop_silence_warning(hoop_silent, f),
         stationarity_warning(ppc, excess_spread, dof, f, lab),
         misfit_warning(check, f, diagnosis),
-        convergence_warning(conv), exact_posterior_warning(diagnosis), conflict_warning(conflict),
+        convergence_warning(conv), exact_posterior_warning(diagnosis),
+        None if hoop_or_prior is None else hoop_or_prior.sentence(), conflict_warning(conflict, hoop_or_prior),
     )
     return [w for w in found if w]

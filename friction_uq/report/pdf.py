@@ -22,6 +22,7 @@ from .quote import quote_line
 from ..diagnostics import Convergence, FNuBand, FUnderPrior, PriorDataConflict, RatioPPC, VariableSummary
 from ..quoted import quoted_summary
 from ..sampler import PosteriorSamples
+from ..hoop_or_prior import HoopOrPrior
 from ..window_halves import WindowHalves
 from .posterior_pages import page_convergence, page_corner, page_hoop, page_ppc, page_propagation
 from .signal_pages import page_forces, page_raw, page_window
@@ -54,6 +55,7 @@ class ReportInputs:
     likelihood: object | None = None  # friction_uq.likelihood.Likelihood, built once by run
     warnings: tuple[str, ...] = ()  # the run's checks that failed (friction_uq.record_run.warnings), shown first
     halves: WindowHalves | None = None  # kappa's change across the window (the run JSON's window_halves)
+    hoop_or_prior: HoopOrPrior | None = None  # f with the hoop gauge and from nu's prior alone, when they disagree
 
 
 #: Top of the summary page's table (axes fraction) for up to ten rows: the sentences above stay clear of it.
@@ -69,8 +71,9 @@ def _fmt(v: float) -> str:
 
 
 def stationary_quoted(r: ReportInputs) -> dict[str, float]:
-    """The stationary analysis' f to quote: its posterior with the output bars' calibration (as the JSON's)."""
-    return quoted_summary(r.samples.flat("f"))
+    """The stationary analysis' f to quote: its posterior with the output bars' calibration (as the JSON's); where
+    the hoop gauge and nu's prior disagree, that with the hoop gauge and that from the prior alone in equal parts."""
+    return quoted_summary(r.samples.flat("f")) if r.hoop_or_prior is None else r.hoop_or_prior.f_quoted
 
 
 def _shrink_to_fit(lines: list[str], room: float, line: float, width: int = 135) -> tuple[list[str], float]:
@@ -99,7 +102,8 @@ def page_summary(r: ReportInputs) -> Figure:
     ax.axis("off")
     # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
     # together where they would run into the table below them
-    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings), hoop=r.samples.hoop), 100))
+    first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings), hoop=r.samples.hoop,
+                                              both=r.hoop_or_prior is not None), 100))
     ax.text(0.0, 1.0, first, fontsize=13, va="top", transform=ax.transAxes, weight="bold",
             color="firebrick" if r.warnings else "black")
     _draw_lines(fig, ax, _summary_lines(r), below=first.count("\n") + 1)

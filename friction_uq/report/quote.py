@@ -14,10 +14,13 @@ from ..discrepancy.candidates_mixture import STATIONARY
 from ..discrepancy.diagnosed_f import further, headline
 
 
-def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool = True) -> tuple[str, Mapping[str, float]]:
+def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool = True,
+               both: bool = False) -> tuple[str, Mapping[str, float]]:
     """(where it comes from, its summary: q05, q50, q95, ...). ``f_stationary``: the stationary analysis' f to
     quote (its posterior with the output bars' calibration, :mod:`friction_uq.quoted`), as the diagnosis's is;
-    ``hoop``: whether the stationary analysis used the hoop gauge (it is left out when it shows no usable pulse)."""
+    ``hoop``: whether the stationary analysis used the hoop gauge (it is left out when it shows no usable pulse);
+    ``both``: ``f_stationary`` is the analysis with the hoop gauge and with nu from the prior alone in equal parts
+    (they disagree: :mod:`friction_uq.hoop_or_prior`)."""
     named = None if diagnosis is None else headline(diagnosis)
     if named is not None:
         label, fx = named
@@ -46,14 +49,18 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
             return (f"the model with the causes diagnose named ({named}) and "
                     f"{', '.join(diagnosis.within_tolerance)} within the check's tolerance, not named ({label})"), fx
         return f"the model with the causes diagnose named ({label})", fx
+    if both:
+        return ("the stationary analysis with the hoop gauge and with nu from the prior file alone, in equal parts "
+                "(they disagree on nu)"), f_stationary
     return ("the stationary analysis (eq. 17 and the hoop gauge)" if hoop else
             "the stationary analysis (eq. 17; the hoop gauge left out)"), f_stationary
 
 
-def quote_line(f_stationary: Mapping[str, float], diagnosis=None, n_warnings: int = 0, *, hoop: bool = True) -> str:
+def quote_line(f_stationary: Mapping[str, float], diagnosis=None, n_warnings: int = 0, *, hoop: bool = True,
+               both: bool = False) -> str:
     """'Headline f = 0.0487 [0.0445, 0.0531] (90 %, the output bars' calibration included), from ...; every check
     passed' (or the warnings' count)."""
-    source, fx = f_to_quote(f_stationary, diagnosis, hoop=hoop)
+    source, fx = f_to_quote(f_stationary, diagnosis, hoop=hoop, both=both)
     trust = ("every check passed" if n_warnings == 0 else
              f"{n_warnings} warning{'s' if n_warnings > 1 else ''}: read {'them' if n_warnings > 1 else 'it'} "
              "before quoting it")

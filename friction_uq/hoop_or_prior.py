@@ -1,0 +1,142 @@
+"""When the tube's hoop gauge and the prior file disagree on nu: f both ways, and the f to quote from both.
+
+The hoop gauge is the record's only witness of nu (docs/physics.md): it reads g times the tube's response to
+the wall pressure, and that pressure is the axial stress times nu / (1 - nu) (eq. 18), so the gauge's calibration
+g and nu trade off. The prior file holds nu to a few hundredths and g to 5 %. A hoop gauge whose scale is off by
+more (a bridge declared quarter that is a half bridge, a gauge factor or an amplifier gain entered wrong, a lead's
+resistance) pulls nu far outside its prior, and f = kappa (1 - nu) / nu with it: on A-03 with its hoop gauge read
+at half its scale, f = 0.090 [0.080, 0.101] for 0.049. The same record cannot say whether the gauge or the
+prior file is wrong; a sample whose nu is not the prior's reads alike.
+
+So when the power-scaling check (:func:`friction_uq.prior_sensitivity.prior_data_conflict`) flags a parameter
+while the hoop term is on, the posterior is sampled again with the hoop gauge left out (nu from the prior file
+alone). The two readings disagree when the check flags nu or the gauge's gain (a prior-data conflict), or when
+neither f's median lies within the other's 90 % interval (a gauge read at twice its scale or more cannot be
+fitted through nu, which stops at 0.5, and is fitted through f, whose prior is then flagged). Then the f to quote
+is the two posteriors in equal parts: its interval holds f whichever of the two is wrong. Both are kept and said
+(the JSON's ``hoop_or_prior``, a warning naming the two values and the hoop gauge's scale against the prior's
+nu). The trigger is the check's own; how often it fires on records the likelihood did not make, and what it
+does to f there, is in docs/trust.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .likelihood.hoop import HoopTerm
+from .models.parameters import summarize_draws
+from .prior_sensitivity import PriorDataConflict
+from .priors import Priors
+from .quoted import quoted_summary
+from .sampler import PosteriorSamples
+
+#: The ``.nc`` group holding the f quoted's draws (the two posteriors in equal parts), which a campaign pools.
+HOOP_OR_PRIOR_GROUP = "hoop_or_prior"
+#: The prior's quantiles said beside the hoop gauge's nu.
+QUANTILES = (0.05, 0.5, 0.95)
+
+
+#: The parameters whose flag implicates the hoop gauge: it is nu's only witness, through g nu / (1 - nu).
+HOOP_WITNESSED = ("nu", "hoop_gain")
+
+
+def worth_asking(conflict: PriorDataConflict, hoop_on: bool) -> bool:
+    """Whether to sample the posterior again with the hoop gauge left out: the hoop term is on and the power-scaling
+    check flags a parameter."""
+    return bool(hoop_on and conflict.flagged)
+
+
+def disagree(conflict: PriorDataConflict, f_hoop: np.ndarray, f_prior: np.ndarray) -> bool:
+    """Whether the two readings disagree (module docstring): the check flags nu or the hoop gauge's gain (a
+    prior-data conflict), or each f's median lies outside the other's 90 % interval (a hoop gauge read far off
+    its scale is fitted through f rather than nu, and only f is flagged). A flag on f that both readings share
+    (its prior squeezing it) is not the hoop gauge's."""
+    if any(n in conflict.flagged for n in HOOP_WITNESSED):
+        return True
+    qh, qp = np.quantile(f_hoop, [0.05, 0.5, 0.95]), np.quantile(f_prior, [0.05, 0.5, 0.95])
+    return not (qh[0] <= qp[1] <= qh[2]) and not (qp[0] <= qh[1] <= qp[2])
+
+
+def _even(x: np.ndarray, n: int) -> np.ndarray:
+    """``n`` of ``x``'s draws, evenly spaced through them (the same draws for the same input)."""
+    return x[np.linspace(0, len(x) - 1, n).round().astype(int)]
+
+
+def equal_parts(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Draws of the equal mixture of two posteriors: as many of each, the smaller count."""
+    n = min(len(a), len(b))
+    return np.concatenate([_even(np.asarray(a, float), n), _even(np.asarray(b, float), n)])
+
+
+def _summary(x: np.ndarray) -> dict[str, float]:
+    q = np.quantile(x, QUANTILES)
+    return {"q05": float(q[0]), "q50": float(q[1]), "q95": float(q[2])}
+
+
+@dataclass(frozen=True)
+class HoopOrPrior:
+    """nu and f read with the hoop gauge and from the prior file alone, and the f to quote from both."""
+
+    nu_hoop: dict[str, float]  # nu's posterior with the hoop gauge: q05, q50, q95
+    nu_prior: dict[str, float]  # nu's prior: q05, q50, q95
+    gauge_scale: float  # the hoop gauge's window mean over the model's from the forces and the prior's nu (reading_over_prediction)
+    f_hoop: dict[str, float]  # f to quote with the hoop gauge (output bars' calibration folded in)
+    f_prior: dict[str, float]  # f to quote with the hoop gauge left out
+    f_quoted: dict[str, float]  # the two in equal parts
+    f_given_headers: dict[str, float]  # the two in equal parts, given the bars' header values: mean, sd, q05, q50, q95
+    flagged: tuple[tuple[str, str], ...]  # what the power-scaling check flagged, and its diagnosis of each
+    f_draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty(0))  # the equal mixture's draws of f
+
+    def sentence(self) -> str:
+        """The warning: what disagrees, f both ways, the f quoted."""
+        def f(x: dict[str, float]) -> str:
+            return f"f = {x['q50']:.4g} [{x['q05']:.4g}, {x['q95']:.4g}]"
+
+        h, p = self.nu_hoop, self.nu_prior
+        return (f"The tube's hoop gauge and the prior file disagree on nu (the prior-data check: "
+                f"{'; '.join(f'{n}: {d}' for n, d in self.flagged)}): with the hoop gauge nu = {h['q50']:.3g} [{h['q05']:.3g}, {h['q95']:.3g}] "
+                f"and {f(self.f_hoop)}; from the prior file's nu ({p['q50']:.3g} [{p['q05']:.3g}, {p['q95']:.3g}]) "
+                f"alone {f(self.f_prior)}. The hoop gauge reads {self.gauge_scale:.2g} times what the forces and the "
+                "prior's nu predict: either its scale is off (gauge factor, bridge, amplifier gain) or the prior file is not "
+                f"this sample's, and one record cannot tell which; the f quoted holds both in equal parts, "
+                f"{f(self.f_quoted)}. A calibration of the hoop gauge or a measured nu decides.")
+
+    def datatree_group(self):
+        """The ``.nc`` group :data:`HOOP_OR_PRIOR_GROUP`: the equal mixture's draws of f (given the bars' header
+        values), which the campaign pools in place of the hoop gauge's posterior alone."""
+        import xarray as xr
+
+        ds = xr.Dataset({"f": (("draw",), np.asarray(self.f_draws, float))},
+                        attrs={"description": "f with the hoop gauge and with nu from the prior file alone, equal parts",
+                               "flagged": "; ".join(f"{n}: {d}" for n, d in self.flagged)})
+        return xr.DataTree(ds)
+
+    def to_json(self) -> dict[str, object]:
+        return {"flagged": dict(self.flagged), "nu_with_hoop": self.nu_hoop, "nu_prior": self.nu_prior,
+                "hoop_scale_against_prior_nu": self.gauge_scale, "f_with_hoop": self.f_hoop,
+                "f_prior_nu_alone": self.f_prior, "f_quoted": self.f_quoted, "f_given_bar_headers": self.f_given_headers,
+                "mixture": "equal parts of the two posteriors"}
+
+
+def reading_over_prediction(hoop: HoopTerm, prior_only: PosteriorSamples, draws: int = 400) -> float:
+    """The hoop gauge's window mean over what the model predicts for it from the forces and the prior's nu (the
+    prior-only posterior's f and nu, the gauge's calibration 1): the median over ``draws`` of its draws."""
+    f, nu = _even(prior_only.flat("f"), draws), _even(prior_only.flat("nu"), draws)
+    predicted = hoop.predict(f, nu, np.ones_like(f)).mean(axis=1)
+    return float(np.median(np.mean(hoop.observed) / predicted))
+
+
+def hoop_or_prior(with_hoop: PosteriorSamples, prior_only: PosteriorSamples, priors: Priors,
+                  conflict: PriorDataConflict, hoop: HoopTerm) -> HoopOrPrior:
+    """The two readings of one record (module docstring): ``with_hoop`` the run's posterior, ``prior_only`` the
+    same with the hoop gauge left out; ``hoop`` the likelihood's hoop term (its reading and prediction)."""
+    nu = with_hoop.flat("nu")
+    nu_p = np.asarray(priors["nu"].ppf(np.array(QUANTILES)), float)
+    scale = reading_over_prediction(hoop, prior_only)
+    f_h, f_p = with_hoop.flat("f"), prior_only.flat("f")
+    both = equal_parts(f_h, f_p)
+    return HoopOrPrior(_summary(nu), {"q05": float(nu_p[0]), "q50": float(nu_p[1]), "q95": float(nu_p[2])}, scale,
+                       quoted_summary(f_h), quoted_summary(f_p), quoted_summary(both), summarize_draws(both),
+                       tuple((n, conflict.diagnosis[n]) for n in conflict.flagged), both)

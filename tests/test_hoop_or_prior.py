@@ -1,0 +1,90 @@
+"""The hoop gauge against nu's prior (friction_uq.hoop_or_prior): a hoop gauge read off its scale moved f by the
+same factor with only a prior-data note; now f is quoted from both readings, and a campaign pools what is quoted."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+from types import SimpleNamespace
+
+import h5py
+import numpy as np
+import pytest
+
+from friction_uq.hoop_or_prior import HOOP_OR_PRIOR_GROUP, disagree, equal_parts
+from friction_uq.prior_sensitivity import PriorDataConflict
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _conflict(flags: dict[str, str]) -> PriorDataConflict:
+    names = ("f", "nu", "hoop_gain")
+    diag = {n: flags.get(n, "") for n in names}
+    flagged = tuple(n for n in names if diag[n] and (n == "f" or diag[n] == "prior-data conflict"))
+    return PriorDataConflict({n: 0.1 for n in names}, {n: 0.1 for n in names}, diag, flagged, 0.05)
+
+
+def test_the_readings_disagree_on_a_conflict_over_nu_or_when_neither_f_holds_the_others_median():
+    rng = np.random.default_rng(0)
+    low, high = rng.normal(0.05, 0.004, 4000), rng.normal(0.09, 0.006, 4000)
+    assert disagree(_conflict({"nu": "prior-data conflict"}), low, low)  # the check's own word on nu
+    assert disagree(_conflict({"f": "prior dominates the data"}), low, high)  # fitted through f: far apart
+    # a squeezed f prior flags f under both readings alike: not the hoop gauge's doing
+    assert not disagree(_conflict({"f": "prior dominates the data"}), low, rng.normal(0.051, 0.004, 4000))
+
+
+def test_equal_parts_takes_as_many_draws_of_each():
+    a, b = np.zeros(10), np.ones(7)
+    both = equal_parts(a, b)
+    assert both.size == 14 and both.sum() == 7
+
+
+@pytest.fixture(scope="module")
+def half_scale_hoop(tmp_path_factory) -> tuple[dict, Path]:
+    """A-03 with its hoop gauge read at half its scale (a half bridge declared a quarter one), through run."""
+    from friction_uq.record_run import run_file
+
+    tmp = tmp_path_factory.mktemp("hoop")
+    rec = tmp / "A-03.h5"
+    shutil.copy(ROOT / "data" / "A" / "A-03.h5", rec)
+    with h5py.File(rec, "r+") as fh:
+        fh["signals/tube_hoop"][...] = fh["signals/tube_hoop"][...] * 0.5
+    res = run_file(rec, out_dir=tmp / "out", seed=3, pdf=False, progress=False, table=False, notes=False,
+                   whole_record=False)
+    return json.loads(res.outputs["json"].read_text()), res.outputs["netcdf"]
+
+
+def test_a_hoop_gauge_off_its_scale_gives_f_from_both_readings(half_scale_hoop):
+    doc, _ = half_scale_hoop
+    hp = doc["hoop_or_prior"]
+    assert hp is not None and "nu" in hp["flagged"]
+    fh, fp, f = hp["f_with_hoop"], hp["f_prior_nu_alone"], doc["f"]
+    assert fh["q05"] > fp["q95"]  # the two readings exclude each other ...
+    assert f["q05"] <= fp["q50"] and fh["q50"] <= f["q95"]  # ... and the f quoted holds both
+    assert f["q05"] == hp["f_quoted"]["q05"] and "in equal parts" in f["source"]
+    assert 0.35 < hp["hoop_scale_against_prior_nu"] < 0.6  # read at half its scale
+    said = [w for w in doc["warnings"] if w.startswith("The tube's hoop gauge and the prior file disagree on nu")]
+    assert len(said) == 1 and not any(w.startswith("The prior file and the data disagree") for w in doc["warnings"])
+
+
+def test_the_campaign_pools_the_f_the_run_quotes(half_scale_hoop):
+    from friction_uq.campaigns.draws import read_test_posterior
+
+    doc, nc = half_scale_hoop
+    with h5py.File(nc) as h:
+        assert h[HOOP_OR_PRIOR_GROUP]["f"].shape[0] > 0
+    r = SimpleNamespace(outputs={"netcdf": nc.name}, label="A-03", campaign="A", window_halves=None,
+                        prior_file=doc["prior_file"], summary={"V": doc["V"]}, path=str(nc))
+    f = read_test_posterior(r, nc.parent).f
+    assert np.quantile(f, 0.05) < doc["hoop_or_prior"]["f_prior_nu_alone"]["q50"]
+    assert np.quantile(f, 0.95) > doc["hoop_or_prior"]["f_with_hoop"]["q50"]
+
+
+def test_a_sound_hoop_gauge_is_read_alone(tmp_path):
+    from friction_uq.record_run import run_file
+
+    res = run_file(ROOT / "data" / "A" / "A-03.h5", out_dir=tmp_path, seed=3, pdf=False, progress=False, table=False,
+                   notes=False, whole_record=False)
+    doc = json.loads(res.outputs["json"].read_text())
+    assert doc["hoop_or_prior"] is None and doc["f"]["source"] == "the stationary analysis (eq. 17 and the hoop gauge)"
