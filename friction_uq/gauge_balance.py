@@ -23,6 +23,8 @@ is what stops the window.
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -121,8 +123,29 @@ def gauge_findings(forces: Forces, apparatus: Apparatus) -> list[GaugeFinding]:
     out.append(GaugeFinding("", "balance", (
         f"the output forces sum to {s * 100:.0f} % of the input force over the loading (eq. 5: 100 % within "
         f"{BALANCE_TOL * 100:.0f} %; the gauges' noise, 1 sd: {percent_text(mf.balance_sd)} %): a gauge's gain, its "
-        f"strain_per_volt or a bar's modulus is off by about {abs(s - 1.0) * 100:.0f} %")))
+        f"strain_per_volt or a bar's modulus is off, and the balance cannot say whose: {one_gauge_alone(mf)}")))
     return out
+
+
+def one_gauge_alone(mf: MeanForces) -> str:
+    """What each gauge would read, were it alone to blame for the balance (eq. 5), and what that makes of f: the input
+    gauge leaves f as it is; an output gauge moves eq. 17's ratio r = F_eo / F_io, and f with ln(1 + r) (eq. 17).
+    The external output force is a tenth of the input force or less, so a balance a few per cent off is its gauge
+    reading twice what it carries, or half: f by nearly that factor."""
+    r = mf.F_eo / mf.F_io if mf.F_io > 0.0 else math.nan
+    parts = [f"the input gauge reading {1.0 / mf.balance:.2g} times what it carries (f as it is)"]
+    for name, own, other, true_ratio in (("internal", mf.F_io, mf.F_eo, lambda g: r * g),
+                                         ("external", mf.F_eo, mf.F_io, lambda g: r / g)):
+        if not mf.F_i > other:
+            parts.append(f"not the {name} output gauge alone (the other output force reaches the input force)")
+        elif not own > 0.0:
+            parts.append(f"not the {name} output gauge alone (it reads no compression)")
+        else:
+            gain = own / (mf.F_i - other)
+            moved = (f" (the true f {math.log1p(true_ratio(gain)) / math.log1p(r):.2g} times the f eq. 17 reads)"
+                     if r > 0.0 else "")
+            parts.append(f"the {name} output gauge {gain:.2g} times{moved}")
+    return ", ".join(parts[:-1]) + " or " + parts[-1]
 
 
 def percent_text(x: float) -> str:

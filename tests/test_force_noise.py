@@ -130,11 +130,27 @@ def test_a_window_found_from_the_ratio_alone_blames_no_gauge_when_none_is() -> N
     window = GaugeFinding("", "window", RATIO_WINDOW_NOTE)
     f = VariableSummary(mean=0.048, sd=0.002, q05=0.045, q50=0.048, q95=0.051, r_hat=1.0, ess_bulk=4000.0)
     assert gauge_warning((unchecked, window), f).startswith("The force balance cannot check the gauges on this record")
-    blamed = GaugeFinding("", "balance", "a gauge's gain ... is off by about 15 %")
+    blamed = GaugeFinding("", "balance", "a gauge's gain ... is off, and the balance cannot say whose: ...")
     suspect = GaugeFinding("", "window", RATIO_WINDOW_NOTE + ", as the suspect gauge makes them")
     assert gauge_warning((blamed, suspect), f).startswith("A gauge disagrees with the others")
     assert gauge_warning((dataclasses.replace(unchecked, kind="balance"), window), f).startswith("A gauge disagrees")
     assert gauge_warning((), f) is None
+
+
+def test_a_balance_off_says_what_each_gauge_alone_would_read_and_make_of_f() -> None:
+    """The external output force is a tenth of the input force: its gauge at twice its scale puts the balance 10 %
+    high, which was said "a gain off by about 10 %" beside f twice the truth. Each gauge's share is said, with f."""
+    from friction_uq.gauge_balance import one_gauge_alone
+
+    said = one_gauge_alone(MeanForces(1000.0, 900.0, 200.0, 5.0, 5.0, 5.0))  # the external reading 2 x its 100 N
+    assert "the input gauge reading 0.91 times what it carries (f as it is)" in said
+    assert "the internal output gauge 1.1 times (the true f 1.1 times the f eq. 17 reads)" in said
+    assert said.endswith("or the external output gauge 2 times (the true f 0.53 times the f eq. 17 reads)")
+    dead = one_gauge_alone(MeanForces(1000.0, -3.0, 2.0, 5.0, 5.0, 5.0))
+    assert "not the internal output gauge alone (it reads no compression)" in dead
+    assert "the external output gauge" in dead and "true f" not in dead  # no ratio to move
+    over = one_gauge_alone(MeanForces(1000.0, 1200.0, 100.0, 5.0, 5.0, 5.0))
+    assert "not the external output gauge alone (the other output force reaches the input force)" in over
 
 
 @pytest.mark.parametrize(("means", "said"), [
@@ -174,7 +190,7 @@ def test_dead_output_gauges_are_not_a_sound_balance(tmp_path: Path, seed: int) -
             ds[...] = np.median(x[:200]) + np.std(x[:200]) * rng.normal(size=x.size)
     faults, notes = record_gauge_check(read_record(path))
     assert faults == []
-    assert any(n.kind == "balance" and "is off by about" in n.sentence for n in notes)
+    assert any(n.kind == "balance" and "the balance cannot say whose" in n.sentence for n in notes)
 
 
 def test_the_input_force_takes_its_gauges_offset_twice() -> None:
