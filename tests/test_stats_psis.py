@@ -61,7 +61,7 @@ def test_a_tail_tied_at_its_smallest_value_is_unreliable_not_nan():
     assert loo.pareto_k_max == math.inf and bool(loo.pareto_k[0] > 0.7)
 
 
-@pytest.mark.parametrize("n_finite", [2, 3, 4])
+@pytest.mark.parametrize("n_finite", [1, 2, 3, 4])
 def test_a_few_finite_ratios_keep_their_raw_weights_and_an_unreliable_k(n_finite):
     """An alternative prior whose support leaves out all but a few of the draws (nu's posterior at 0.49, a uniform
     prior up to 0.45): arviz_stats' tail of two to four draws was empty, an IndexError ending the run."""
@@ -69,6 +69,7 @@ def test_a_few_finite_ratios_keep_their_raw_weights_and_an_unreliable_k(n_finite
     lr[:n_finite] = np.linspace(-1.0, 0.5, n_finite)
     out = psis(lr)
     assert out.pareto_k == math.inf
+    assert psis(np.where(np.isfinite(lr), 0.3, -np.inf)).pareto_k == math.inf  # equal, yet too few to trust
     w = np.exp(out.log_weights)
     assert np.isclose(w.sum(), 1.0) and np.all(w[n_finite:] == 0.0)
     assert np.allclose(w[:n_finite], np.exp(lr[:n_finite]) / np.exp(lr[:n_finite]).sum())

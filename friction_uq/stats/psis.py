@@ -31,9 +31,10 @@ class PSIS:
         return 1.0 / np.sum(np.exp(2.0 * self.log_weights), axis=-1)
 
 
-#: Fewest finite log ratios whose tail a Pareto fit is asked of (below it: raw weights, k = inf). A prior
-#: alternative whose support leaves out all but a few of the draws (nu's posterior at 0.49 against a uniform
-#: prior up to 0.45) gave arviz_stats two to four, and an internal error.
+#: Fewest finite log ratios whose weights are smoothed or called reliable (below it: raw weights, k = inf, even
+#: when they are equal: one draw carrying all the weight is no estimate). A prior alternative whose support
+#: leaves out all but a few of the draws (nu's posterior at 0.49 against a uniform prior up to 0.45) gave
+#: arviz_stats two to four, and an internal error.
 MIN_FINITE = 5
 
 
@@ -58,12 +59,12 @@ def psis(log_ratios: np.ndarray) -> PSIS:
             k[i] = math.inf
             continue
         x = row[ok] - np.max(row[ok])
+        if ok.sum() < MIN_FINITE:  # one draw, or arviz_stats' empty tail of 2-4 (an IndexError): unreliable
+            k[i] = math.inf
+            out[i, ok] = x - np.logaddexp.reduce(x)
+            continue
         if np.ptp(x) <= 1e-12:
             out[i, ok] = -math.log(ok.sum())
-            continue
-        if ok.sum() < MIN_FINITE:  # arviz_stats' tail of 2-4 draws is empty: an IndexError, not a fit
-            lw, k[i] = x, math.inf
-            out[i, ok] = lw - np.logaddexp.reduce(lw)
             continue
         try:
             lw, ki = array_stats.psislw(-x, r_eff=1.0)
