@@ -25,12 +25,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .diagnostics.datatree import derived_draws
 from .likelihood.hoop import HoopTerm
 from .models.parameters import summarize_draws
 from .prior_sensitivity import PriorDataConflict
 from .priors import Priors
 from .quoted import quoted_summary
 from .sampler import PosteriorSamples
+from .window import StationaryData
 
 #: The ``.nc`` group holding the f quoted's draws (the two posteriors in equal parts), which a campaign pools.
 HOOP_OR_PRIOR_GROUP = "hoop_or_prior"
@@ -81,35 +83,51 @@ class HoopOrPrior:
 
     nu_hoop: dict[str, float]  # nu's posterior with the hoop gauge: q05, q50, q95
     nu_prior: dict[str, float]  # nu's prior: q05, q50, q95
-    gauge_scale: float  # the hoop gauge's window mean over the model's from the forces and the prior's nu (reading_over_prediction)
+    gauge_scale: float  # the gauge's window mean over the model's from the forces and the prior's nu
     f_hoop: dict[str, float]  # f to quote with the hoop gauge (output bars' calibration folded in)
     f_prior: dict[str, float]  # f to quote with the hoop gauge left out
     f_quoted: dict[str, float]  # the two in equal parts
     f_given_headers: dict[str, float]  # the two in equal parts, given the bars' header values: mean, sd, q05, q50, q95
     flagged: tuple[tuple[str, str], ...]  # what the power-scaling check flagged, and its diagnosis of each
-    f_draws: np.ndarray = field(repr=False, default_factory=lambda: np.empty(0))  # the equal mixture's draws of f
+    #: the equal mixture's joint draws of f, nu, kappa and p_mean (Pa), given the bars' header values
+    draws: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
 
-    def sentence(self) -> str:
-        """The warning: what disagrees, f both ways, the f quoted."""
+    @property
+    def f_draws(self) -> np.ndarray:
+        return self.draws["f"]
+
+    @property
+    def medians(self) -> dict[str, float]:
+        """The two readings' f to quote, medians: "prior" (nu from the prior file alone) and "hoop"."""
+        return {"prior": self.f_prior["q50"], "hoop": self.f_hoop["q50"]}
+
+    def sentence(self, *, diagnosed: bool = False) -> str:
+        """The warning: what disagrees, f both ways, and what is quoted (``diagnosed``: the headline is the f of
+        the causes ``diagnose`` named, whose models read nu through the hoop gauge as well)."""
         def f(x: dict[str, float]) -> str:
             return f"f = {x['q50']:.4g} [{x['q05']:.4g}, {x['q95']:.4g}]"
 
-        h, p = self.nu_hoop, self.nu_prior
-        return (f"The tube's hoop gauge and the prior file disagree on nu (the prior-data check: "
-                f"{'; '.join(f'{n}: {d}' for n, d in self.flagged)}): with the hoop gauge nu = {h['q50']:.3g} [{h['q05']:.3g}, {h['q95']:.3g}] "
-                f"and {f(self.f_hoop)}; from the prior file's nu ({p['q50']:.3g} [{p['q05']:.3g}, {p['q95']:.3g}]) "
-                f"alone {f(self.f_prior)}. The hoop gauge reads {self.gauge_scale:.2g} times what the forces and the "
-                "prior's nu predict: either its scale is off (gauge factor, bridge, amplifier gain) or the prior file is not "
-                f"this sample's, and one record cannot tell which; the f quoted holds both in equal parts, "
-                f"{f(self.f_quoted)}. A calibration of the hoop gauge or a measured nu decides.")
+        h, p, q = self.nu_hoop, self.nu_prior, self.f_quoted
+        quoted = (f"`diagnose`'s f reads nu through the hoop gauge as well: quote it beside f from the prior's nu "
+                  f"alone, or the stationary analysis' two readings in equal parts, f from {q['q05']:.4g} to "
+                  f"{q['q95']:.4g}" if diagnosed else
+                  f"the f quoted holds both in equal parts: from {q['q05']:.4g} to {q['q95']:.4g} (90 %)")
+        return (f"The tube's hoop gauge and the prior file disagree (the prior-data check: "
+                f"{'; '.join(f'{n}: {d}' for n, d in self.flagged)}): with the hoop gauge nu = {h['q50']:.3g} "
+                f"[{h['q05']:.3g}, {h['q95']:.3g}] and {f(self.f_hoop)}; from the prior file's nu ({p['q50']:.3g} "
+                f"[{p['q05']:.3g}, {p['q95']:.3g}]) alone {f(self.f_prior)}. The hoop gauge reads "
+                f"{self.gauge_scale:.2g} times what the forces and the prior's nu predict: either its scale is off "
+                "(gauge factor, bridge, amplifier gain) or the prior file is not this sample's, and one record cannot "
+                f"tell which; {quoted}. A calibration of the hoop gauge or a measured nu decides.")
 
     def datatree_group(self):
-        """The ``.nc`` group :data:`HOOP_OR_PRIOR_GROUP`: the equal mixture's draws of f (given the bars' header
-        values), which the campaign pools in place of the hoop gauge's posterior alone."""
+        """The ``.nc`` group :data:`HOOP_OR_PRIOR_GROUP`: the equal mixture's joint draws of f, nu, kappa and
+        p_mean (given the bars' header values), which a campaign pools in place of the hoop gauge's posterior."""
         import xarray as xr
 
-        ds = xr.Dataset({"f": (("draw",), np.asarray(self.f_draws, float))},
-                        attrs={"description": "f with the hoop gauge and with nu from the prior file alone, equal parts",
+        ds = xr.Dataset({k: (("draw",), np.asarray(v, float)) for k, v in self.draws.items()},
+                        attrs={"description": "the stationary posterior with the hoop gauge and with nu from the "
+                                              "prior file alone, equal parts",
                                "flagged": "; ".join(f"{n}: {d}" for n, d in self.flagged)})
         return xr.DataTree(ds)
 
@@ -128,15 +146,25 @@ def reading_over_prediction(hoop: HoopTerm, prior_only: PosteriorSamples, draws:
     return float(np.median(np.mean(hoop.observed) / predicted))
 
 
+def _joint(samples: PosteriorSamples, data: StationaryData, n: int) -> dict[str, np.ndarray]:
+    """``n`` joint draws of f, nu, kappa and p_mean, evenly spaced through the chains."""
+    f, nu = _even(samples.flat("f"), n), _even(samples.flat("nu"), n)
+    derived = derived_draws({"f": f, "nu": nu}, data)
+    return {"f": f, "nu": nu, "kappa": derived["kappa"], "p_mean": derived["p_mean"]}
+
+
 def hoop_or_prior(with_hoop: PosteriorSamples, prior_only: PosteriorSamples, priors: Priors,
-                  conflict: PriorDataConflict, hoop: HoopTerm) -> HoopOrPrior:
+                  conflict: PriorDataConflict, hoop: HoopTerm, data: StationaryData) -> HoopOrPrior:
     """The two readings of one record (module docstring): ``with_hoop`` the run's posterior, ``prior_only`` the
-    same with the hoop gauge left out; ``hoop`` the likelihood's hoop term (its reading and prediction)."""
+    same with the hoop gauge left out; ``hoop`` the likelihood's hoop term (its reading and prediction), ``data``
+    the stationary data (for kappa and p_mean)."""
     nu = with_hoop.flat("nu")
     nu_p = np.asarray(priors["nu"].ppf(np.array(QUANTILES)), float)
-    scale = reading_over_prediction(hoop, prior_only)
     f_h, f_p = with_hoop.flat("f"), prior_only.flat("f")
-    both = equal_parts(f_h, f_p)
-    return HoopOrPrior(_summary(nu), {"q05": float(nu_p[0]), "q50": float(nu_p[1]), "q95": float(nu_p[2])}, scale,
-                       quoted_summary(f_h), quoted_summary(f_p), quoted_summary(both), summarize_draws(both),
-                       tuple((n, conflict.diagnosis[n]) for n in conflict.flagged), both)
+    n = min(len(f_h), len(f_p))
+    a, b = _joint(with_hoop, data, n), _joint(prior_only, data, n)
+    draws = {k: np.concatenate([a[k], b[k]]) for k in a}
+    return HoopOrPrior(_summary(nu), {"q05": float(nu_p[0]), "q50": float(nu_p[1]), "q95": float(nu_p[2])},
+                       reading_over_prediction(hoop, prior_only), quoted_summary(f_h), quoted_summary(f_p),
+                       quoted_summary(draws["f"]), summarize_draws(draws["f"]),
+                       tuple((n, conflict.diagnosis[n]) for n in conflict.flagged), draws)

@@ -64,8 +64,20 @@ def test_a_hoop_gauge_off_its_scale_gives_f_from_both_readings(half_scale_hoop):
     assert f["q05"] <= fp["q50"] and fh["q50"] <= f["q95"]  # ... and the f quoted holds both
     assert f["q05"] == hp["f_quoted"]["q05"] and "in equal parts" in f["source"]
     assert 0.35 < hp["hoop_scale_against_prior_nu"] < 0.6  # read at half its scale
-    said = [w for w in doc["warnings"] if w.startswith("The tube's hoop gauge and the prior file disagree on nu")]
+    said = [w for w in doc["warnings"] if w.startswith("The tube's hoop gauge and the prior file disagree")]
     assert len(said) == 1 and not any(w.startswith("The prior file and the data disagree") for w in doc["warnings"])
+    assert f"from {f['q05']:.4g} to {f['q95']:.4g} (90 %)" in said[0]
+
+
+def test_the_headline_of_two_readings_gives_each_and_no_median_between_them():
+    """The mixture's median can sit between the readings, where neither puts weight (a hoop gauge at 0.3 times:
+    0.091 between 0.045 and 0.151): the headline gives the interval and each reading's median."""
+    from friction_uq.report.quote import quote_line
+
+    fx = {"q05": 0.038, "q50": 0.070, "q95": 0.099, "mean": 0.068, "sd": 0.02}
+    line = quote_line(fx, None, 2, both={"prior": 0.0453, "hoop": 0.0899})
+    assert line.startswith("Headline f from 0.0380 to 0.0990 (90 %") and "0.0700" not in line
+    assert "nu from the prior file alone (0.0453) and with the hoop gauge (0.0899)" in line
 
 
 def test_the_campaign_pools_the_f_the_run_quotes(half_scale_hoop):
@@ -76,9 +88,15 @@ def test_the_campaign_pools_the_f_the_run_quotes(half_scale_hoop):
         assert h[HOOP_OR_PRIOR_GROUP]["f"].shape[0] > 0
     r = SimpleNamespace(outputs={"netcdf": nc.name}, label="A-03", campaign="A", window_halves=None,
                         prior_file=doc["prior_file"], summary={"V": doc["V"]}, path=str(nc))
-    f = read_test_posterior(r, nc.parent).f
-    assert np.quantile(f, 0.05) < doc["hoop_or_prior"]["f_prior_nu_alone"]["q50"]
-    assert np.quantile(f, 0.95) > doc["hoop_or_prior"]["f_with_hoop"]["q50"]
+    post = read_test_posterior(r, nc.parent)
+    assert np.quantile(post.f, 0.05) < doc["hoop_or_prior"]["f_prior_nu_alone"]["q50"]
+    assert np.quantile(post.f, 0.95) > doc["hoop_or_prior"]["f_with_hoop"]["q50"]
+    # nu (and p_mean, which follows it) the same two readings, not the hoop gauge's alone: a campaign's pooled nu
+    # moved from 0.373 to 0.337 with one test's hoop gauge at half its scale
+    nu_hoop, nu_prior = doc["hoop_or_prior"]["nu_with_hoop"], doc["hoop_or_prior"]["nu_prior"]
+    assert np.mean(post.nu < nu_hoop["q95"]) == pytest.approx(0.5, abs=0.05)
+    assert np.mean(post.nu > nu_prior["q05"]) == pytest.approx(0.5, abs=0.1)
+    assert np.all(np.isfinite(post.kappa)) and np.all(post.p_mean > 0)
 
 
 def test_a_sound_hoop_gauge_is_read_alone(tmp_path):
@@ -88,3 +106,14 @@ def test_a_sound_hoop_gauge_is_read_alone(tmp_path):
                    notes=False, whole_record=False)
     doc = json.loads(res.outputs["json"].read_text())
     assert doc["hoop_or_prior"] is None and doc["f"]["source"] == "the stationary analysis (eq. 17 and the hoop gauge)"
+
+
+def test_under_diagnose_the_warning_says_the_diagnosed_f_reads_the_hoop_gauge_too():
+    from friction_uq.hoop_or_prior import HoopOrPrior
+
+    hp = HoopOrPrior({"q05": 0.23, "q50": 0.25, "q95": 0.27}, {"q05": 0.35, "q50": 0.4, "q95": 0.45}, 0.45,
+                     {"q05": 0.08, "q50": 0.09, "q95": 0.1}, {"q05": 0.036, "q50": 0.045, "q95": 0.057},
+                     {"q05": 0.038, "q50": 0.07, "q95": 0.099}, {}, (("nu", "prior-data conflict"),))
+    said = hp.sentence(diagnosed=True)
+    assert "`diagnose`'s f reads nu through the hoop gauge as well" in said and "f from 0.038 to 0.099" in said
+    assert "the f quoted holds both" in hp.sentence()

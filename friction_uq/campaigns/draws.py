@@ -5,8 +5,9 @@ With ``--diagnose`` each record's ``.nc`` names the group of the model its headl
 (``discrepancy_final_group``); that group holds the draws of f_effective and, beside them, the log
 density of the prior they were drawn under (``log_prior_f_effective``, written by the run:
 friction_uq.discrepancy.effective_prior). The campaign reads both and divides that prior out. Where the run found the hoop gauge and nu's prior in
-disagreement, the stationary f it pools is the run's f quoted, both readings in equal parts (the ``.nc`` group
-``hoop_or_prior``, friction_uq.hoop_or_prior).
+disagreement, the stationary draws it reads (f, kappa, nu, p_mean) are both readings in equal parts, as the run
+quotes f (the ``.nc`` group ``hoop_or_prior``, friction_uq.hoop_or_prior); a cause ``diagnose`` named gives f
+under its model, as the run's headline does.
 """
 
 from __future__ import annotations
@@ -60,8 +61,8 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
         with h5py.File(nc, "r") as h:
             post = h["posterior"]
             draws = {k: thin(post[k][()]) for k in ("f", "kappa", "nu", "p_mean")}
-            if HOOP_OR_PRIOR_GROUP in h:  # the hoop gauge and nu's prior disagree: f as the run quotes it, from both
-                draws["f"] = thin(h[HOOP_OR_PRIOR_GROUP]["f"][()])
+            if HOOP_OR_PRIOR_GROUP in h:  # the hoop gauge and nu's prior disagree: both readings, as the run quotes f
+                draws = {k: thin(h[HOOP_OR_PRIOR_GROUP][k][()]) for k in ("f", "kappa", "nu", "p_mean")}
             f_model = f_log_prior = None
             # diagnosed (absent: no diagnosis, or an older version; "": no cause named)
             final = _text(h.attrs.get("discrepancy_final_group"))

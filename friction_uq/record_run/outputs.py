@@ -69,7 +69,8 @@ RUN_SCHEMA_VERSION = 10
 
 
 def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],
-             diagnosis=None, *, hoop: bool = True, both: bool = False) -> dict[str, object]:
+             diagnosis=None, *, hoop: bool = True,
+             both: dict[str, float] | None = None) -> dict[str, object]:
     """The JSON's ``f``: the f to quote (:func:`friction_uq.report.quote.f_to_quote`, with the output bars'
     calibration: :mod:`friction_uq.quoted`), the model it comes from, the calibration's sd (the budget, and what was
     folded in beyond what the model's likelihood carries) and the same f given
@@ -103,10 +104,11 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
 
 def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary], conv: Convergence,
                   outputs: dict[str, Path], seconds: float, conflict: PriorDataConflict | None = None,
-                  findings: list[str] | None = None) -> str:
-    """The table the terminal ends with."""
+                  findings: list[str] | None = None, *, both: bool = False) -> str:
+    """The table the terminal ends with (``both``: the headline is two readings, this table the hoop gauge's)."""
     units = {"p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
-    lines = [f"{campaign} {test_id}: posterior (90 % credible intervals), given the output bars' header values",
+    lines = [f"{campaign} {test_id}: posterior (90 % credible intervals), given the output bars' header values"
+             + (", with the hoop gauge (the headline holds it and nu from the prior alone)" if both else ""),
              f"{'quantity':<10} {'unit':<5} {'q50':>10} {'q05':>10} {'q95':>10} {'mean':>10} {'sd':>10}"]
     for name in ("f", "nu", "kappa", "hoop_gain", "ratio", "p_mean", "tau_mean", "V"):
         if name not in allv:

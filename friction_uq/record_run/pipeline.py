@@ -247,6 +247,11 @@ def _complete_datatree(post: StationaryPosterior, s: RunSetup, seed: int) -> Non
     })
 
 
+def _both(post: StationaryPosterior) -> dict[str, float] | None:
+    """The two readings' medians of f when the hoop gauge and nu's prior disagree, else None."""
+    return None if post.hoop_or_prior is None else post.hoop_or_prior.medians
+
+
 def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck | None, diag: object | None,
                    doc: dict[str, object], warns: list[str], outputs: dict[str, Path], seconds: float, *,
                    page: bool) -> None:
@@ -254,7 +259,7 @@ def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck
     from ..report.pdf import first_whole_record_page
     from ..report.quote import quote_line
 
-    print(quote_line(post.f_quoted, diag, len(warns), hoop=post.samples.hoop, both=post.hoop_or_prior is not None))
+    print(quote_line(post.f_quoted, diag, len(warns), hoop=post.samples.hoop, both=_both(post)))
     for w in warns:
         print(f"WARNING: {w}")
     lines = []
@@ -263,4 +268,4 @@ def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck
     if diag is not None:
         lines.append(doc["discrepancy"]["sentence"])
     print(summary_table(s.record.campaign, s.record.test_id, dict(post.summary) | {"V": post.V}, post.convergence,
-                        outputs, seconds, post.conflict, lines))
+                        outputs, seconds, post.conflict, lines, both=post.hoop_or_prior is not None))

@@ -25,7 +25,7 @@ def run_document(s: RunSetup, post: StationaryPosterior, *, seed: int, seconds: 
     summary, conv = post.summary, post.convergence
     doc: dict[str, object] = {"schema": RUN_SCHEMA, "schema_version": RUN_SCHEMA_VERSION, "warnings": warns,
                               "f": quoted_f(post.f_quoted, post.f_read.to_json(), diag, hoop=post.samples.hoop,
-                                            both=post.hoop_or_prior is not None)}
+                                            both=None if post.hoop_or_prior is None else post.hoop_or_prior.medians)}
     allv = dict(summary) | {"V": post.V}
     for name in JSON_VARIABLES:
         doc["f_stationary" if name == "f" else name] = _summary_json(allv[name])

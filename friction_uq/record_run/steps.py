@@ -191,4 +191,4 @@ def _hoop_or_prior(s: RunSetup, samples: PosteriorSamples, conflict: PriorDataCo
                              likelihood=_likelihood(s.prepared, s.settings, hoop=False))
     if not disagree(conflict, samples.flat("f"), alone.flat("f")):
         return None
-    return hoop_or_prior(samples, alone, s.priors, conflict, s.likelihood.hoop)
+    return hoop_or_prior(samples, alone, s.priors, conflict, s.likelihood.hoop, s.prepared.data)

@@ -210,6 +210,13 @@ def exact_posterior_warning(diagnosis) -> str | None:
             "again with another --seed and compare.")
 
 
+def _diagnosed_f(diagnosis) -> bool:
+    """Whether the f to quote is a diagnosed model's (a cause named, or a mixture with candidates)."""
+    from ..discrepancy.diagnosed_f import headline
+
+    return diagnosis is not None and headline(diagnosis) is not None
+
+
 def conflict_warning(conflict: PriorDataConflict | None, hoop_or_prior: HoopOrPrior | None = None) -> str | None:
     """The prior-data check's flags, unless the hoop gauge's disagreement with the prior says them already."""
     if conflict is None or not conflict.flagged or hoop_or_prior is not None:
@@ -234,6 +241,7 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
         stationarity_warning(ppc, excess_spread, dof, f, lab),
         misfit_warning(check, f, diagnosis),
         convergence_warning(conv), exact_posterior_warning(diagnosis),
-        None if hoop_or_prior is None else hoop_or_prior.sentence(), conflict_warning(conflict, hoop_or_prior),
+        None if hoop_or_prior is None else hoop_or_prior.sentence(diagnosed=_diagnosed_f(diagnosis)),
+        conflict_warning(conflict, hoop_or_prior),
     )
     return [w for w in found if w]

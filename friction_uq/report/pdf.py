@@ -103,7 +103,7 @@ def page_summary(r: ReportInputs) -> Figure:
     # wrapped here, not by matplotlib (whose wrap=True measures the text word by word); the lines shrink
     # together where they would run into the table below them
     first = "\n".join(textwrap.wrap(quote_line(stationary_quoted(r), r.diagnosis, len(r.warnings), hoop=r.samples.hoop,
-                                              both=r.hoop_or_prior is not None), 100))
+                                              both=None if r.hoop_or_prior is None else r.hoop_or_prior.medians), 100))
     ax.text(0.0, 1.0, first, fontsize=13, va="top", transform=ax.transAxes, weight="bold",
             color="firebrick" if r.warnings else "black")
     _draw_lines(fig, ax, _summary_lines(r), below=first.count("\n") + 1)
@@ -125,6 +125,8 @@ def _summary_lines(r: ReportInputs) -> list[str]:
     f, nu = s["f"], s["nu"]
     named = None if r.diagnosis is None else outcome_headline(r.diagnosis)  # the JSON's f (the f to quote)
     stationary = "The stationary analysis: "
+    if named is None and r.hoop_or_prior is not None:  # the first line holds this reading and the prior's nu's
+        stationary = "The stationary analysis with the hoop gauge (one of the two readings the first line holds): "
     if named is not None and r.diagnosis.named_causes:
         stationary = f"The stationary analysis without the named causes (page {whole_record_page(r) + 2} for them): "
     elif named is not None:  # nothing named: a mixture of the candidates (and, from run, of this analysis)

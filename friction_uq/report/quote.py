@@ -15,12 +15,12 @@ from ..discrepancy.diagnosed_f import further, headline
 
 
 def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool = True,
-               both: bool = False) -> tuple[str, Mapping[str, float]]:
+               both: Mapping[str, float] | None = None) -> tuple[str, Mapping[str, float]]:
     """(where it comes from, its summary: q05, q50, q95, ...). ``f_stationary``: the stationary analysis' f to
     quote (its posterior with the output bars' calibration, :mod:`friction_uq.quoted`), as the diagnosis's is;
     ``hoop``: whether the stationary analysis used the hoop gauge (it is left out when it shows no usable pulse);
-    ``both``: ``f_stationary`` is the analysis with the hoop gauge and with nu from the prior alone in equal parts
-    (they disagree: :mod:`friction_uq.hoop_or_prior`)."""
+    ``both``: the two readings' medians ("prior", "hoop") when ``f_stationary`` is the analysis with the hoop gauge
+    and with nu from the prior alone in equal parts (they disagree: :mod:`friction_uq.hoop_or_prior`)."""
     named = None if diagnosis is None else headline(diagnosis)
     if named is not None:
         label, fx = named
@@ -51,18 +51,23 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
         return f"the model with the causes diagnose named ({label})", fx
     if both:
         return ("the stationary analysis with the hoop gauge and with nu from the prior file alone, in equal parts "
-                "(they disagree on nu)"), f_stationary
+                "(they disagree)"), f_stationary
     return ("the stationary analysis (eq. 17 and the hoop gauge)" if hoop else
             "the stationary analysis (eq. 17; the hoop gauge left out)"), f_stationary
 
 
 def quote_line(f_stationary: Mapping[str, float], diagnosis=None, n_warnings: int = 0, *, hoop: bool = True,
-               both: bool = False) -> str:
+               both: Mapping[str, float] | None = None) -> str:
     """'Headline f = 0.0487 [0.0445, 0.0531] (90 %, the output bars' calibration included), from ...; every check
-    passed' (or the warnings' count)."""
+    passed' (or the warnings' count). From two readings that disagree (``both``), the interval and each reading's
+    median: the mixture's own median may sit between them, where neither puts weight."""
     source, fx = f_to_quote(f_stationary, diagnosis, hoop=hoop, both=both)
     trust = ("every check passed" if n_warnings == 0 else
              f"{n_warnings} warning{'s' if n_warnings > 1 else ''}: read {'them' if n_warnings > 1 else 'it'} "
              "before quoting it")
+    if both and source.startswith("the stationary analysis with the hoop gauge and"):
+        return (f"Headline f from {fx['q05']:.4f} to {fx['q95']:.4f} (90 %, the output bars' calibration included): "
+                f"the stationary analysis with nu from the prior file alone ({both['prior']:.4f}) and with the hoop "
+                f"gauge ({both['hoop']:.4f}), which disagree, in equal parts; {trust}.")
     return (f"Headline f = {fx['q50']:.4f} [{fx['q05']:.4f}, {fx['q95']:.4f}] (90 %, the output bars' calibration "
             f"included), from {source}; {trust}.")
