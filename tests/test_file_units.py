@@ -33,7 +33,9 @@ def test_a_column_name_ends_in_its_unit_or_not(name, unit):
 
 def test_a_units_row_has_a_unit_in_every_cell_that_is_not_empty():
     assert units_row(["(us)", "(mV)", "", "(V)"], 4) == ["us", "mV", None, "V"]
-    assert units_row(["s", "V", "V"], 4) is None  # not one cell per column
+    assert units_row(["s", "V", "V"], 4) == ["s", "V", "V", None]  # the empty cells at its end dropped by the split
+    assert units_row(["s", "V", "V", "V", "V"], 4) is None  # more cells than columns: not this table's row
+    assert units_row(["(s)", "(A)"], 2) == ["s", "A"]  # a current probe's unit is a unit, not a word
     assert units_row(["s", "V", "probe"], 3) is None  # a word that is no unit: not a units row
     assert units_row(["", "", ""], 3) is None
 
@@ -43,6 +45,7 @@ def test_conflicts_are_said_only_where_the_file_says_another_unit():
     assert channel_unit_conflict("mV", "V") == 'write units = "mV"'
     assert channel_unit_conflict("microstrain", "strain") == 'write units = "microstrain"'
     assert "is it the time column" in channel_unit_conflict("s", "V")
+    assert "is it the right column" in channel_unit_conflict("A", "V")
     assert time_unit_conflict("us", "\u00b5s") is None and time_unit_conflict("s", "s") is None
     assert time_unit_conflict("V", "s") is None  # a time column the file calls volts: its range decides
     assert time_unit_conflict("ms", "s") == 'write [time] units = "ms"'

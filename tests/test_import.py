@@ -359,6 +359,34 @@ def test_a_unit_the_file_writes_against_the_one_declared_is_refused(tmp_path, sc
     assert key in err and words in err, err
 
 
+@pytest.mark.parametrize("row, words", [
+    ("(us),,,,", "[time] units: is 's', but"),  # the empty cells at its end (the split drops them)
+    ("s,V,mV", "[channels.internal_output_bar] units: is 'V', but"),  # fewer cells than columns
+    ("s,V,V,(A),V", "[channels.external_output_bar] units: is 'V', but"),  # a current probe's column
+    ("s,V,mV,V,V\n,,,,", "[channels.internal_output_bar] units: is 'V', but"),  # a line of delimiters before the data
+])
+def test_a_units_row_however_it_is_cut_is_read(tmp_path, scope_csv, capsys, row, words):
+    """A reviewer's cases, each imported as if it held volts and seconds: a units row whose empty cells at its end
+    the split drops, one shorter than the header, a unit that is no gauge's, a line of delimiters below it."""
+    _units_row(scope_csv, row)
+    assert words in _refused(tmp_path, [scope_csv], setup_doc(), capsys)
+
+
+def test_columns_by_number_take_their_names_and_units_from_the_header_not_the_units_row(tmp_path, scope_csv, capsys):
+    """With columns given by number, the message named column 3 after its units-row cell ("column 'mV'"), and a
+    header "Time (us)" was not read."""
+    _units_row(scope_csv, "s,V,mV,V,V")
+    doc = setup_doc(time={"column": 1})
+    for k, g in enumerate(COLUMNS, start=2):
+        doc["channels"][g]["column"] = k
+    err = _refused(tmp_path, [scope_csv], doc, capsys)
+    assert "gives column 'CH2' (number 3) in mV by its units row (line 7)" in err, err
+    text = scope_csv.read_text().replace("s,V,mV,V,V\n", "\n")  # no units row: the header's names say it
+    scope_csv.write_text(text.replace("Time,CH1,CH2,CH3,CH4", "Time (us),CH1,CH2,CH3,CH4"))
+    err = _refused(tmp_path, [scope_csv], doc, capsys)
+    assert "[time] units: is 's', but" in err and "in us by its name" in err, err
+
+
 def test_a_unit_in_a_column_name_is_read_and_a_row_of_other_words_is_not_a_units_row(tmp_path, scope_csv, capsys):
     _units_row(scope_csv, "Channel,probe 10:1,probe 10:1,probe 1:1,probe 1:1")  # words, not units: nothing said
     text = scope_csv.read_text().replace("Time,CH1,CH2,CH3,CH4", "Time (s),CH1,CH2 [mV],CH3,CH4")

@@ -81,17 +81,29 @@ def _header(path: Path, head: list[str], start: int, delim: str | None,
     return None, []
 
 
-def _units(head: list[str], start: int, hline: int | None, named: bool, delim: str | None, ncols: int,
-           header: list[str], idx: list[int]) -> tuple[list[str | None], int | None]:
-    """Each asked column's unit, and the line of the units row it came from: the nearest line above the data when
-    it is a units row (:func:`.file_units.units_row`) and not the header that names the columns; else the
-    bracketed end of each column's name in the header (``Time (s)``)."""
-    above = next((i for i in range(start - 1, max(-1, start - 4), -1) if head[i].strip()), None)
-    if above is not None and not (named and above == hline):
-        row = units_row(fields(head[above], delim), ncols)
-        if row is not None:
-            return [row[i] for i in idx], above + 1
-    return [suffix_unit(header[i]) if named and i < len(header) else None for i in idx], None
+def _units_row_above(head: list[str], start: int, delim: str | None, ncols: int,
+                     names: list[str]) -> tuple[int | None, list[str | None]]:
+    """(index, each column's unit) of a units row right above the data (:func:`.file_units.units_row`; lines of
+    delimiters alone are passed over), else (None, []). A line that names every column asked for is the header,
+    whatever its words."""
+    for i in range(start - 1, max(-1, start - 4), -1):
+        cells = fields(head[i], delim)
+        if not any(c.strip().strip('"') for c in cells):
+            continue
+        low = [c.strip().strip('"').lower() for c in cells]
+        row = units_row(cells, ncols)
+        if row is None or (names and all(w.lower() in low for w in names)):
+            return None, []
+        return i, row
+    return None, []
+
+
+def _units(urow: list[str | None], header: list[str], named: bool, ncols: int, idx: list[int]) -> list[str | None]:
+    """Each asked column's unit: from the units row, else the bracketed end of its name in the header (``Time (s)``)
+    when the header names the columns (columns asked by name, or a header line with one name per column)."""
+    names = named or len(header) == ncols
+    return [(urow[i] if i < len(urow) else None) or (suffix_unit(header[i]) if names and i < len(header) else None)
+            for i in idx]
 
 
 def _index(path: Path, key: str | int, header: list[str], header_line: int | None, ncols: int) -> int:
@@ -200,7 +212,8 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
     delim, dec, ncols = find_dialect(p, tail, text)
     start = data_start(p, head, delim, dec, ncols)
     names = [w for w in wanted if isinstance(w, str)]
-    hline, header = _header(p, head, start, delim, names)
+    uline, urow = _units_row_above(head, start, delim, ncols, names)
+    hline, header = _header(p, head, start if uline is None else uline, delim, names)
     idx = [_index(p, w, header, None if hline is None else hline + 1, ncols) for w in wanted]
     labels = [repr(header[i]) if i < len(header) else f"{i + 1}" for i in idx]
     labels = [f"{lab} (number {i + 1})" for lab, i in zip(labels, idx)]
@@ -227,9 +240,9 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
         err = _locate_bad_cell(p, text.split("\n"), start, delim, dec, idx, labels, ncols)
         raise (err or ScopeFileError(f"{p}: cannot be read as a table from line {start + 1}: {exc}")) from None
     cols = {w: np.ascontiguousarray(data[:, uniq.index(i)]) for w, i in zip(wanted, idx)}
-    units, units_line = _units(head, start, hline, bool(names), delim, ncols, header, idx)
+    units = _units(urow, header, bool(names), ncols, idx)
     return TextTable(p, cols, dict(zip(wanted, labels)), start + 1, None if hline is None else hline + 1, delim, dec,
-                     dict(zip(wanted, units)), units_line)
+                     dict(zip(wanted, units)), None if uline is None else uline + 1)
 
 
 def describe_text(path: str | Path) -> list[str]:

@@ -20,6 +20,9 @@ STRAIN = {"strain": "strain", "m/m": "strain", "\u03b5": "strain", "microstrain"
           "\u03bcstrain": "microstrain", "ustrain": "microstrain"}
 TIME = {"s": "s", "sec": "s", "second": "s", "seconds": "s", "ms": "ms", "msec": "ms", "us": "us",
         "\u00b5s": "us", "\u03bcs": "us", "usec": "us", "ns": "ns", "nsec": "ns"}
+#: Units a scope writes for what no gauge channel holds (a current probe, a percentage, a power, a frequency).
+OTHER = {"a": "A", "ma": "mA", "amp": "A", "amps": "A", "ampere": "A", "%": "%", "db": "dB", "dbm": "dBm",
+         "w": "W", "hz": "Hz", "pa": "Pa", "n": "N", "\u00b0c": "degC", "degc": "degC"}
 
 _SUFFIX = re.compile(r"[(\[]\s*([^()\[\]]{1,16}?)\s*[)\]]\s*$")
 
@@ -29,7 +32,7 @@ def unit_name(cell: str) -> str | None:
     s = cell.strip().strip('"').strip()
     m = re.fullmatch(r"[(\[]\s*(.*?)\s*[)\]]", s)
     key = (m.group(1) if m else s).replace(" ", "").casefold()
-    return VOLTAGE.get(key) or STRAIN.get(key) or TIME.get(key)
+    return VOLTAGE.get(key) or STRAIN.get(key) or TIME.get(key) or OTHER.get(key)
 
 
 def suffix_unit(name: str) -> str | None:
@@ -39,10 +42,11 @@ def suffix_unit(name: str) -> str | None:
 
 
 def units_row(cells: list[str], ncols: int) -> list[str | None] | None:
-    """Each column's unit when the line ``cells`` is a units row (one cell per column, every cell that is not
-    empty naming a unit, at least one of them), else None."""
-    if len(cells) != ncols:
+    """Each column's unit when the line ``cells`` is a units row (at most one cell per column, the missing ones at
+    its end empty, every cell that is not empty naming a unit, at least one of them), else None."""
+    if len(cells) > ncols:
         return None
+    cells = list(cells) + [""] * (ncols - len(cells))
     units = [unit_name(c) if c.strip().strip('"') else None for c in cells]
     named = [u for u, c in zip(units, cells) if c.strip().strip('"')]
     return units if named and all(named) else None
@@ -57,6 +61,8 @@ def channel_unit_conflict(file_unit: str | None, declared: str) -> str | None:
         return f"the file gives its unit as {file_unit}, a time: is it the time column?"
     if file_unit in ("uV", "kV"):
         return f"write the channel's numbers in V or mV (SETUP.toml has no {file_unit})"
+    if file_unit in OTHER.values():
+        return f"a gauge's channel holds volts or strain: is it the right column (SETUP.toml has no {file_unit})?"
     return f'write units = "{file_unit}"'
 
 
