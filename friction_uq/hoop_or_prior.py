@@ -91,6 +91,7 @@ class HoopOrPrior:
     flagged: tuple[tuple[str, str], ...]  # what the power-scaling check flagged, and its diagnosis of each
     #: the equal mixture's joint draws of f, nu, kappa and p_mean (Pa), given the bars' header values
     draws: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
+    prior_converged: bool = True  # whether the sampling with the hoop gauge left out met the stopping rule
 
     @property
     def f_draws(self) -> np.ndarray:
@@ -118,7 +119,9 @@ class HoopOrPrior:
                 f"[{p['q05']:.3g}, {p['q95']:.3g}]) alone {f(self.f_prior)}. The hoop gauge reads "
                 f"{self.gauge_scale:.2g} times what the forces and the prior's nu predict: either its scale is off "
                 "(gauge factor, bridge, amplifier gain) or the prior file is not this sample's, and one record cannot "
-                f"tell which; {quoted}. A calibration of the hoop gauge or a measured nu decides.")
+                f"tell which; {quoted}. A calibration of the hoop gauge or a measured nu decides."
+                + ("" if self.prior_converged else " (The sampling with nu from the prior alone stopped short of its "
+                   "convergence rule: its interval is not reliable; run again with another --seed.)"))
 
     def datatree_group(self):
         """The ``.nc`` group :data:`HOOP_OR_PRIOR_GROUP`: the equal mixture's joint draws of f, nu, kappa and
@@ -135,7 +138,7 @@ class HoopOrPrior:
         return {"flagged": dict(self.flagged), "nu_with_hoop": self.nu_hoop, "nu_prior": self.nu_prior,
                 "hoop_scale_against_prior_nu": self.gauge_scale, "f_with_hoop": self.f_hoop,
                 "f_prior_nu_alone": self.f_prior, "f_quoted": self.f_quoted, "f_given_bar_headers": self.f_given_headers,
-                "mixture": "equal parts of the two posteriors"}
+                "mixture": "equal parts of the two posteriors", "prior_nu_alone_converged": self.prior_converged}
 
 
 def reading_over_prediction(hoop: HoopTerm, prior_only: PosteriorSamples, draws: int = 400) -> float:
@@ -167,4 +170,4 @@ def hoop_or_prior(with_hoop: PosteriorSamples, prior_only: PosteriorSamples, pri
     return HoopOrPrior(_summary(nu), {"q05": float(nu_p[0]), "q50": float(nu_p[1]), "q95": float(nu_p[2])},
                        reading_over_prediction(hoop, prior_only), quoted_summary(f_h), quoted_summary(f_p),
                        quoted_summary(draws["f"]), summarize_draws(draws["f"]),
-                       tuple((n, conflict.diagnosis[n]) for n in conflict.flagged), draws)
+                       tuple((n, conflict.diagnosis[n]) for n in conflict.flagged), draws, bool(prior_only.converged))
