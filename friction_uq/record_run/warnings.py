@@ -32,6 +32,7 @@ from ..gauge_balance import BALANCE_TOL, GaugeFinding, balance_departure
 from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
+from ..discrepancy.diagnosed_f import headline
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from ..hoop_or_prior import HoopOrPrior
 from ..prior_sensitivity import PriorDataConflict
@@ -212,8 +213,6 @@ def exact_posterior_warning(diagnosis) -> str | None:
 
 def _diagnosed_f(diagnosis) -> bool:
     """Whether the f to quote is a diagnosed model's (a cause named, or a mixture with candidates)."""
-    from ..discrepancy.diagnosed_f import headline
-
     return diagnosis is not None and headline(diagnosis) is not None
 
 
