@@ -372,6 +372,15 @@ def test_a_units_row_however_it_is_cut_is_read(tmp_path, scope_csv, capsys, row,
     assert words in _refused(tmp_path, [scope_csv], setup_doc(), capsys)
 
 
+def test_a_unit_read_from_a_name_beside_a_units_row_is_said_to_come_from_the_name(tmp_path, scope_csv, capsys):
+    _units_row(scope_csv, "s,V,,V,V")  # the units row says nothing of CH2; its name does
+    scope_csv.write_text(scope_csv.read_text().replace("Time,CH1,CH2,CH3,CH4", "Time,CH1,CH2 [mV],CH3,CH4"))
+    doc = setup_doc()
+    doc["channels"]["internal_output_bar"]["column"] = "CH2 [mV]"
+    err = _refused(tmp_path, [scope_csv], doc, capsys)
+    assert "gives column 'CH2 [mV]' (number 3) in mV by its name;" in err, err
+
+
 def test_columns_by_number_take_their_names_and_units_from_the_header_not_the_units_row(tmp_path, scope_csv, capsys):
     """With columns given by number, the message named column 3 after its units-row cell ("column 'mV'"), and a
     header "Time (us)" was not read."""

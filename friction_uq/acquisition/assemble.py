@@ -104,18 +104,17 @@ def _read_file(setup: Setup, file: Path, chans: list[ChannelSetup]) -> list[Chan
 def _check_units(setup: Setup, file: Path, table: TextTable, chans: list[ChannelSetup]) -> None:
     """Refuse a channel or time column whose unit in the file (a units row, or its name's bracketed end) is not the
     one SETUP.toml declares: the file's numbers would be read a thousand or a million times off."""
-    where = f"its units row (line {table.units_line})" if table.units_line else "its name"
     for c in chans:
         problem = channel_unit_conflict(table.units.get(c.column), c.units)
         if problem:
             raise SetupError(f"{setup.path}: [channels.{c.gauge}] units: is {c.units!r}, but {file} gives column "
-                             f"{table.labels[c.column]} in {table.units[c.column]} by {where}; {problem}")
+                             f"{table.labels[c.column]} in {table.units[c.column]} by {table.units_from[c.column]}; {problem}")
     ts = setup.time
     if ts is not None and ts.column is not None:
         problem = time_unit_conflict(table.units.get(ts.column), ts.units)
         if problem:
             raise SetupError(f"{setup.path}: [time] units: is {ts.units!r}, but {file} gives the time column "
-                             f"{table.labels[ts.column]} in {table.units[ts.column]} by {where}; {problem}")
+                             f"{table.labels[ts.column]} in {table.units[ts.column]} by {table.units_from[ts.column]}; {problem}")
 
 
 def _common_time_base(chans: list[Channel]) -> tuple[float, float, int]:

@@ -47,10 +47,10 @@ class TextTable:
     header_line: int | None
     delimiter: str | None
     decimal: str
-    #: the unit the file writes beside each column asked for (None: it says none this package knows), and the
-    #: line of the units row they came from (None: from the header's names, or no units at all)
+    #: the unit the file writes beside each column asked for (None: it says none this package knows), and where:
+    #: "units row (line N)" or "name"
     units: dict[str | int, str | None] = field(default_factory=dict)
-    units_line: int | None = None
+    units_from: dict[str | int, str] = field(default_factory=dict)
 
     @property
     def dialect(self) -> str:
@@ -98,12 +98,18 @@ def _units_row_above(head: list[str], start: int, delim: str | None, ncols: int,
     return None, []
 
 
-def _units(urow: list[str | None], header: list[str], named: bool, ncols: int, idx: list[int]) -> list[str | None]:
-    """Each asked column's unit: from the units row, else the bracketed end of its name in the header (``Time (s)``)
-    when the header names the columns (columns asked by name, or a header line with one name per column)."""
+def _units(urow: list[str | None], uline: int | None, header: list[str], named: bool, ncols: int,
+           idx: list[int]) -> list[tuple[str | None, str]]:
+    """Each asked column's (unit, where it was read): from the units row, else the bracketed end of its name in the
+    header (``Time (s)``) when the header names the columns (columns asked by name, or one name per column)."""
     names = named or len(header) == ncols
-    return [(urow[i] if i < len(urow) else None) or (suffix_unit(header[i]) if names and i < len(header) else None)
-            for i in idx]
+    out = []
+    for i in idx:
+        if i < len(urow) and urow[i] is not None:
+            out.append((urow[i], f"its units row (line {uline + 1})"))
+        else:
+            out.append((suffix_unit(header[i]) if names and i < len(header) else None, "its name"))
+    return out
 
 
 def _index(path: Path, key: str | int, header: list[str], header_line: int | None, ncols: int) -> int:
@@ -240,9 +246,9 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
         err = _locate_bad_cell(p, text.split("\n"), start, delim, dec, idx, labels, ncols)
         raise (err or ScopeFileError(f"{p}: cannot be read as a table from line {start + 1}: {exc}")) from None
     cols = {w: np.ascontiguousarray(data[:, uniq.index(i)]) for w, i in zip(wanted, idx)}
-    units = _units(urow, header, bool(names), ncols, idx)
+    units = _units(urow, uline, header, bool(names), ncols, idx)
     return TextTable(p, cols, dict(zip(wanted, labels)), start + 1, None if hline is None else hline + 1, delim, dec,
-                     dict(zip(wanted, units)), None if uline is None else uline + 1)
+                     {w: u for w, (u, _) in zip(wanted, units)}, {w: at for w, (_, at) in zip(wanted, units)})
 
 
 def describe_text(path: str | Path) -> list[str]:
