@@ -129,8 +129,8 @@ class HoopOrPrior:
         import xarray as xr
 
         ds = xr.Dataset({k: (("draw",), np.asarray(v, float)) for k, v in self.draws.items()},
-                        attrs={"description": "the stationary posterior with the hoop gauge and with nu from the "
-                                              "prior file alone, equal parts",
+                        attrs={"description": "the stationary posterior with the hoop gauge (first half of each "
+                                              "array) and with nu from the prior file alone (second half), equal parts",
                                "flagged": "; ".join(f"{n}: {d}" for n, d in self.flagged)})
         return xr.DataTree(ds)
 

@@ -49,3 +49,13 @@ def test_conflicts_are_said_only_where_the_file_says_another_unit():
     assert time_unit_conflict("us", "\u00b5s") is None and time_unit_conflict("s", "s") is None
     assert time_unit_conflict("V", "s") is None  # a time column the file calls volts: its range decides
     assert time_unit_conflict("ms", "s") == 'write [time] units = "ms"'
+
+
+def test_a_metadata_line_of_numbered_columns_is_no_header_to_read_units_from():
+    """Columns by number, no header, a line "Sample Rate (Hz),1000000" right above the data: its bracket is no
+    column's unit (a reviewer's case; a "Sampling interval (us)" would have refused a time column in s)."""
+    from friction_uq.acquisition.delimited import _units
+
+    assert _units([], None, ["Sample Rate (Hz)", "1000000"], False, 2, [0, 1], ".") == [(None, "its name")] * 2
+    assert _units([], None, ["Time (us)", "CH1 [mV]"], False, 2, [0, 1], ".") == [("us", "its name"),
+                                                                               ("mV", "its name")]

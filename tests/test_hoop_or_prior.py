@@ -117,3 +117,34 @@ def test_under_diagnose_the_warning_says_the_diagnosed_f_reads_the_hoop_gauge_to
     said = hp.sentence(diagnosed=True)
     assert "`diagnose`'s f reads nu through the hoop gauge as well" in said and "f from 0.038 to 0.099" in said
     assert "the f quoted holds both" in hp.sentence()
+
+
+def test_a_test_whose_hoop_gauge_disagrees_is_left_out_of_the_campaigns_nu():
+    """Its nu is half the prior's, whose spread can exceed the prior's (a negative precision moved the campaign's nu),
+    and half a reading the run could not trust."""
+    from friction_uq.campaigns.analysis import campaign_nu
+    from friction_uq.campaigns.draws import RecordPosterior
+
+    rng = np.random.default_rng(1)
+
+    def test(nu, sd, both=False):
+        x = rng.normal(nu, sd, 2000)
+        return RecordPosterior("t", "A", x, x, x, x, {"mean": 9.0, "sd": 0.1}, "p", hoop_disagrees=both)
+
+    sound = [test(0.38, 0.01) for _ in range(3)]
+    mixed = test(0.30, 0.06, both=True)
+    assert campaign_nu(sound + [mixed], 0.4, 0.03) == campaign_nu(sound, 0.4, 0.03)
+    assert campaign_nu([mixed], 0.4, 0.03) == (0.4, 0.03)
+
+
+def test_the_campaign_reads_kappa_from_the_reading_without_the_hoop_gauge():
+    """kappa does not depend on nu; a gauge at three times its scale is fitted through f and put the hoop reading's
+    kappa at 0.34 against the forces' 0.030. A group of f alone (the session's first version) gives f only."""
+    from friction_uq.campaigns.draws import _both_readings
+
+    n = 500
+    group = {"f": np.r_[np.full(n, 0.4), np.full(n, 0.05)], "nu": np.r_[np.full(n, 0.45), np.full(n, 0.4)],
+             "kappa": np.r_[np.full(n, 0.34), np.full(n, 0.03)], "p_mean": np.full(2 * n, 8e7)}
+    out = _both_readings(group)
+    assert np.all(out["kappa"] == 0.03) and set(np.unique(out["f"])) == {0.05, 0.4}
+    assert set(_both_readings({"f": group["f"]})) == {"f"}

@@ -48,7 +48,7 @@ class TextTable:
     delimiter: str | None
     decimal: str
     #: the unit the file writes beside each column asked for (None: it says none this package knows), and where:
-    #: "units row (line N)" or "name"
+    #: "its units row (line N)" or "its name"
     units: dict[str | int, str | None] = field(default_factory=dict)
     units_from: dict[str | int, str] = field(default_factory=dict)
 
@@ -99,10 +99,11 @@ def _units_row_above(head: list[str], start: int, delim: str | None, ncols: int,
 
 
 def _units(urow: list[str | None], uline: int | None, header: list[str], named: bool, ncols: int,
-           idx: list[int]) -> list[tuple[str | None, str]]:
+           idx: list[int], dec: str) -> list[tuple[str | None, str]]:
     """Each asked column's (unit, where it was read): from the units row, else the bracketed end of its name in the
-    header (``Time (s)``) when the header names the columns (columns asked by name, or one name per column)."""
-    names = named or len(header) == ncols
+    header (``Time (s)``) when the header names the columns: columns asked by name, or one name per column and no
+    number among them (not a metadata line such as ``Sample Rate (Hz),1000000``)."""
+    names = named or (len(header) == ncols and not any(is_number(c.strip().strip('"'), dec) for c in header))
     out = []
     for i in idx:
         if i < len(urow) and urow[i] is not None:
@@ -246,7 +247,7 @@ def read_delimited(path: str | Path, wanted: list[str | int]) -> TextTable:
         err = _locate_bad_cell(p, text.split("\n"), start, delim, dec, idx, labels, ncols)
         raise (err or ScopeFileError(f"{p}: cannot be read as a table from line {start + 1}: {exc}")) from None
     cols = {w: np.ascontiguousarray(data[:, uniq.index(i)]) for w, i in zip(wanted, idx)}
-    units = _units(urow, uline, header, bool(names), ncols, idx)
+    units = _units(urow, uline, header, bool(names), ncols, idx, dec)
     return TextTable(p, cols, dict(zip(wanted, labels)), start + 1, None if hline is None else hline + 1, delim, dec,
                      {w: u for w, (u, _) in zip(wanted, units)}, {w: at for w, (_, at) in zip(wanted, units)})
 

@@ -37,7 +37,12 @@ LAW_DRAWS = 160
 
 
 def campaign_nu(tests: Sequence[RecordPosterior], prior_mean: float, prior_sd: float) -> tuple[float, float]:
-    """nu shared by the tests: normal approximations of their posteriors combined, the prior counted once."""
+    """nu shared by the tests: normal approximations of their posteriors combined, the prior counted once. A test
+    whose hoop gauge and nu's prior disagree is left out: its nu is half the prior's, which its spread can exceed
+    (a negative precision), and half a reading the run could not trust."""
+    tests = [t for t in tests if not t.hoop_disagrees]
+    if not tests:
+        return prior_mean, prior_sd
     prec = sum(1.0 / np.var(t.nu) for t in tests) - (len(tests) - 1) / prior_sd**2
     num = sum(np.mean(t.nu) / np.var(t.nu) for t in tests) - (len(tests) - 1) * prior_mean / prior_sd**2
     if prec <= 1.0 / prior_sd**2:  # the tests add nothing beyond the prior (no hoop term): keep the prior

@@ -5,9 +5,10 @@ With ``--diagnose`` each record's ``.nc`` names the group of the model its headl
 (``discrepancy_final_group``); that group holds the draws of f_effective and, beside them, the log
 density of the prior they were drawn under (``log_prior_f_effective``, written by the run:
 friction_uq.discrepancy.effective_prior). The campaign reads both and divides that prior out. Where the run found the hoop gauge and nu's prior in
-disagreement, the stationary draws it reads (f, kappa, nu, p_mean) are both readings in equal parts, as the run
-quotes f (the ``.nc`` group ``hoop_or_prior``, friction_uq.hoop_or_prior); a cause ``diagnose`` named gives f
-under its model, as the run's headline does.
+disagreement, the stationary draws it reads (f, nu, p_mean) are both readings in equal parts, as the run quotes
+f, and kappa the reading without the hoop gauge (the ``.nc`` group ``hoop_or_prior``, friction_uq.hoop_or_prior);
+such a test is left out of the campaign's nu. A cause ``diagnose`` named gives f under its model, as the run's
+headline does.
 """
 
 from __future__ import annotations
@@ -48,6 +49,9 @@ class RecordPosterior:
     #: kappa's change across the stationary window and the halves' slip, speed and pressure (the slip law's
     #: data); None when the run gave none
     halves: WindowHalves | None = None
+    #: the run found the hoop gauge and nu's prior in disagreement (friction_uq.hoop_or_prior): its nu is not a
+    #: witness of the campaign's nu
+    hoop_disagrees: bool = False
 
 
 def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
@@ -61,8 +65,9 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
         with h5py.File(nc, "r") as h:
             post = h["posterior"]
             draws = {k: thin(post[k][()]) for k in ("f", "kappa", "nu", "p_mean")}
-            if HOOP_OR_PRIOR_GROUP in h:  # the hoop gauge and nu's prior disagree: both readings, as the run quotes f
-                draws = {k: thin(h[HOOP_OR_PRIOR_GROUP][k][()]) for k in ("f", "kappa", "nu", "p_mean")}
+            both = HOOP_OR_PRIOR_GROUP in h  # the hoop gauge and nu's prior disagree: both readings, as the run quotes f
+            if both:
+                draws |= _both_readings(h[HOOP_OR_PRIOR_GROUP])
             f_model = f_log_prior = None
             # diagnosed (absent: no diagnosis, or an older version; "": no cause named)
             final = _text(h.attrs.get("discrepancy_final_group"))
@@ -85,7 +90,19 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
                               "not finite at some draws (a draw where its prior has no density cannot be pooled)")
     return RecordPosterior(r.label, str(r.campaign), draws["f"], draws["kappa"], draws["nu"], draws["p_mean"],
                            r.summary["V"], str(r.prior_file), f_model, f_log_prior,
-                           halves)
+                           halves, both)
+
+
+def _both_readings(group) -> dict[str, np.ndarray]:
+    """f, nu and p_mean of the two readings in equal parts; kappa of the reading without the hoop gauge (the
+    group's second half), the forces' own: kappa does not depend on nu, and a gauge far off its scale is fitted
+    through f and moves the hoop reading's kappa with it (tenfold at three times its scale). A group that holds f
+    alone (written by this session's first version) gives f only."""
+    out = {"f": thin(group["f"][()])}
+    if "kappa" in group:
+        kappa = np.asarray(group["kappa"][()], float)
+        out |= {"kappa": thin(kappa[kappa.size // 2:]), "nu": thin(group["nu"][()]), "p_mean": thin(group["p_mean"][()])}
+    return out
 
 
 def _text(value: object) -> str | None:

@@ -32,10 +32,10 @@ from ..gauge_balance import BALANCE_TOL, GaugeFinding, balance_departure
 from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
-from ..discrepancy.diagnosed_f import headline
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from ..hoop_or_prior import HoopOrPrior
 from ..prior_sensitivity import PriorDataConflict
+from ..report.quote import f_from_diagnosis
 from ..stats.exact import ess_floor
 
 #: Least fraction of the window where the smoothed ratio lies in its 90 % noise band (about 0.9 on a
@@ -211,11 +211,6 @@ def exact_posterior_warning(diagnosis) -> str | None:
             "again with another --seed and compare.")
 
 
-def _diagnosed_f(diagnosis) -> bool:
-    """Whether the f to quote is a diagnosed model's (a cause named, or a mixture with candidates)."""
-    return diagnosis is not None and headline(diagnosis) is not None
-
-
 def conflict_warning(conflict: PriorDataConflict | None, hoop_or_prior: HoopOrPrior | None = None) -> str | None:
     """The prior-data check's flags, unless the hoop gauge's disagreement with the prior says them already."""
     if conflict is None or not conflict.flagged or hoop_or_prior is not None:
@@ -240,7 +235,7 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
         stationarity_warning(ppc, excess_spread, dof, f, lab),
         misfit_warning(check, f, diagnosis),
         convergence_warning(conv), exact_posterior_warning(diagnosis),
-        None if hoop_or_prior is None else hoop_or_prior.sentence(diagnosed=_diagnosed_f(diagnosis)),
+        None if hoop_or_prior is None else hoop_or_prior.sentence(diagnosed=f_from_diagnosis(diagnosis)),
         conflict_warning(conflict, hoop_or_prior),
     )
     return [w for w in found if w]

@@ -56,6 +56,11 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
             "the stationary analysis (eq. 17; the hoop gauge left out)"), f_stationary
 
 
+def f_from_diagnosis(diagnosis) -> bool:
+    """Whether the f to quote is a diagnosed model's (a cause named, or a mixture with candidates)."""
+    return diagnosis is not None and headline(diagnosis) is not None
+
+
 def quote_line(f_stationary: Mapping[str, float], diagnosis=None, n_warnings: int = 0, *, hoop: bool = True,
                both: Mapping[str, float] | None = None) -> str:
     """'Headline f = 0.0487 [0.0445, 0.0531] (90 %, the output bars' calibration included), from ...; every check
