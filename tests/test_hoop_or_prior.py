@@ -148,3 +148,16 @@ def test_the_campaign_reads_kappa_from_the_reading_without_the_hoop_gauge():
     out = _both_readings(group)
     assert np.all(out["kappa"] == 0.03) and set(np.unique(out["f"])) == {0.05, 0.4}
     assert set(_both_readings({"f": group["f"]})) == {"f"}
+
+
+def test_the_campaign_says_which_tests_hoop_gauge_disagreed():
+    from friction_uq.campaigns.conclusions import CampaignAnalysis
+    from friction_uq.campaigns.draws import RecordPosterior
+    from friction_uq.campaigns.outputs import statements
+
+    x = np.full(10, 0.05)
+    tests = [RecordPosterior(label, "A", x, x, x, x, {"mean": 9.0, "sd": 0.1}, "p", hoop_disagrees=both)
+             for label, both in (("A A-01", False), ("A A-03", True))]
+    said = statements(CampaignAnalysis(tests=tests, pooled={}, tallies={}))
+    assert any(s.startswith("test A A-03: the hoop gauge and the prior file disagree on nu") for s in said)
+    assert not any("A A-01" in s for s in said)
