@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .diagnostics import VariableSummary
 from .diagnostics.datatree import derived_draws
 from .likelihood.hoop import HoopTerm
 from .models.parameters import summarize_draws
@@ -75,6 +76,14 @@ def equal_parts(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def _summary(x: np.ndarray) -> dict[str, float]:
     q = np.quantile(x, QUANTILES)
     return {"q05": float(q[0]), "q50": float(q[1]), "q95": float(q[2])}
+
+
+@dataclass(frozen=True)
+class TwoReadings(VariableSummary):
+    """f's summary over the two readings in equal parts: its median can sit between them, where neither puts
+    weight, so it is said as its interval (:func:`friction_uq.record_run.warnings` reads ``interval_only``)."""
+
+    interval_only = True
 
 
 @dataclass(frozen=True)

@@ -161,3 +161,15 @@ def test_the_campaign_says_which_tests_hoop_gauge_disagreed():
     said = statements(CampaignAnalysis(tests=tests, pooled={}, tallies={}))
     assert any(s.startswith("test A A-03: the hoop gauge and the prior file disagree on nu") for s in said)
     assert not any("A A-01" in s for s in said)
+
+
+def test_the_other_warnings_quote_two_readings_by_their_interval():
+    """The misfit warning said "may bias f = 0.06989 [0.03827, 0.09798]": a median between the readings, where neither
+    puts weight (at three times the gauge's scale it differed from the headline's in the third digit)."""
+    from friction_uq.diagnostics import VariableSummary
+    from friction_uq.hoop_or_prior import TwoReadings
+    from friction_uq.record_run.warnings import _f_text
+
+    one = VariableSummary(mean=0.068, sd=0.02, q05=0.03827, q50=0.06989, q95=0.09798, r_hat=1.0, ess_bulk=4000.0)
+    assert _f_text(one) == "f = 0.06989 [0.03827, 0.09798]"
+    assert _f_text(TwoReadings(**vars(one))) == "f (from 0.03827 to 0.09798, two readings)"

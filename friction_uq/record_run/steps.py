@@ -32,7 +32,7 @@ from ..diagnostics import (
     summarize,
 )
 from ..errors import OutputError, SamplingError
-from ..hoop_or_prior import HOOP_OR_PRIOR_GROUP, HoopOrPrior, disagree, hoop_or_prior, worth_asking
+from ..hoop_or_prior import HOOP_OR_PRIOR_GROUP, HoopOrPrior, TwoReadings, disagree, hoop_or_prior, worth_asking
 from ..likelihood import Likelihood
 from ..prior_sensitivity import FUnderPrior, PriorDataConflict
 from ..priors import Priors
@@ -135,7 +135,7 @@ class StationaryPosterior:
         f = self.summary["f"]
         if self.hoop_or_prior is None:
             return f
-        return dataclasses.replace(f, **self.hoop_or_prior.f_given_headers)
+        return TwoReadings(**(dataclasses.asdict(f) | self.hoop_or_prior.f_given_headers))
 
 
 def stationary_posterior(s: RunSetup, *, seed: int, backend: Path, progress: bool, say: Callable[[str], None],

@@ -53,6 +53,10 @@ def _stat(x: float) -> str:
 
 
 def _f_text(f: VariableSummary) -> str:
+    """f as a warning quotes it; two readings in equal parts (:class:`~friction_uq.hoop_or_prior.TwoReadings`) by
+    their interval alone, their mixture's median sitting between them."""
+    if getattr(f, "interval_only", False):
+        return f"f (from {f.q05:.4g} to {f.q95:.4g}, two readings)"
     return f"f = {f.q50:.4g} [{f.q05:.4g}, {f.q95:.4g}]"
 
 
