@@ -33,6 +33,7 @@ from .prior_sensitivity import PriorDataConflict
 from .priors import Priors
 from .quoted import quoted_summary
 from .sampler import PosteriorSamples
+from .stats.thinning import evenly_spaced
 from .window import StationaryData
 
 #: The ``.nc`` group holding the f quoted's draws (the two posteriors in equal parts), which a campaign pools.
@@ -62,15 +63,11 @@ def disagree(conflict: PriorDataConflict, f_hoop: np.ndarray, f_prior: np.ndarra
     return not (qh[0] <= qp[1] <= qh[2]) and not (qp[0] <= qh[1] <= qp[2])
 
 
-def _even(x: np.ndarray, n: int) -> np.ndarray:
-    """``n`` of ``x``'s draws, evenly spaced through them (the same draws for the same input)."""
-    return x[np.linspace(0, len(x) - 1, n).round().astype(int)]
-
-
 def equal_parts(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Draws of the equal mixture of two posteriors: as many of each, the smaller count."""
-    n = min(len(a), len(b))
-    return np.concatenate([_even(np.asarray(a, float), n), _even(np.asarray(b, float), n)])
+    """Draws of the equal mixture of two posteriors: as many of each, the smaller count, evenly spaced through each
+    (two variables of one posterior, cut alike, stay paired)."""
+    n = min(np.size(a), np.size(b))
+    return np.concatenate([evenly_spaced(a, n), evenly_spaced(b, n)])
 
 
 def _summary(x: np.ndarray) -> dict[str, float]:
@@ -81,9 +78,7 @@ def _summary(x: np.ndarray) -> dict[str, float]:
 @dataclass(frozen=True)
 class TwoReadings(VariableSummary):
     """f's summary over the two readings in equal parts: its median can sit between them, where neither puts
-    weight, so it is said as its interval (:func:`friction_uq.record_run.warnings` reads ``interval_only``)."""
-
-    interval_only = True
+    weight, so the warnings say it as its interval (:mod:`friction_uq.record_run.warnings`)."""
 
 
 @dataclass(frozen=True)
@@ -153,14 +148,14 @@ class HoopOrPrior:
 def reading_over_prediction(hoop: HoopTerm, prior_only: PosteriorSamples, draws: int = 400) -> float:
     """The hoop gauge's window mean over what the model predicts for it from the forces and the prior's nu (the
     prior-only posterior's f and nu, the gauge's calibration 1): the median over ``draws`` of its draws."""
-    f, nu = _even(prior_only.flat("f"), draws), _even(prior_only.flat("nu"), draws)
+    f, nu = evenly_spaced(prior_only.flat("f"), draws), evenly_spaced(prior_only.flat("nu"), draws)
     predicted = hoop.predict(f, nu, np.ones_like(f)).mean(axis=1)
     return float(np.median(np.mean(hoop.observed) / predicted))
 
 
-def _joint(samples: PosteriorSamples, data: StationaryData, n: int) -> dict[str, np.ndarray]:
-    """``n`` joint draws of f, nu, kappa and p_mean, evenly spaced through the chains."""
-    f, nu = _even(samples.flat("f"), n), _even(samples.flat("nu"), n)
+def _readings(samples: PosteriorSamples, data: StationaryData) -> dict[str, np.ndarray]:
+    """Every draw's f, nu, kappa and p_mean (Pa)."""
+    f, nu = samples.flat("f"), samples.flat("nu")
     derived = derived_draws({"f": f, "nu": nu}, data)
     return {"f": f, "nu": nu, "kappa": derived["kappa"], "p_mean": derived["p_mean"]}
 
@@ -172,10 +167,9 @@ def hoop_or_prior(with_hoop: PosteriorSamples, prior_only: PosteriorSamples, pri
     the stationary data (for kappa and p_mean)."""
     nu = with_hoop.flat("nu")
     nu_p = np.asarray(priors["nu"].ppf(np.array(QUANTILES)), float)
-    f_h, f_p = with_hoop.flat("f"), prior_only.flat("f")
-    n = min(len(f_h), len(f_p))
-    a, b = _joint(with_hoop, data, n), _joint(prior_only, data, n)
-    draws = {k: np.concatenate([a[k], b[k]]) for k in a}
+    a, b = _readings(with_hoop, data), _readings(prior_only, data)
+    draws = {k: equal_parts(a[k], b[k]) for k in a}
+    f_h, f_p = a["f"], b["f"]
     return HoopOrPrior(_summary(nu), {"q05": float(nu_p[0]), "q50": float(nu_p[1]), "q95": float(nu_p[2])},
                        reading_over_prediction(hoop, prior_only), quoted_summary(f_h), quoted_summary(f_p),
                        quoted_summary(draws["f"]), summarize_draws(draws["f"]),

@@ -30,6 +30,7 @@ from scipy.special import logsumexp
 
 from ..models.parameters import effective_sample_size
 from ..priors import Priors
+from ..stats.thinning import evenly_spaced
 
 MAX_MC_VARIANCE = 1.0
 DRAWS_PER_TEST = 1000
@@ -84,9 +85,8 @@ def implied_kappa_log_prior(kappa: np.ndarray, priors: Priors, *, n_nu: int = 80
 
 
 def thin(x: np.ndarray, n: int = DRAWS_PER_TEST) -> np.ndarray:
-    """At most n draws, evenly spaced (deterministic)."""
-    x = np.asarray(x, float).ravel()
-    return x if x.size <= n else x[np.linspace(0, x.size - 1, n).round().astype(int)]
+    """At most n draws, evenly spaced (deterministic: :func:`friction_uq.stats.thinning.evenly_spaced`)."""
+    return evenly_spaced(x, n)
 
 
 def strata(x: np.ndarray, n: int) -> np.ndarray:

@@ -33,7 +33,7 @@ from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
 from ..discrepancy.whole_record import CHANNEL_LABELS
-from ..hoop_or_prior import HoopOrPrior
+from ..hoop_or_prior import HoopOrPrior, TwoReadings
 from ..prior_sensitivity import PriorDataConflict
 from ..report.quote import f_from_diagnosis
 from ..stats.exact import ess_floor
@@ -55,7 +55,7 @@ def _stat(x: float) -> str:
 def _f_text(f: VariableSummary) -> str:
     """f as a warning quotes it; two readings in equal parts (:class:`~friction_uq.hoop_or_prior.TwoReadings`) by
     their interval alone, their mixture's median sitting between them."""
-    if getattr(f, "interval_only", False):
+    if isinstance(f, TwoReadings):
         return f"f (from {f.q05:.4g} to {f.q95:.4g}, two readings)"
     return f"f = {f.q50:.4g} [{f.q05:.4g}, {f.q95:.4g}]"
 

@@ -70,7 +70,7 @@ def quote_line(f_stationary: Mapping[str, float], diagnosis=None, n_warnings: in
     trust = ("every check passed" if n_warnings == 0 else
              f"{n_warnings} warning{'s' if n_warnings > 1 else ''}: read {'them' if n_warnings > 1 else 'it'} "
              "before quoting it")
-    if both and source.startswith("the stationary analysis with the hoop gauge and"):
+    if both and not f_from_diagnosis(diagnosis):  # the stationary analysis' two readings are the f quoted
         return (f"Headline f from {fx['q05']:.4f} to {fx['q95']:.4f} (90 %, the output bars' calibration included): "
                 f"the stationary analysis with nu from the prior file alone ({both['prior']:.4f}) and with the hoop "
                 f"gauge ({both['hoop']:.4f}), which disagree, in equal parts; {trust}.")
