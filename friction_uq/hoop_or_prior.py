@@ -33,7 +33,7 @@ from .prior_sensitivity import PriorDataConflict
 from .priors import Priors
 from .quoted import quoted_summary
 from .sampler import PosteriorSamples
-from .stats.thinning import evenly_spaced
+from .stats.thinning import equal_parts, evenly_spaced
 from .window import StationaryData
 
 #: The ``.nc`` group holding the f quoted's draws (the two posteriors in equal parts), which a campaign pools.
@@ -61,13 +61,6 @@ def disagree(conflict: PriorDataConflict, f_hoop: np.ndarray, f_prior: np.ndarra
         return True
     qh, qp = np.quantile(f_hoop, [0.05, 0.5, 0.95]), np.quantile(f_prior, [0.05, 0.5, 0.95])
     return not (qh[0] <= qp[1] <= qh[2]) and not (qp[0] <= qh[1] <= qp[2])
-
-
-def equal_parts(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Draws of the equal mixture of two posteriors: as many of each, the smaller count, evenly spaced through each
-    (two variables of one posterior, cut alike, stay paired)."""
-    n = min(np.size(a), np.size(b))
-    return np.concatenate([evenly_spaced(a, n), evenly_spaced(b, n)])
 
 
 def _summary(x: np.ndarray) -> dict[str, float]:
@@ -102,21 +95,27 @@ class HoopOrPrior:
         return self.draws["f"]
 
     @property
+    def f_prior_draws(self) -> np.ndarray:
+        """f's draws with nu from the prior file alone (the equal mixture's second half), given the bars' headers."""
+        f = self.draws["f"]
+        return f[f.size // 2:]
+
+    @property
     def medians(self) -> dict[str, float]:
         """The two readings' f to quote, medians: "prior" (nu from the prior file alone) and "hoop"."""
         return {"prior": self.f_prior["q50"], "hoop": self.f_hoop["q50"]}
 
-    def sentence(self, *, diagnosed: bool = False) -> str:
-        """The warning: what disagrees, f both ways, and what is quoted (``diagnosed``: the headline is the f of
-        the causes ``diagnose`` named, whose models read nu through the hoop gauge as well)."""
+    def sentence(self, *, diagnosed: dict[str, float] | None = None) -> str:
+        """The warning: what disagrees, f both ways, and what is quoted (``diagnosed``: the f to quote when it is
+        ``diagnose``'s, whose models read nu through the hoop gauge as well, in equal parts with f from the prior's
+        nu alone: friction_uq.discrepancy.diagnosed_f)."""
         def f(x: dict[str, float]) -> str:
             return f"f = {x['q50']:.4g} [{x['q05']:.4g}, {x['q95']:.4g}]"
 
-        h, p, q = self.nu_hoop, self.nu_prior, self.f_quoted
-        quoted = (f"`diagnose`'s f reads nu through the hoop gauge as well: quote it beside f from the prior's nu "
-                  f"alone, or the stationary analysis' two readings in equal parts, f from {q['q05']:.4g} to "
-                  f"{q['q95']:.4g}" if diagnosed else
-                  f"the f quoted holds both in equal parts: from {q['q05']:.4g} to {q['q95']:.4g} (90 %)")
+        h, p, q = self.nu_hoop, self.nu_prior, diagnosed or self.f_quoted
+        quoted = (f"`diagnose`'s models read nu through the hoop gauge as well: the f quoted holds their f and f from "
+                  f"the prior's nu alone in equal parts, from {q['q05']:.4g} to {q['q95']:.4g} (90 %)" if diagnosed
+                  else f"the f quoted holds both in equal parts: from {q['q05']:.4g} to {q['q95']:.4g} (90 %)")
         return (f"The tube's hoop gauge and the prior file disagree (the prior-data check: "
                 f"{'; '.join(f'{n}: {d}' for n, d in self.flagged)}): with the hoop gauge nu = {h['q50']:.3g} "
                 f"[{h['q05']:.3g}, {h['q95']:.3g}] and {f(self.f_hoop)}; from the prior file's nu ({p['q50']:.3g} "

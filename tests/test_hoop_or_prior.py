@@ -12,7 +12,8 @@ import h5py
 import numpy as np
 import pytest
 
-from friction_uq.hoop_or_prior import HOOP_OR_PRIOR_GROUP, disagree, equal_parts
+from friction_uq.hoop_or_prior import HOOP_OR_PRIOR_GROUP, disagree
+from friction_uq.stats.thinning import equal_parts
 from friction_uq.prior_sensitivity import PriorDataConflict
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -108,15 +109,120 @@ def test_a_sound_hoop_gauge_is_read_alone(tmp_path):
     assert doc["hoop_or_prior"] is None and doc["f"]["source"] == "the stationary analysis (eq. 17 and the hoop gauge)"
 
 
-def test_under_diagnose_the_warning_says_the_diagnosed_f_reads_the_hoop_gauge_too():
+def test_under_diagnose_the_warning_gives_the_diagnosed_f_quoted_with_the_priors_nu():
     from friction_uq.hoop_or_prior import HoopOrPrior
 
     hp = HoopOrPrior({"q05": 0.23, "q50": 0.25, "q95": 0.27}, {"q05": 0.35, "q50": 0.4, "q95": 0.45}, 0.45,
                      {"q05": 0.08, "q50": 0.09, "q95": 0.1}, {"q05": 0.036, "q50": 0.045, "q95": 0.057},
                      {"q05": 0.038, "q50": 0.07, "q95": 0.099}, {}, (("nu", "prior-data conflict"),))
-    said = hp.sentence(diagnosed=True)
-    assert "`diagnose`'s f reads nu through the hoop gauge as well" in said and "f from 0.038 to 0.099" in said
-    assert "the f quoted holds both" in hp.sentence()
+    said = hp.sentence(diagnosed={"q05": 0.041, "q50": 0.06, "q95": 0.075})
+    assert "`diagnose`'s models read nu through the hoop gauge as well" in said
+    assert "f from the prior's nu alone in equal parts, from 0.041 to 0.075 (90 %)" in said
+    assert "the f quoted holds both" in hp.sentence() and "0.038 to 0.099" in hp.sentence()
+
+
+def _diagnosed(f_prior_nu=None):
+    """A diagnosis that named a clearance, f 0.065 +- 0.004 with nu read through the hoop gauge."""
+    from friction_uq.discrepancy.diagnosis import Diagnosis
+    from friction_uq.discrepancy.extended import Variant
+    from friction_uq.discrepancy.mechanisms import MECHANISMS
+    from friction_uq.discrepancy.verdict import Verdict
+
+    clearance = Variant(MECHANISMS["clearance"])
+    z = np.random.default_rng(2).standard_normal(3000)
+    fin = SimpleNamespace(label="clearance", variants=(clearance,), f_effective=0.065 + 0.004 * z)
+    return Diagnosis(baseline=SimpleNamespace(label="baseline", variants=()), rounds=(), misfits=(),
+                     causes=(clearance,), not_separable=(), separate_by=None, final=fin,
+                     verdicts=(Verdict("named", (), named="clearance"),), f_prior_nu=f_prior_nu)
+
+
+def test_a_diagnosed_f_reading_a_disputed_hoop_gauge_is_quoted_with_the_priors_nu_in_equal_parts():
+    """A-03 with its hoop gauge at half its scale, run --diagnose: the named causes' f 0.065 [0.050, 0.076] for
+    0.048, every model reading nu through the gauge. The f to quote now holds it and the stationary f from nu's
+    prior alone in equal parts, each half folding in its own calibration; the headline, the warnings and the
+    sentence give its interval and not the median between the two."""
+    from friction_uq.discrepancy.diagnosed_f import _folded, f_draws_to_quote, headline, readings_of_nu
+    from friction_uq.discrepancy.diagnosis_words import _f_said
+    from friction_uq.quoted import folded_sd
+    from friction_uq.record_run.warnings import _next_step
+    from friction_uq.report.quote import f_to_quote, quote_line
+
+    prior = 0.045 + 0.006 * np.random.default_rng(3).standard_normal(2000)
+    alone, both = _diagnosed(), _diagnosed(prior)
+    assert readings_of_nu(alone) is None and f_draws_to_quote(alone).size == 3000
+    x = f_draws_to_quote(both)
+    assert x.size == 4000 and np.mean(x < 0.055) == pytest.approx(0.5, abs=0.02)
+    sd = _folded(both)
+    assert sd.shape == x.shape and np.all(sd[2000:] == folded_sd()) and np.all(sd[:2000] == _folded(alone))
+    fx, f1 = headline(both)[1], headline(alone)[1]
+    assert fx["q05"] < 0.045 < 0.065 < fx["q95"] and f1["q05"] > 0.055  # alone, the truth's side is left out
+    two = readings_of_nu(both)
+    assert two["diagnosed"] == pytest.approx(0.065, abs=0.001) and two["prior"] == pytest.approx(0.045, abs=0.001)
+    source, quoted = f_to_quote({"q05": 0.0, "q50": 0.0, "q95": 0.0}, both)
+    assert quoted == fx and source.endswith("in equal parts with the stationary analysis with nu from the prior file "
+                                            "alone (the hoop gauge, through which every model reads nu, and the "
+                                            "prior file disagree)")
+    line = quote_line({"q05": 0.0, "q50": 0.0, "q95": 0.0}, both, 2)
+    assert line.startswith(f"Headline f from {fx['q05']:.4f} to {fx['q95']:.4f} (90 %") and f"{fx['q50']:.4f}" not in line
+    assert f"nu read through the hoop gauge ({two['diagnosed']:.4f})" in line
+    assert f"nu from the prior file alone ({two['prior']:.4f}), which disagree, in equal parts" in line
+    said = _next_step(both, None)
+    assert f"from {fx['q05']:.4g} to {fx['q95']:.4g} (the JSON's f, half of it with nu from the prior file alone)" \
+        in said and f"{fx['q50']:.4g}" not in said, said
+    assert _f_said(both, fx).startswith(f"f from {fx['q05']:.3f} to {fx['q95']:.3f} (half of it")
+    assert _f_said(alone, f1) == f"f = {f1['q50']:.3f} [{f1['q05']:.3f}, {f1['q95']:.3f}]"
+
+
+@pytest.mark.slow
+def test_run_diagnose_on_a_hoop_gauge_at_half_its_scale_quotes_both_readings(tmp_path):
+    """The record end to end (about 90 s): `run --diagnose` named causes whose f, 0.065 [0.050, 0.076], read nu
+    through the gauge and left out the sample's 0.048; the JSON's f now holds the stationary reading from nu's prior
+    alone as well, and the one warning about the gauge gives the same interval."""
+    from friction_uq.record_run import run_file
+
+    rec = tmp_path / "A-03.h5"
+    shutil.copy(ROOT / "data" / "A" / "A-03.h5", rec)
+    with h5py.File(rec, "r+") as fh:
+        fh["signals/tube_hoop"][...] = fh["signals/tube_hoop"][...] * 0.5
+        truth = float(fh["truth"].attrs["friction_f_d"]), float(fh["truth"].attrs["friction_f_s"])
+    res = run_file(rec, out_dir=tmp_path / "out", seed=1, pdf=False, progress=False, table=False, notes=False,
+                   diagnose=True)
+    doc = json.loads(res.outputs["json"].read_text())
+    f, two, hp = doc["f"], doc["f"]["readings_of_nu"], doc["hoop_or_prior"]
+    assert doc["discrepancy"]["causes"] and res.diagnosis.f_prior_nu is not None
+    assert two["prior_nu_alone"] == pytest.approx(float(np.median(res.diagnosis.f_prior_nu)), rel=1e-12)
+    assert f["q05"] < min(two.values()) and max(two.values()) < f["q95"]
+    assert f["q05"] < hp["f_prior_nu_alone"]["q50"] and truth[0] < f["q05"] and f["q95"] < truth[1]
+    said = [w for w in doc["warnings"] if w.startswith("The tube's hoop gauge and the prior file disagree")]
+    assert len(said) == 1 and f"from {f['q05']:.4g} to {f['q95']:.4g} (90 %)" in said[0]
+    assert doc["schema_version"] == 11
+
+
+def test_a_diagnosed_campaign_pools_the_stationary_readings_of_a_test_whose_hoop_gauge_disagrees(tmp_path):
+    """Its diagnosed models read nu through the disputed gauge, and the run's f mixes them with the prior's nu
+    alone, a mixture whose prior the campaign cannot divide out: the stationary f of both readings is pooled in
+    their place, under the prior file's f prior."""
+    import xarray as xr
+
+    from friction_uq.campaigns.draws import read_test_posterior
+    from friction_uq.prior_loader import PRIORS_DIR, load_priors
+
+    prior = str(PRIORS_DIR / "I1.toml")
+    post = {k: (("chain", "draw"), np.full((1, 400), m)) for k, m in (("f", 0.09), ("kappa", 0.03), ("nu", 0.25),
+                                                                      ("p_mean", 4e7))}
+    both = {"f": np.r_[np.full(400, 0.09), np.full(400, 0.045)], "nu": np.r_[np.full(400, 0.25), np.full(400, 0.4)],
+            "kappa": np.full(800, 0.03), "p_mean": np.full(800, 4e7)}
+    model = {"f_effective": (("chain", "draw"), np.full((1, 400), 0.065)),
+             "log_prior_f_effective": (("chain", "draw"), np.zeros((1, 400)))}
+    dt = xr.DataTree.from_dict({"/posterior": xr.Dataset(post), "/discrepancy_clearance/posterior": xr.Dataset(model),
+                                f"/{HOOP_OR_PRIOR_GROUP}": xr.Dataset({k: (("draw",), v) for k, v in both.items()})})
+    dt.attrs["discrepancy_final_group"] = "discrepancy_clearance"
+    dt.to_netcdf(tmp_path / "A_A-03.nc", engine="h5netcdf")
+    r = SimpleNamespace(outputs={"netcdf": "A_A-03.nc"}, label="A A-03", campaign="A", window_halves=None,
+                        prior_file=prior, summary={"V": {"mean": 9.0, "sd": 0.1}}, path="A-03.h5")
+    t = read_test_posterior(r, tmp_path)
+    assert t.hoop_disagrees and set(np.unique(t.f_model)) == {0.045, 0.09}
+    np.testing.assert_allclose(t.f_model_log_prior, load_priors(prior)["f"].logpdf(t.f_model))
 
 
 def test_a_test_whose_hoop_gauge_disagrees_is_left_out_of_the_campaigns_nu():

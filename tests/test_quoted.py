@@ -115,7 +115,7 @@ def test_what_a_model_carries_is_not_folded_in_again():
     x = _lognormal_grid(np.log(0.05), 0.02, 4001)
     fits = [SimpleNamespace(label="clearance", variants=(clearance,)),
             SimpleNamespace(label="gauge_gain[internal_output_bar]", variants=(gain,))]
-    dg = SimpleNamespace(swap_models=(), mixture_f=np.concatenate([x, 1.2 * x, 0.9 * x]), causes=(), final=fits[0],
+    dg = SimpleNamespace(swap_models=(), f_prior_nu=None, mixture_f=np.concatenate([x, 1.2 * x, 0.9 * x]), causes=(), final=fits[0],
                          mixture_weights={"clearance": 0.5, "gauge_gain[internal_output_bar]": 0.3, "unknown": 0.2},
                          mixture_source=np.repeat([0, 1, 2], x.size),
                          baseline=SimpleNamespace(label="reference", variants=()),

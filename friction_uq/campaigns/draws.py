@@ -7,8 +7,9 @@ density of the prior they were drawn under (``log_prior_f_effective``, written b
 friction_uq.discrepancy.effective_prior). The campaign reads both and divides that prior out. Where the run found the hoop gauge and nu's prior in
 disagreement, the stationary draws it reads (f, nu, p_mean) are both readings in equal parts, as the run quotes
 f, and kappa the reading without the hoop gauge (the ``.nc`` group ``hoop_or_prior``, friction_uq.hoop_or_prior);
-such a test is left out of the campaign's nu. A cause ``diagnose`` named gives f under its model, as the run's
-headline does.
+such a test is left out of the campaign's nu, and, diagnosed, gives its stationary f (both readings) in place of
+its models' f, which read nu through the hoop gauge. A cause ``diagnose`` named gives f under its model, as the
+run's headline does.
 """
 
 from __future__ import annotations
@@ -71,12 +72,14 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
             f_model = f_log_prior = None
             # diagnosed (absent: no diagnosis, or an older version; "": no cause named)
             final = _text(h.attrs.get("discrepancy_final_group"))
-            if final:
+            if final and not both:
                 group = h[f"{final}/posterior"]
                 f_model = thin(group["f_effective"][()])
                 if "log_prior_f_effective" in group:
                     f_log_prior = thin(group["log_prior_f_effective"][()])
-            elif final is not None:  # diagnosed, no cause named: the stationary f, under the prior file's f prior
+            elif final is not None:  # diagnosed, no cause named (or its models read nu through a hoop gauge the
+                # prior file disputes: the run quotes their f with nu's prior alone in equal parts, a mixture whose
+                # prior the campaign cannot divide out): the stationary f, under the prior file's f prior
                 f_model = draws["f"]
                 f_log_prior = np.asarray(load_priors(r.prior_file)["f"].logpdf(f_model), float)
     except (OSError, KeyError, ValueError) as exc:

@@ -119,7 +119,8 @@ def statements(ca: CampaignAnalysis) -> list[str]:
         their, are = ("their", "they are") if many else ("its", "it is")
         out.append(f"{'tests' if many else 'test'} {', '.join(disagree)}: the hoop gauge and the prior file disagree "
                    f"on nu ({'each' if many else 'the'} run's warning): {their} stationary f is both readings in "
-                   f"equal parts, {their} kappa the forces' own, and {are} left out of the campaign's nu")
+                   f"equal parts (in place of the diagnosed f, whose models read nu through the hoop gauge, when "
+                   f"diagnosed), {their} kappa the forces' own, and {are} left out of the campaign's nu")
     # after the law: what the tests share; the stationary f's pooling just after the diagnosed f's
     for p in [q for name, p in ca.pooled.items() for q in (p, ca.pooled_stationary.get(name)) if q is not None]:
         if p.refused:

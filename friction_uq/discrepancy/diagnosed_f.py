@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..quoted import OUTPUT_BARS, WHOLE_RECORD_MODEL_FORM, folded_sd, quoted_summary
+from ..stats.thinning import equal_parts
 from .candidates_mixture import STATIONARY, open_rounds
 from .diagnosis import Diagnosis
 from .extended import Variant
@@ -70,9 +71,9 @@ def member_variants(dg: Diagnosis, label: str) -> tuple[Variant, ...]:
     return next((m.variants for m in fits if m.label == label), ())
 
 
-def _folded(dg: Diagnosis, model_form: float = WHOLE_RECORD_MODEL_FORM) -> float | np.ndarray:
-    """The sd folded into the f to quote: the final model's, or per draw of the mixture its model's (the stationary
-    analysis' draws carry their model form already)."""
+def _folded_diagnosed(dg: Diagnosis, model_form: float) -> float | np.ndarray:
+    """The sd folded into the diagnosed f: the final model's, or per draw of the mixture its model's (the
+    stationary analysis' draws carry their model form already)."""
     if dg.mixture_f is None:
         return folded_sd_of(dg.final.variants, model_form)
     sds = np.array([folded_sd() if k == STATIONARY else folded_sd_of(member_variants(dg, k), model_form)
@@ -80,10 +81,36 @@ def _folded(dg: Diagnosis, model_form: float = WHOLE_RECORD_MODEL_FORM) -> float
     return sds[np.asarray(dg.mixture_source, int)] if dg.mixture_source is not None else float(sds.max())
 
 
-def f_draws_to_quote(dg: Diagnosis) -> np.ndarray:
-    """The draws the diagnosed f to quote comes from: the stacking mixture's, else the final model's (given the
-    bars' header values)."""
+def _diagnosed_draws(dg: Diagnosis) -> np.ndarray:
+    """The diagnosed f's draws: the stacking mixture's, else the final model's (given the bars' header values)."""
     return dg.mixture_f if dg.mixture_f is not None else dg.final.f_effective
+
+
+def _folded(dg: Diagnosis, model_form: float = WHOLE_RECORD_MODEL_FORM) -> float | np.ndarray:
+    """The sd folded into the f to quote, per draw of :func:`f_draws_to_quote` where it varies: the diagnosed
+    f's, and the stationary analysis' own for the half from nu's prior alone (``Diagnosis.f_prior_nu``)."""
+    sd = _folded_diagnosed(dg, model_form)
+    if dg.f_prior_nu is None:
+        return sd
+    own = np.broadcast_to(np.asarray(sd, float), np.shape(_diagnosed_draws(dg)))
+    return equal_parts(own, np.full(np.size(dg.f_prior_nu), folded_sd()))
+
+
+def f_draws_to_quote(dg: Diagnosis) -> np.ndarray:
+    """The draws the diagnosed f to quote comes from (given the bars' header values): the stacking mixture's, else
+    the final model's; in equal parts with the stationary analysis' f from nu's prior alone when the hoop gauge,
+    through which every model reads nu, and the prior file disagree (``Diagnosis.f_prior_nu``)."""
+    f = _diagnosed_draws(dg)
+    return f if dg.f_prior_nu is None else equal_parts(f, dg.f_prior_nu)
+
+
+def readings_of_nu(dg: Diagnosis) -> dict[str, float] | None:
+    """The medians of the two halves of the f to quote when it holds two readings of nu (``Diagnosis.f_prior_nu``):
+    "diagnosed" (its models, nu read through the hoop gauge) and "prior" (the stationary analysis, nu from the
+    prior file alone), given the bars' header values; None otherwise."""
+    if dg.f_prior_nu is None:
+        return None
+    return {"diagnosed": float(np.median(_diagnosed_draws(dg))), "prior": float(np.median(dg.f_prior_nu))}
 
 
 def quoted_of(dg: Diagnosis, model_form: float = WHOLE_RECORD_MODEL_FORM) -> dict[str, float]:

@@ -97,6 +97,11 @@ class Diagnosis:
     #: the delay on one gauge that the first round's candidates agree on, when the record does not tell apart
     #: delay-like faults of the measurement chain (:mod:`.front_delay`); None otherwise
     shared_delay: SharedDelay | None = None
+    #: the stationary analysis' draws of f with nu from the prior file alone (given the bars' header values), when
+    #: ``run`` found the hoop gauge and nu's prior in disagreement (friction_uq.hoop_or_prior): every model here
+    #: reads nu through the hoop gauge as well, so the f to quote holds the diagnosed f and these in equal parts
+    #: (:func:`.diagnosed_f.f_draws_to_quote`); None otherwise
+    f_prior_nu: np.ndarray | None = None
 
     @property
     def verdict(self) -> Verdict | None:

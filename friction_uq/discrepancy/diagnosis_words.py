@@ -111,7 +111,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
     fx = headline(dg)[1]
-    return (f"{lead} f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}] {quote}, {f_without['q50']:.3f} from "
+    return (f"{lead} {_f_said(dg, fx)} {quote}, {f_without['q50']:.3f} from "
             f"the stationary analysis {'alone' if STATIONARY in dg.mixture_weights else 'without them'}. Why: "
             f"{_describe(dg)}; the {evidence}'s evidence is "
             f"{first.delpd:.0f} +- {first.se:.0f} nats.{by_weight_clause(dg)}{swapped_clause(dg)}{sep}{delay_clause(dg)}"
@@ -124,6 +124,15 @@ def _evidence_of(dg: Diagnosis, cause: Variant):
     k = dg.causes.index(cause)
     return next((r for r in dg.rounds[k] if r.fit.variants[-1] == cause), dg.ranking[0]) if k < len(dg.rounds) \
         else dg.ranking[0]
+
+
+def _f_said(dg: Diagnosis, fx: dict[str, float]) -> str:
+    """'f = 0.049 [0.044, 0.054]'; by its interval alone, and why, when it holds two readings of nu
+    (``Diagnosis.f_prior_nu``: the hoop gauge and the prior file disagree)."""
+    if dg.f_prior_nu is None:
+        return f"f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}]"
+    return (f"f from {fx['q05']:.3f} to {fx['q95']:.3f} (half of it the stationary analysis with nu from the prior "
+            "file alone, the hoop gauge and the prior file disagreeing)")
 
 
 def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
@@ -144,11 +153,11 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
                 "and better than every other.")
     if STATIONARY in dg.mixture_weights:  # half the stationary analysis' f (candidates_mixture)
         half = 100 * dg.mixture_weights[STATIONARY]
-        return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the stationary analysis "
+        return (f"{what} {_f_said(dg, fm)} from the stationary analysis "
                 f"({half:.0f} %) and the candidates weighted by how well each predicts the record ({shares}): the f "
                 f"to quote, wide enough for whichever of them is right; {f_without['q50']:.3f} from the stationary "
                 "analysis alone.")
-    return (f"{what} f = {fm['q50']:.3f} [{fm['q05']:.3f}, {fm['q95']:.3f}] from the candidates weighted by how well "
+    return (f"{what} {_f_said(dg, fm)} from the candidates weighted by how well "
             f"each predicts the record ({shares}; the f to quote, wide enough for whichever of them is right), "
             f"{f_without['q50']:.3f} from the stationary analysis.")
 

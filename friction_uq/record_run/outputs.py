@@ -54,7 +54,9 @@ def reproducible(dt):
 
 
 
-#: The run's JSON: its schema name and version (10: ``hoop_or_prior``, f with the hoop gauge and from nu's prior
+#: The run's JSON: its schema name and version (11: a diagnosed ``f`` holds, where the hoop gauge and nu's prior
+#: disagree, the diagnosed f and the stationary f from nu's prior alone in equal parts, their medians in
+#: ``f.readings_of_nu``; 10: ``hoop_or_prior``, f with the hoop gauge and from nu's prior
 #: alone when the two disagree, ``f`` then the two in equal parts; 9: ``discrepancy.shared_delay``, the delay on one gauge the candidates
 #: the record does not tell apart agree on; 8: ``discrepancy.causes`` leaves out a later round's chain entry kept
 #: in the model within the whole-record check's tolerance, listed in ``discrepancy.within_tolerance``; 7: a ranking
@@ -65,7 +67,7 @@ def reproducible(dt):
 #: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
-RUN_SCHEMA_VERSION = 10
+RUN_SCHEMA_VERSION = 11
 
 
 def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],
@@ -77,7 +79,7 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
     the bars' header values (``given_bar_headers``, the posterior's own); where it comes from a fitted model or a
     stacking mixture, how its draws were obtained and the Pareto k of the final model's importance step. ``f_stationary``: the stationary f to quote,
     ``f_stationary_posterior`` its posterior summary."""
-    from ..discrepancy.diagnosed_f import f_draws_to_quote, folded_of, headline
+    from ..discrepancy.diagnosed_f import f_draws_to_quote, folded_of, headline, readings_of_nu
     from ..likelihood.force_level import RATIO_MODEL_FORM
     from ..physics.bars import FORCE_RATIO_CALIBRATION_SD
     from ..quoted import folded_sd
@@ -92,6 +94,8 @@ def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, f
                               | {"bar_calibration_sd": FORCE_RATIO_CALIBRATION_SD, "model_form_sd": RATIO_MODEL_FORM,
                                  "calibration_folded_in_sd": folded_sd() if named is None else folded_of(diagnosis),
                                  "given_bar_headers": {k: given[k] for k in ("mean", "sd", "q05", "q50", "q95")}})
+    if named is not None and (two := readings_of_nu(diagnosis)) is not None:  # the two halves' medians
+        out["readings_of_nu"] = {"with_hoop_gauge": two["diagnosed"], "prior_nu_alone": two["prior"]}
     if diagnosis is not None and (diagnosis.causes or diagnosis.mixture_f is not None):
         from ..discrepancy.outcome import posterior_method_of
 

@@ -229,8 +229,9 @@ def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck,
     say("diagnose: fitting each mechanism of the catalogue to the whole record")
     start = {"f": post.summary["f"].q50, "nu": post.summary["nu"].q50}
     diag = run_stage.run_diagnose(s.prepared, s.priors, start, hoop=s.use_hoop, seed=seed, say=say, check=wrc,
-                                 stationary_f=post.samples.flat("f") if post.hoop_or_prior is None
-                                 else post.hoop_or_prior.f_draws)
+                                 stationary_f=post.samples.flat("f"))
+    if post.hoop_or_prior is not None:  # its models read nu through the hoop gauge as well: f from both readings
+        diag = dataclasses.replace(diag, f_prior_nu=post.hoop_or_prior.f_prior_draws)
     outcome.add_to_datatree(post.datatree, diag, s.priors["f"])
     return diag
 

@@ -32,6 +32,7 @@ from ..gauge_balance import BALANCE_TOL, GaugeFinding, balance_departure
 from ..diagnostics import Convergence, VariableSummary
 from ..diagnostics.ppc import RatioPPC
 from ..discrepancy.check import WholeRecordCheck
+from ..discrepancy.diagnosed_f import further, headline
 from ..discrepancy.whole_record import CHANNEL_LABELS
 from ..hoop_or_prior import HoopOrPrior, TwoReadings
 from ..prior_sensitivity import PriorDataConflict
@@ -74,23 +75,29 @@ def stationarity_warning(ppc: RatioPPC, excess_spread: float, dof: int, f: Varia
             "steadier window (--window) or `friction-uq diagnose` is safer.")
 
 
+def _diagnosed_text(fm: dict[str, float], diagnosis) -> str:
+    """The diagnosed f to quote as a warning says it: by its interval alone when it holds two readings of nu
+    (``Diagnosis.f_prior_nu``), whose mixture's median sits between them."""
+    if diagnosis.f_prior_nu is not None:
+        return f"from {fm['q05']:.4g} to {fm['q95']:.4g} (the JSON's f, half of it with nu from the prior file alone)"
+    return f"{fm['q50']:.4g} [{fm['q05']:.4g}, {fm['q95']:.4g}] (the JSON's f)"
+
+
 def _next_step(diagnosis, f: VariableSummary) -> str:
     """What to do about a misfit: diagnose it, or (diagnosed) quote f under the causes it named."""
     if diagnosis is None:
         return "`friction-uq diagnose` names the cause and gives f under it."
     from ..discrepancy.candidates_mixture import STATIONARY
-    from ..discrepancy.diagnosed_f import further, headline
 
     if more := further(diagnosis):  # causes named, and further ones the record leans to without naming one
         fm = headline(diagnosis)[1]
         names = ", ".join(v.label for v in diagnosis.named_causes) or "none"
         return (f"`diagnose` names {names}, and the record leans to a further cause without naming one "
                 f"({', '.join(more.values())}); "
-                f"f from the stacking mixture is {fm['q50']:.4g} [{fm['q05']:.4g}, {fm['q95']:.4g}] (the JSON's f), "
+                f"f from the stacking mixture is {_diagnosed_text(fm, diagnosis)}, "
                 "wide enough for whichever of them is right: quote that, with this warning.")
     if diagnosis.mixture_f is not None:  # unexplained, or candidates (fitted in turn or not) the record leaves open
         fm = headline(diagnosis)[1]
-        q05, q50, q95 = fm["q05"], fm["q50"], fm["q95"]
         named = ", ".join(v.label for v in diagnosis.named_causes)
         open_ = diagnosis.open_candidates if named else (diagnosis.not_separable or diagnosis.open_candidates)
         listed = f" ({', '.join(open_)})" if open_ else ""
@@ -104,16 +111,16 @@ def _next_step(diagnosis, f: VariableSummary) -> str:
         else:
             what = f"the record does not tell its candidate causes apart{listed}"
         half = " and the stationary analysis in equal parts" if STATIONARY in diagnosis.mixture_weights else ""
-        return (f"`diagnose`: {what}; f from their stacking mixture{half} is {q50:.4g} [{q05:.4g}, {q95:.4g}] (the "
-                "JSON's f), wide enough for whichever of them is right: quote that, with this warning.")
+        return (f"`diagnose`: {what}; f from their stacking mixture{half} is {_diagnosed_text(fm, diagnosis)}, "
+                "wide enough for whichever of them is right: quote that, with this warning.")
     if not diagnosis.causes:
         return "`diagnose` named no cause: f is then to be quoted with this warning, or not at all."
     fx = headline(diagnosis)[1]  # the JSON's f: the named model's, with the bars' calibration
     names = ", ".join(v.label for v in diagnosis.named_causes) or "none"
     if diagnosis.within_tolerance:  # in the model, not named: f is that model's
         names += f" (with {', '.join(diagnosis.within_tolerance)} in the model within the check's tolerance, not named)"
-    return (f"`diagnose` names {names}: f under them is {fx['q50']:.4g} [{fx['q05']:.4g}, {fx['q95']:.4g}] "
-            "(the JSON's f), which is the f to quote.")
+    return (f"`diagnose` names {names}: f under them is {_diagnosed_text(fx, diagnosis)}, "
+            "which is the f to quote.")
 
 
 def misfit_warning(check: WholeRecordCheck | None, f: VariableSummary, diagnosis=None) -> str | None:
@@ -239,7 +246,8 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
         stationarity_warning(ppc, excess_spread, dof, f, lab),
         misfit_warning(check, f, diagnosis),
         convergence_warning(conv), exact_posterior_warning(diagnosis),
-        None if hoop_or_prior is None else hoop_or_prior.sentence(diagnosed=f_from_diagnosis(diagnosis)),
+        None if hoop_or_prior is None else hoop_or_prior.sentence(
+            diagnosed=headline(diagnosis)[1] if f_from_diagnosis(diagnosis) else None),
         conflict_warning(conflict, hoop_or_prior),
     )
     return [w for w in found if w]

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..discrepancy.candidates_mixture import STATIONARY
-from ..discrepancy.diagnosed_f import further, headline
+from ..discrepancy.diagnosed_f import further, headline, readings_of_nu
 
 
 def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool = True,
@@ -24,36 +24,44 @@ def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool 
     named = None if diagnosis is None else headline(diagnosis)
     if named is not None:
         label, fx = named
-        if more := further(diagnosis):  # the causes named, and further ones the last round leaned to unnamed
-            named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
-            alike = "no further cause, or one that leaves f as it is,"  # a member giving the final f lends its weight
-            shares = ", ".join(f"{alike if k == diagnosis.final.label else '+ ' + more[k]} {w:.2f}"
-                               for k, w in diagnosis.mixture_weights.items())
-            return (f"the causes diagnose named ({named}) mixed with the further causes the record leans to "
-                    f"without naming one ({shares})", fx)
-        if diagnosis.mixture_of == "superfluous":  # a candidate fitted in turn the later causes did not need
-            named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
-            said = (f"the {label}: the causes diagnose named ({named}) with and without "
-                    f"{', '.join(diagnosis.superfluous)}, fitted in turn and not needed")
-            return said, fx
-        if diagnosis.mixture_f is not None:  # unexplained, or candidates the record does not tell apart
-            named = ", ".join(v.label for v in diagnosis.named_causes)
-            if named:  # a cause named, a later round's candidates left open
-                return f"the {label}: the causes diagnose named ({named}) and candidates it could not tell apart", fx
-            if STATIONARY in diagnosis.mixture_weights:  # nothing named: half the stationary analysis' f
-                return (f"the stationary analysis and the candidates diagnose could not tell apart, in equal parts "
-                        f"({label})"), fx
-            return f"the {label}, candidates diagnose could not tell apart", fx
-        if diagnosis.within_tolerance:  # a later round's mechanism kept in the model, not named
-            named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
-            return (f"the model with the causes diagnose named ({named}) and "
-                    f"{', '.join(diagnosis.within_tolerance)} within the check's tolerance, not named ({label})"), fx
-        return f"the model with the causes diagnose named ({label})", fx
+        said = _diagnosed_source(diagnosis, label)
+        if diagnosis.f_prior_nu is not None:  # its models read nu through a hoop gauge the prior file disputes
+            said += (", in equal parts with the stationary analysis with nu from the prior file alone (the hoop "
+                     "gauge, through which every model reads nu, and the prior file disagree)")
+        return said, fx
     if both:
         return ("the stationary analysis with the hoop gauge and with nu from the prior file alone, in equal parts "
                 "(they disagree)"), f_stationary
     return ("the stationary analysis (eq. 17 and the hoop gauge)" if hoop else
             "the stationary analysis (eq. 17; the hoop gauge left out)"), f_stationary
+
+
+def _diagnosed_source(diagnosis, label: str) -> str:
+    """Where a diagnosed f to quote comes from (:func:`f_to_quote`), before any second reading of nu."""
+    if more := further(diagnosis):  # the causes named, and further ones the last round leaned to unnamed
+        named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
+        alike = "no further cause, or one that leaves f as it is,"  # a member giving the final f lends its weight
+        shares = ", ".join(f"{alike if k == diagnosis.final.label else '+ ' + more[k]} {w:.2f}"
+                           for k, w in diagnosis.mixture_weights.items())
+        return (f"the causes diagnose named ({named}) mixed with the further causes the record leans to "
+                f"without naming one ({shares})")
+    if diagnosis.mixture_of == "superfluous":  # a candidate fitted in turn the later causes did not need
+        named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
+        return (f"the {label}: the causes diagnose named ({named}) with and without "
+                f"{', '.join(diagnosis.superfluous)}, fitted in turn and not needed")
+    if diagnosis.mixture_f is not None:  # unexplained, or candidates the record does not tell apart
+        named = ", ".join(v.label for v in diagnosis.named_causes)
+        if named:  # a cause named, a later round's candidates left open
+            return f"the {label}: the causes diagnose named ({named}) and candidates it could not tell apart"
+        if STATIONARY in diagnosis.mixture_weights:  # nothing named: half the stationary analysis' f
+            return (f"the stationary analysis and the candidates diagnose could not tell apart, in equal parts "
+                    f"({label})")
+        return f"the {label}, candidates diagnose could not tell apart"
+    if diagnosis.within_tolerance:  # a later round's mechanism kept in the model, not named
+        named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
+        return (f"the model with the causes diagnose named ({named}) and "
+                f"{', '.join(diagnosis.within_tolerance)} within the check's tolerance, not named ({label})")
+    return f"the model with the causes diagnose named ({label})"
 
 
 def f_from_diagnosis(diagnosis) -> bool:
@@ -70,6 +78,11 @@ def quote_line(f_stationary: Mapping[str, float], diagnosis=None, n_warnings: in
     trust = ("every check passed" if n_warnings == 0 else
              f"{n_warnings} warning{'s' if n_warnings > 1 else ''}: read {'them' if n_warnings > 1 else 'it'} "
              "before quoting it")
+    if (two := None if diagnosis is None else readings_of_nu(diagnosis)) and f_from_diagnosis(diagnosis):
+        return (f"Headline f from {fx['q05']:.4f} to {fx['q95']:.4f} (90 %, the output bars' calibration included): "
+                f"{_diagnosed_source(diagnosis, headline(diagnosis)[0])}, nu read through the hoop gauge "
+                f"({two['diagnosed']:.4f}), and the stationary analysis with nu from the prior file alone "
+                f"({two['prior']:.4f}), which disagree, in equal parts; {trust}.")
     if both and not f_from_diagnosis(diagnosis):  # the stationary analysis' two readings are the f quoted
         return (f"Headline f from {fx['q05']:.4f} to {fx['q95']:.4f} (90 %, the output bars' calibration included): "
                 f"the stationary analysis with nu from the prior file alone ({both['prior']:.4f}) and with the hoop "
