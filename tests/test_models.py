@@ -157,3 +157,18 @@ def test_extension_parameters_reach_the_simulator(trapezoid_record):
     wide = model.predict({"f": 0.07, "nu": 0.38, "hoop_gain": 1.0, "gap": 10e-6}).strains["tube_hoop"]
     # a clearance lowers the wall pressure: the tube swells less (compression positive: less negative)
     assert np.min(wide) > np.min(base) * 0.95
+
+
+def test_a_start_beyond_a_bounded_support_is_moved_just_inside_it():
+    """A clean axisymmetric record with its hoop gauge at twice its scale: the stationary nu, whose support reaches
+    0.5, started the simulator's fits (nu below 0.49) at 0.495, and `run --diagnose` ended in an internal error
+    ("Initial guess is outside of provided bounds")."""
+    from friction_uq.models.simulator import NU as SIMULATOR_NU
+
+    assert SIMULATOR_NU.nearest_inside(0.4) == 0.4
+    for beyond in (0.49, 0.495, 0.5, 0.7):
+        inside = SIMULATOR_NU.nearest_inside(beyond)
+        assert inside == pytest.approx(0.49 - 0.49e-3) and np.isfinite(SIMULATOR_NU.to_unbounded(inside))
+    assert SIMULATOR_NU.nearest_inside(-0.1) == pytest.approx(0.49e-3)
+    half_line = Parameter("gap", "m", 0.0, math.inf, "a gap")
+    assert half_line.nearest_inside(8e-6) == 8e-6  # no width to step in by: as given

@@ -81,7 +81,7 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
     def values_of(z: np.ndarray) -> dict[str, float]:
         return {p.name: float(p.from_unbounded(zi)) for p, zi in zip(params, z)}
 
-    z0 = np.array([float(p.to_unbounded(start[p.name])) for p in params])
+    z0 = np.array([float(p.to_unbounded(p.nearest_inside(start[p.name]))) for p in params])
     scale = {n: (float(z0[i]), 3.0) for i, n in enumerate(names)}
     scale.update(prior_scale or {})
     centre = np.array([scale[n][0] for n in names])
@@ -99,7 +99,7 @@ def fit_whole_record(lik: WholeRecordLikelihood, log_prior: LogPrior, start: Map
             r = np.full(n_data[0] if n_data else lik.n_samples, 1e3)
         return np.concatenate([r, (z - centre) / width])
 
-    starts = [np.array([float(p.to_unbounded(alt.get(p.name, start[p.name]))) for p in params])
+    starts = [np.array([float(p.to_unbounded(p.nearest_inside(alt.get(p.name, start[p.name])))) for p in params])
               for alt in ({}, *extra_starts)]
     res = _best_mode(residuals, starts, width)
     zm = res.x

@@ -60,6 +60,17 @@ class Parameter:
         if not self.scale > 0.0 or (self.scale != 1.0 and not (math.isinf(self.low) and math.isinf(self.high))):
             raise ValueError(f"parameter {self.name}: a scale (> 0) is for a parameter on the whole real line")
 
+    def nearest_inside(self, value: float, margin: float = 1e-3) -> float:
+        """``value`` where it lies strictly inside the support; on a bounded support, a value on or beyond a bound is
+        moved to ``margin`` of the width inside it: a start for a mode search taken from another model, whose
+        support can be wider (the closed form's nu reaches 0.5, the simulator's 0.49), then maps to a finite
+        coordinate. (A half-line has no width to step in by: its value is returned as given.)"""
+        v = float(value)
+        if self.low < v < self.high or not math.isfinite(self.high - self.low):
+            return v
+        width = self.high - self.low
+        return float(np.clip(v, self.low + margin * width, self.high - margin * width))
+
     def contains(self, value: np.ndarray | float) -> np.ndarray:
         """True where ``value`` lies strictly inside the support."""
         v = np.asarray(value, float)
