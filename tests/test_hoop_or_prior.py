@@ -87,7 +87,7 @@ def test_the_campaign_pools_the_f_the_run_quotes(half_scale_hoop):
     doc, nc = half_scale_hoop
     with h5py.File(nc) as h:
         assert h[HOOP_OR_PRIOR_GROUP]["f"].shape[0] > 0
-    r = SimpleNamespace(outputs={"netcdf": nc.name}, label="A-03", campaign="A", window_halves=None,
+    r = SimpleNamespace(outputs={"netcdf": nc.name}, label="A-03", campaign="A", window_halves=None, warnings=[],
                         prior_file=doc["prior_file"], summary={"V": doc["V"]}, path=str(nc))
     post = read_test_posterior(r, nc.parent)
     assert np.quantile(post.f, 0.05) < doc["hoop_or_prior"]["f_prior_nu_alone"]["q50"]
@@ -218,7 +218,7 @@ def test_a_diagnosed_campaign_pools_the_stationary_readings_of_a_test_whose_hoop
                                 f"/{HOOP_OR_PRIOR_GROUP}": xr.Dataset({k: (("draw",), v) for k, v in both.items()})})
     dt.attrs["discrepancy_final_group"] = "discrepancy_clearance"
     dt.to_netcdf(tmp_path / "A_A-03.nc", engine="h5netcdf")
-    r = SimpleNamespace(outputs={"netcdf": "A_A-03.nc"}, label="A A-03", campaign="A", window_halves=None,
+    r = SimpleNamespace(outputs={"netcdf": "A_A-03.nc"}, label="A A-03", campaign="A", window_halves=None, warnings=[],
                         prior_file=prior, summary={"V": {"mean": 9.0, "sd": 0.1}}, path="A-03.h5")
     t = read_test_posterior(r, tmp_path)
     assert t.hoop_disagrees and set(np.unique(t.f_model)) == {0.045, 0.09}

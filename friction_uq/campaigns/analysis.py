@@ -27,6 +27,7 @@ from .laws import LAW_PARAMS, Elpd, Fit, LawData, Model, law_mean
 from .next_test_choice import advice, rank_next_tests
 from .draws import RecordPosterior, pool_tests, read_test_posterior
 from .pooling import implied_kappa_log_prior, strata
+from .warned import pooled_without_warned
 
 __all__ = ["WEIGHT_RULE", "CampaignAnalysis", "RecordPosterior", "analyse", "analyse_tests", "read_test_posterior",
            "supported_laws", "verdict"]
@@ -177,7 +178,8 @@ def analyse_tests(tests: Sequence[RecordPosterior], tallies: dict[str, dict[str,
     t0 = time.perf_counter()
     tests = list(tests)
     pooled, stationary, note = pool_tests(tests)
-    ca = CampaignAnalysis(tests, pooled, tallies, pooled_stationary=stationary)
+    ca = CampaignAnalysis(tests, pooled, tallies, pooled_stationary=stationary,
+                          pooled_without_warned=pooled_without_warned(tests, pooled.get("f")))
     ca.sentences += note
     if len(tests) < MIN_TESTS_FOR_LAWS:
         ca.sentences.append(f"friction law: {len(tests)} analysed test(s); comparing laws needs at least "

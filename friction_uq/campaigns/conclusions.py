@@ -41,6 +41,8 @@ class CampaignAnalysis:
     #: (:meth:`~.law_comparison.LawComparison.offset_alternative`), with the sentence where a law with a pressure term
     #: is named or the set-up is flagged by every law with and without the offset (those without ruled out); else empty
     pressure_or_setup: dict[str, object] = field(default_factory=dict)
+    #: f pooled on ``pooled["f"]``'s basis without the tests whose runs warned (:mod:`.warned`); None when none did
+    pooled_without_warned: Pooled | None = None
 
     def f_curve(self, model: str, V: np.ndarray, p: np.ndarray, setup: str, *, n: int = 400,
                 slip: np.ndarray | None = None) -> np.ndarray:

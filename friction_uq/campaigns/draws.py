@@ -53,6 +53,8 @@ class RecordPosterior:
     #: the run found the hoop gauge and nu's prior in disagreement (friction_uq.hoop_or_prior): its nu is not a
     #: witness of the campaign's nu
     hoop_disagrees: bool = False
+    #: the run's warnings (its JSON's), each a sentence
+    warnings: tuple[str, ...] = ()
 
 
 def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
@@ -93,7 +95,7 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
                               "not finite at some draws (a draw where its prior has no density cannot be pooled)")
     return RecordPosterior(r.label, str(r.campaign), draws["f"], draws["kappa"], draws["nu"], draws["p_mean"],
                            r.summary["V"], str(r.prior_file), f_model, f_log_prior,
-                           halves, both)
+                           halves, both, tuple(r.warnings))
 
 
 def _both_readings(group) -> dict[str, np.ndarray]:
@@ -127,7 +129,7 @@ def pool_tests(tests: Sequence[RecordPosterior]) -> tuple[dict[str, Pooled], dic
     if not tests:
         return {}, {}, []
     priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
-    f_stat = pool([StoredDraws(t.label, t.setup, t.f, priors[t.prior_file]["f"].logpdf(t.f)) for t in tests], "f")
+    f_stat = pool(f_draws(tests, "stationary"), "f")
     kappa = pool([StoredDraws(t.label, t.setup, t.kappa, implied_kappa_log_prior(t.kappa, priors[t.prior_file]))
                   for t in tests], "kappa")
     n_diag = sum(t.f_model is not None and t.f_model_log_prior is not None for t in tests)
@@ -136,6 +138,15 @@ def pool_tests(tests: Sequence[RecordPosterior]) -> tuple[dict[str, Pooled], dic
             f"pooled f: the stationary analysis's, since {n_diag} of {len(tests)} tests carry f under a diagnosed "
             "model with the prior its draws were made under (pooling the diagnosed f needs every test)"]
         return {"f": f_stat, "kappa": kappa}, {}, note
-    f_diag = pool([StoredDraws(t.label, t.setup, t.f_model, t.f_model_log_prior) for t in tests], "f",
-                  basis="diagnosed")
+    f_diag = pool(f_draws(tests, "diagnosed"), "f", basis="diagnosed")
     return {"f": f_diag, "kappa": kappa}, {"f": f_stat}, []
+
+
+def f_draws(tests: Sequence[RecordPosterior], basis: str) -> list[StoredDraws]:
+    """Each test's draws of f and the log density of the prior they were drawn under, as the pooling reads them:
+    ``basis`` "stationary" (the stationary analysis' f, under its prior file's f prior) or "diagnosed" (f under
+    each test's diagnosed model, under the prior the run stored beside it)."""
+    if basis == "diagnosed":
+        return [StoredDraws(t.label, t.setup, t.f_model, t.f_model_log_prior) for t in tests]
+    priors = {t.prior_file: load_priors(t.prior_file) for t in tests}
+    return [StoredDraws(t.label, t.setup, t.f, priors[t.prior_file]["f"].logpdf(t.f)) for t in tests]

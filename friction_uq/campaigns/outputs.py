@@ -1,17 +1,19 @@
 """The campaign's outputs: ``campaign.json`` (schema below), ``campaign.nc`` and the text summary.
 
-``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 5``; version 1 had no weights, and its
+``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 6``; version 5 had no record's
+``warnings`` nor ``pooled_without_warned``; version 1 had no weights, and its
 set-up offsets were free; version 2 pooled the stationary f whatever the records carried, and had no ``basis``
 nor ``pooled_stationary``; version 3's pressure law was a straight line in p, its parameters ``f_ref`` and
 ``c_per_p_ref``; version 4 had no slip law, and its ELPDs were of the tests' levels alone, without each
 test's change across its window, so they are not comparable with version 5's): ``records`` (each
 record's path, set-up, test id, ``status`` done | skipped | failed, the refusal ``message``,
-seconds, the ``causes`` its diagnosis named or null), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
+seconds, the ``causes`` its diagnosis named or null, the run's ``warnings``), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
 scatter ``sigma`` with 90 % intervals, each test's effective sample size, the Monte Carlo variance
 of the hyper-log-likelihood, or ``refused`` with the reason; ``basis``: ``diagnosed`` when f is f under each
 test's diagnosed model (every test diagnosed), its prior on f_effective divided out, else ``stationary``),
 ``pooled_stationary`` (``f`` of the stationary analysis, as in ``pooled``, when ``pooled.f`` is the diagnosed f;
-else empty), ``friction_law`` (``best``: the law that
+else empty), ``pooled_without_warned`` (``f`` pooled as ``pooled.f`` from the tests whose runs gave no warning,
+or null when none did: :mod:`.warned`), ``friction_law`` (``best``: the law that
 carries the stacking weight (one of constant, velocity, pressure, slip, pressure+velocity) or null;
 ``chosen_model``; ``weights``: each law's stacking weight; ``supported``: the fewest laws carrying 90 %
 of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and its weight;
@@ -45,9 +47,10 @@ from .._atomic import atomic_path, write_bytes
 from .._json_text import json_text
 from .analysis import CampaignAnalysis, f_law_draws, supported_laws
 from .job import RecordResult
+from .warned import warned_statement
 
 SCHEMA = "friction-uq/campaign"
-SCHEMA_VERSION = 5
+SCHEMA_VERSION = 6
 
 
 #: The law parameters' meanings and units, as the JSON's ``friction_law.meanings`` and the sentences give them.
@@ -131,6 +134,8 @@ def statements(ca: CampaignAnalysis) -> list[str]:
                        f"[{p.sigma['q05']:.2g}, {p.sigma['q95']:.2g}] (90 %; {len(p.tests)} tests, smallest ESS "
                        f"{min(p.ess.values()):.0f}, Monte Carlo variance of the pooled log-likelihood "
                        f"{p.mc_variance:.2g})")
+    if said := warned_statement(ca.tests, ca.pooled_without_warned):
+        out.append(said)
     return out
 
 
@@ -142,7 +147,7 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
         "settings": settings, "counts": counts,
         "records": [{"path": r.path, "campaign": r.campaign, "test_id": r.test_id, "status": r.status,
                      "message": r.message, "seconds": r.seconds, "converged": r.converged, "notes": r.notes,
-                     "causes": r.causes}
+                     "causes": r.causes, "warnings": r.warnings}
                     for r in results],
     }
     if ca is None:
@@ -157,6 +162,7 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
     doc |= {
         "pooled": {k: p.to_json() for k, p in ca.pooled.items()},
         "pooled_stationary": {k: p.to_json() for k, p in ca.pooled_stationary.items()},
+        "pooled_without_warned": None if ca.pooled_without_warned is None else ca.pooled_without_warned.to_json(),
         "friction_law": {"best": ca.best, "chosen_model": ca.chosen, "ranking": ca.ranking,
                          "weights": ca.weights, "supported": supported_laws(ca.weights, ca.ranking) if ca.weights else [],
                          "posterior": ca.law_posterior, "models": models,
@@ -227,10 +233,10 @@ def write_netcdf(ca: CampaignAnalysis, path: Path) -> Path:
 
 def summary_text(doc: dict[str, Any]) -> str:
     """Plain-text campaign summary: one line per record, then the statements."""
-    lines = [f"{'record':<28} {'set-up':<7} {'test':<8} {'status':<8} {'s':>6}  message"]
+    lines = [f"{'record':<28} {'set-up':<7} {'test':<8} {'status':<8} {'s':>6} {'warnings':>8}  message"]
     for r in doc["records"]:
         lines.append(f"{Path(r['path']).name:<28} {r['campaign'] or '-'!s:<7} {r['test_id'] or '-'!s:<8} "
-                     f"{r['status']:<8} {r['seconds']:>6.1f}  {r['message'] or ''}")
+                     f"{r['status']:<8} {r['seconds']:>6.1f} {len(r.get('warnings') or []):>8}  {r['message'] or ''}")
     c = doc["counts"]
     lines.append(f"{c['done']} analysed, {c['skipped']} up to date, {c['failed']} failed")
     ranking = doc["friction_law"].get("ranking") or []

@@ -24,7 +24,8 @@ def _wrapped(lines: list[str], width: int = 150) -> str:
 
 
 def _summary_page(ca: CampaignAnalysis, doc: dict[str, Any]):
-    """The verdict in sentences, then every test in a table: set-up, test, V, p, f with its interval, causes."""
+    """The verdict in sentences, then every test in a table: set-up, test, V, p, f with its interval, the count of
+    its run's warnings, causes."""
     fig, ax = figure(f"Campaign: {doc['counts']['done'] + doc['counts']['skipped']} tests analysed, "
                      f"{doc['counts']['failed']} refused")
     ax.axis("off")
@@ -36,16 +37,17 @@ def _summary_page(ca: CampaignAnalysis, doc: dict[str, Any]):
         q = np.quantile(f, [0.05, 0.5, 0.95])
         named = causes.get((t.setup, t.label.split(" ")[-1]))
         rows.append([t.setup, t.label.split(" ")[-1], f"{t.V['mean']:.2f}", f"{np.median(t.p_mean) * 1e-6:.0f}",
-                     f"{q[1]:.4f} [{q[0]:.4f}, {q[2]:.4f}]", "not diagnosed" if named is None else
-                     (", ".join(named) or "none")])
+                     f"{q[1]:.4f} [{q[0]:.4f}, {q[2]:.4f}]", str(len(t.warnings)), "not diagnosed" if named is None
+                     else (", ".join(named) or "none")])
     for r in doc["records"]:
         if r["status"] == "failed":
-            rows.append([str(r["campaign"] or "-"), str(r["test_id"] or "-"), "", "", "refused", textwrap.shorten(
-                str(r["message"] or ""), 60)])
+            rows.append([str(r["campaign"] or "-"), str(r["test_id"] or "-"), "", "", "refused", "",
+                         textwrap.shorten(str(r["message"] or ""), 60)])
     if rows:
-        head = ["set-up", "test", "V (m/s)", "p_mean (MPa)", "f, median [90 %]", "causes named (diagnose)"]
+        head = ["set-up", "test", "V (m/s)", "p_mean (MPa)", "f, median [90 %]", "warnings", "causes named (diagnose)"]
         tab = ax.table(cellText=rows[:28], colLabels=head, loc="lower center", cellLoc="left",
-                       colWidths=[0.07, 0.1, 0.08, 0.1, 0.2, 0.45], bbox=[0.0, 0.0, 1.0, min(0.55, 0.03 * (len(rows) + 1))])
+                       colWidths=[0.07, 0.1, 0.08, 0.1, 0.2, 0.08, 0.37],
+                       bbox=[0.0, 0.0, 1.0, min(0.55, 0.03 * (len(rows) + 1))])
         tab.auto_set_font_size(False)
         tab.set_fontsize(8)
     fig.text(0.01, 0.01, _wrapped(["f: under each test's diagnosed model where diagnose ran, else the stationary "
