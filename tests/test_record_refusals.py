@@ -168,6 +168,26 @@ def scramble_after_signature(path: Path) -> Path:
     return path
 
 
+def damaged_chunk(name: str) -> Mutation:
+    """/signals/<name> stored gzip-compressed in chunks, one chunk's bytes then overwritten (a disk or a copy
+    that damaged the file's middle): HDF5 opens the file and fails on that dataset's read."""
+
+    def mutate(path: Path) -> Path:
+        with h5py.File(path, "r+") as fh:
+            data, attrs = fh["signals"][name][()], dict(fh["signals"][name].attrs)
+            del fh["signals"][name]
+            ds = fh["signals"].create_dataset(name, data=data, compression="gzip", chunks=(max(1, data.size // 4),))
+            for k, v in attrs.items():
+                ds.attrs[k] = v
+            offset = ds.id.get_chunk_info(1).byte_offset
+        raw = bytearray(path.read_bytes())
+        raw[offset + 10:offset + 60] = bytes(b ^ 0xFF for b in raw[offset + 10:offset + 60])
+        path.write_bytes(bytes(raw))
+        return path
+
+    return mutate
+
+
 def empty_hdf5(path: Path) -> Path:
     with h5py.File(path, "w"):
         pass
@@ -213,6 +233,9 @@ CASES = [
     Case("truncated-1k", truncate(lambda n: 1024), "/", "damaged or truncated HDF5 file"),
     Case("truncated-signature-only", truncate(lambda n: 8), "/", "damaged or truncated HDF5 file"),
     Case("zeros-after-signature", scramble_after_signature, "/", "damaged or truncated HDF5 file"),
+    # a damaged chunk in a dataset: that dataset named, not the file's root
+    Case("damaged-chunk", damaged_chunk("internal_output_bar"), "/signals/internal_output_bar",
+         "cannot be read: its stored data are damaged", cli=True),
     Case("missing-file", absent, "/", "file not found", cli=True),
     Case("directory", a_directory, "/", "is a directory", cli=True),
     Case("hdf5-but-not-a-record", empty_hdf5, "/", "required attribute 'format' is missing"),

@@ -263,7 +263,10 @@ def _read_channel(ds: Any, name: str, where: str, r: Reader, read: dict[str, Cha
         scale = spv
     else:
         scale = UNITS[units]
-    raw = np.asarray(ds[()], dtype=np.float64)
+    try:  # a chunk HDF5 cannot decompress or read: the dataset named, not the file's root
+        raw = np.asarray(ds[()], dtype=np.float64)
+    except OSError as exc:
+        raise r.fail(where, f"cannot be read: its stored data are damaged ({exc})") from None
     check_samples(raw, where, r)
     strain = -scale * raw  # the one sign flip of the package: compression positive from here on
     strain.setflags(write=False)
