@@ -41,8 +41,8 @@ def test_the_pooled_f_without_the_warned_tests_is_said_beside_it():
     assert sound is not None and sound.tests == ["A A-01", "A A-02"] and sound.basis == allf.basis
     assert sound.mu["q95"] < allf.mu["q50"] and sound.mu["q50"] == pytest.approx(0.050, abs=0.001)
     said = [s for s in campaign_doc([], ca, seed=1, settings={})["statements"] if "warning" in s]
-    assert len(said) == 1 and said[0].startswith("tests A A-04 (1 warning), A A-05 (2 warnings) carry their runs' "
-                                                 "warnings"), said
+    assert len(said) == 1 and said[0].startswith("tests whose runs warned (how many warnings: A A-04 (1), A A-05 (2); "
+                                                 "each run's JSON"), said
     assert f"pooled f without them: population mean {sound.mu['q50']:.4g}" in said[0]
 
 
@@ -55,6 +55,9 @@ def test_nothing_is_said_when_no_run_warned_and_too_few_tests_left_are_said_so()
     alone = pooled_without_warned(few, analyse_tests(few, tally_causes([]), seed=1).pooled["f"])
     said = warned_statement(few, alone)
     assert alone.refused and said.endswith(f"without them: {alone.refused}")
+    every = [_test("A A-01", 0.05, ["x"]), _test("A A-02", 0.05, ["y", "z"])]
+    assert warned_statement(every, pooled_without_warned(every, alone)).startswith(
+        "every test's run warned (how many warnings: A A-01 (1), A A-02 (2);")
 
 
 def test_a_records_result_carries_its_runs_warnings(tmp_path):

@@ -32,20 +32,21 @@ def pooled_without_warned(tests: Sequence[RecordPosterior], pooled_f: Pooled | N
 
 
 def warned_statement(tests: Sequence[RecordPosterior], without: Pooled | None) -> str | None:
-    """'tests A A-03 (2 warnings), B B-02 (1) carry their runs' warnings ...; pooled f without them: ...'; None
+    """'tests whose runs warned (how many warnings): A A-03 (2), B B-02 (1) ...; pooled f without them: ...'; None
     when no run warned."""
     marked = warned(tests)
     if not marked:
         return None
-    many = len(marked) > 1
-    listed = ", ".join(f"{t.label} ({len(t.warnings)} warning{'s' if len(t.warnings) > 1 else ''})" for t in marked)
-    head = (f"{'tests' if many else 'test'} {listed} {'carry their runs' if many else 'carries its run'}' warnings "
-            f"(each run's JSON and report say why; the campaign's JSON lists them): the pooled f holds "
-            f"{'them' if many else 'it'}")
+    listed = ", ".join(f"{t.label} ({len(t.warnings)})" for t in marked)
+    why = "each run's JSON and report say why; the campaign's JSON lists them"
+    if len(marked) == len(tests):
+        return (f"every test's run warned (how many warnings: {listed}; {why}): the pooled f rests on warned tests "
+                "alone")
+    head = f"tests whose runs warned (how many warnings: {listed}; {why}): the pooled f holds them"
     if without is None:
         return head
     if without.refused:
-        return f"{head}; without {'them' if many else 'it'}: {without.refused}"
+        return f"{head}; without them: {without.refused}"
     mu = without.mu
-    return (f"{head}; pooled f without {'them' if many else 'it'}: population mean {mu['q50']:.4g} "
-            f"[{mu['q05']:.4g}, {mu['q95']:.4g}] (90 %; {len(without.tests)} tests)")
+    return (f"{head}; pooled f without them: population mean {mu['q50']:.4g} [{mu['q05']:.4g}, {mu['q95']:.4g}] "
+            f"(90 %; {len(without.tests)} tests)")
