@@ -91,10 +91,6 @@ class HoopOrPrior:
     prior_converged: bool = True  # whether the sampling with the hoop gauge left out met the stopping rule
 
     @property
-    def f_draws(self) -> np.ndarray:
-        return self.draws["f"]
-
-    @property
     def f_prior_draws(self) -> np.ndarray:
         """f's draws with nu from the prior file alone (the equal mixture's second half), given the bars' headers."""
         f = self.draws["f"]

@@ -43,7 +43,7 @@ def test_the_pooled_f_without_the_warned_tests_is_said_beside_it():
     said = [s for s in campaign_doc([], ca, seed=1, settings={})["statements"] if "warning" in s]
     assert len(said) == 1 and said[0].startswith("tests whose runs warned (how many warnings: A A-04 (1), A A-05 (2); "
                                                  "each run's JSON"), said
-    assert f"pooled f without them: population mean {sound.mu['q50']:.4g}" in said[0]
+    assert f"pooled f of the stationary analysis without them: population mean {sound.mu['q50']:.4g}" in said[0]
 
 
 def test_nothing_is_said_when_no_run_warned_and_too_few_tests_left_are_said_so():

@@ -93,7 +93,7 @@ def test_each_models_group_holds_the_log_prior_of_f_effective_beside_its_draws(t
     rng = np.random.default_rng(0)
     base = _model("baseline", (), rng.normal(0.05, 0.002, 200))
     vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
-    dg = SimpleNamespace(swap_models=(), baseline=base, final=vel, causes=vel.variants,
+    dg = SimpleNamespace(swap_models=(), f_prior_nu=None, baseline=base, final=vel, causes=vel.variants,
                          rounds=((SimpleNamespace(fit=vel),),),
                          posterior_method="importance", context=CTX, seed=4, mixture_f=None)
     with _written(dg, tmp_path) as back:
@@ -123,7 +123,7 @@ def test_the_mixture_group_holds_each_draws_prior_from_the_model_it_came_from(tm
     vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
     f = np.concatenate([base.f_effective[:30], vel.f_effective[:70]])
     source = np.repeat([0, 1], [30, 70])
-    dg = SimpleNamespace(swap_models=(), baseline=base, final=base, causes=(), rounds=((SimpleNamespace(fit=vel),),),
+    dg = SimpleNamespace(swap_models=(), f_prior_nu=None, baseline=base, final=base, causes=(), rounds=((SimpleNamespace(fit=vel),),),
                          ranking=(SimpleNamespace(fit=vel),), posterior_method=None, context=CTX, seed=4,
                          mixture_f=f, mixture_source=source, mixture_weights={"reference": 0.3, "velocity_friction": 0.7},
                          verdict=SimpleNamespace(kind="unexplained"))
@@ -146,7 +146,7 @@ def test_the_stationary_half_of_a_mixture_keeps_the_f_prior_and_says_so(tmp_path
     stationary = rng.normal(0.052, 0.003, 50)
     f = np.concatenate([stationary, vel.f_effective[:50]])
     source = np.repeat([0, 1], [50, 50])
-    dg = SimpleNamespace(swap_models=(), baseline=base, final=vel, causes=vel.variants,
+    dg = SimpleNamespace(swap_models=(), f_prior_nu=None, baseline=base, final=vel, causes=vel.variants,
                          rounds=((SimpleNamespace(fit=vel),),),
                          posterior_method="importance", context=CTX, seed=4, mixture_f=f, mixture_source=source,
                          mixture_weights={"stationary": 0.5, "velocity_friction": 0.5},
@@ -165,16 +165,16 @@ def test_the_method_of_the_f_to_quote_is_the_mixtures_where_f_is_one():
 
     rng = np.random.default_rng(3)
     vel = _model("velocity_friction", ("velocity_friction",), rng.normal(0.06, 0.002, 200))
-    one = SimpleNamespace(final=vel, causes=vel.variants, posterior_method="importance", mixture_f=None,
+    one = SimpleNamespace(final=vel, f_prior_nu=None, causes=vel.variants, posterior_method="importance", mixture_f=None,
                           mixture_weights={})
     assert posterior_method_of(one) == "importance"
-    mixed = SimpleNamespace(final=vel, causes=vel.variants, posterior_method="importance",
+    mixed = SimpleNamespace(final=vel, f_prior_nu=None, causes=vel.variants, posterior_method="importance",
                             mixture_f=rng.normal(0.06, 0.002, 100),
                             mixture_weights={"stationary": 0.5, "velocity_friction": 0.5})
     assert posterior_method_of(mixed) == ("stacking mixture: the final model's draws from its exact posterior where "
                                           "it is a member, the other members' normal approximations, half of it the "
                                           "stationary posterior's draws")
-    candidates = SimpleNamespace(final=vel, causes=(), posterior_method=None, mixture_f=mixed.mixture_f,
+    candidates = SimpleNamespace(final=vel, f_prior_nu=None, causes=(), posterior_method=None, mixture_f=mixed.mixture_f,
                                  mixture_weights={"reference": 0.4, "velocity_friction": 0.6})
     assert posterior_method_of(candidates) == "stacking mixture of the candidates' normal approximations"
 
@@ -188,7 +188,7 @@ def test_a_mixture_member_that_drew_no_draw_is_written_without_one(tmp_path):
     slip = _model("slip_friction", ("slip_friction",), rng.normal(0.055, 0.002, 200))
     f = np.concatenate([base.f_effective[:40], vel.f_effective[:60]])
     source = np.repeat([0, 1], [40, 60])  # slip_friction (index 2) drew nothing
-    dg = SimpleNamespace(swap_models=(), baseline=base, final=base, causes=(), rounds=((SimpleNamespace(fit=vel),
+    dg = SimpleNamespace(swap_models=(), f_prior_nu=None, baseline=base, final=base, causes=(), rounds=((SimpleNamespace(fit=vel),
                                                                         SimpleNamespace(fit=slip)),),
                          posterior_method=None, context=CTX, seed=4, mixture_f=f, mixture_source=source,
                          mixture_weights={"reference": 0.4, "velocity_friction": 0.5999, "slip_friction": 1e-4},

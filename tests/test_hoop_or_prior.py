@@ -279,3 +279,24 @@ def test_the_other_warnings_quote_two_readings_by_their_interval():
     one = VariableSummary(mean=0.068, sd=0.02, q05=0.03827, q50=0.06989, q95=0.09798, r_hat=1.0, ess_bulk=4000.0)
     assert _f_text(one) == "f = 0.06989 [0.03827, 0.09798]"
     assert _f_text(TwoReadings(**vars(one))) == "f (from 0.03827 to 0.09798, two readings)"
+
+
+def test_with_two_readings_of_nu_the_shares_said_are_of_the_whole_f_to_quote():
+    """A reviewer's case (A-03, hoop gauge at twice its scale, nothing named): the sentence said "half of it ... from
+    the prior file alone" beside "the stationary analysis (50 %) and the candidates (dispersion 30 %, clearance
+    20 %)", 150 % in all, and quoted the stationary f by the median between its two readings. Each member's share
+    is now halved, the stationary f said by its interval, and the posterior method names the prior's half."""
+    from dataclasses import replace
+
+    from friction_uq.discrepancy.diagnosis_words import _median, _percent, _said
+    from friction_uq.discrepancy.outcome import posterior_method_of
+
+    one, two = _diagnosed(), _diagnosed(np.full(10, 0.045))
+    one, two = (replace(d, posterior_method="importance") for d in (one, two))
+    assert _percent(one, 0.3) == "30 %" and _percent(two, 0.3) == "15 %" and _percent(two, 0.5) == "25 %"
+    fs = {"q05": 0.038, "q50": 0.071, "q95": 0.099}
+    assert _said(one, fs) == "f = 0.071 [0.038, 0.099]" and _median(one, fs) == "0.071"
+    assert "0.071" not in _said(two, fs) + _median(two, fs) and _median(two, fs).startswith("0.038 to 0.099")
+    assert posterior_method_of(one) == "importance"
+    assert posterior_method_of(two) == ("importance; in equal parts with the stationary posterior's draws with nu "
+                                        "from the prior file alone")

@@ -151,7 +151,8 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
                     for r in results],
     }
     if ca is None:
-        doc |= {"pooled": {}, "pooled_stationary": {}, "friction_law": {"best": None, "ranking": []}, "flagged": [],
+        doc |= {"pooled": {}, "pooled_stationary": {}, "pooled_without_warned": None,
+                "friction_law": {"best": None, "ranking": []}, "flagged": [],
                 "causes": {}, "statements": ["no record was analysed: nothing to pool"]}
         return doc
     models = {}

@@ -1,7 +1,9 @@
 """The tests whose runs warned, and the campaign's pooled f without them.
 
 A run's warning says that its f may be biased (a misfit the model cannot explain, a force ratio that wanders over
-the window, gauges out of balance, a hoop gauge that disagrees with nu's prior, ...). The campaign pools every
+the window, gauges out of balance, a hoop gauge that disagrees with nu's prior, ...). Under ``--diagnose`` a test
+whose misfit ``diagnose`` explained keeps the misfit's warning (it says which f to quote), so the pooled f without
+the warned tests leaves out the tests whose f a named cause corrected too. The campaign pools every
 analysed test, since a warning is not a verdict that the test is wrong; but a person quoting the pooled f must know
 which tests carried one, and whether the pooled f hangs on them. So the campaign lists the warned tests with their
 counts (each run's JSON and report say why; the campaign's JSON lists every warning) and pools f again on the same
@@ -48,5 +50,6 @@ def warned_statement(tests: Sequence[RecordPosterior], without: Pooled | None) -
     if without.refused:
         return f"{head}; without them: {without.refused}"
     mu = without.mu
-    return (f"{head}; pooled f without them: population mean {mu['q50']:.4g} [{mu['q05']:.4g}, {mu['q95']:.4g}] "
-            f"(90 %; {len(without.tests)} tests)")
+    basis = "under each test's diagnosed model" if without.basis == "diagnosed" else "of the stationary analysis"
+    return (f"{head}; pooled f {basis} without them: population mean {mu['q50']:.4g} [{mu['q05']:.4g}, "
+            f"{mu['q95']:.4g}] (90 %; {len(without.tests)} tests)")

@@ -128,7 +128,8 @@ def headline(dg: Diagnosis) -> tuple[str, dict[str, float]] | None:
     """The headline f of a diagnosed record: the final model's label and its f when a cause was named; the
     stacking mixture's when the record named candidates or an unexplained misfit (:mod:`.verdict`); None when
     nothing needed explaining (the headline is then the stationary analysis' f). The f's summary carries the output
-    bars' calibration (:mod:`friction_uq.quoted`), as the JSON's ``f`` does."""
+    bars' calibration (:mod:`friction_uq.quoted`), as the JSON's ``f`` does, and, where the hoop gauge and nu's
+    prior disagree, the stationary f from nu's prior alone for half (:func:`f_draws_to_quote`)."""
     if dg.mixture_f is not None:
         return mixture_label(dg), quoted_of(dg)
     if dg.causes:

@@ -61,13 +61,13 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     if not dg.causes and dg.misfits and not dg.misfits[0].detected:
         return (f"The simulated test reproduces every gauge within what two simulators of the same test differ by: "
                 f"nothing to explain (closest cause: {dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- "
-                f"{dg.ranking[0].se:.1f} nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
-                f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
+                f"{dg.ranking[0].se:.1f} nats, docs/glossary.md); {_said(dg, f_without)} "
+                f"stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     if not dg.causes:
         return (f"No cause of the catalogue explains the record clearly better than the simple model (closest: "
                 f"{dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f} "
-                f"nats, docs/glossary.md); f = {f_without['q50']:.3f} [{f_without['q05']:.3f}, "
-                f"{f_without['q95']:.3f}] stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
+                f"nats, docs/glossary.md); {_said(dg, f_without)} "
+                f"stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     steps, order = ordered_steps(dg)
     opening = found(order, steps, dg)
     fitted = "; ".join(f"{cause_words(v, dg)}, f {a:.3f} -> {b:.3f}" for v, a, b in steps)
@@ -94,7 +94,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = f" {dg.separate_by[:1].upper()}{dg.separate_by[1:]} would tell them apart." if dg.separate_by else ""
     elif more := further(dg):  # the last round's weight lies on further mechanisms it did not name: their mixture
         lead = f"{opening} {named or fitted}{gauges}.{spare}"
-        shares = ", ".join(f"{'them' if k == dg.final.label else '+ ' + more[k]} {100 * w:.0f} %"
+        shares = ", ".join(f"{'them' if k == dg.final.label else '+ ' + more[k]} {_percent(dg, w)}"
                            for k, w in dg.mixture_weights.items())
         with_them = "the model with them and " if dg.final.label in dg.mixture_weights else ""
         quote = (f"from {with_them}the further causes the record leans to without naming one, weighted by how well "
@@ -111,7 +111,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         sep = f" This record does not tell apart {', '.join(dg.not_separable)}; {dg.separate_by} would." \
             if dg.not_separable else ""
     fx = headline(dg)[1]
-    return (f"{lead} {_f_said(dg, fx)} {quote}, {f_without['q50']:.3f} from "
+    return (f"{lead} {_f_said(dg, fx)} {quote}, {_median(dg, f_without)} from "
             f"the stationary analysis {'alone' if STATIONARY in dg.mixture_weights else 'without them'}. Why: "
             f"{_describe(dg)}; the {evidence}'s evidence is "
             f"{first.delpd:.0f} +- {first.se:.0f} nats.{by_weight_clause(dg)}{swapped_clause(dg)}{sep}{delay_clause(dg)}"
@@ -126,6 +126,25 @@ def _evidence_of(dg: Diagnosis, cause: Variant):
         else dg.ranking[0]
 
 
+def _percent(dg: Diagnosis, w: float) -> str:
+    """A mixture member's share of the f to quote: its stacking weight, halved where the f to quote holds the
+    stationary f from nu's prior alone for the other half (``Diagnosis.f_prior_nu``)."""
+    return f"{100 * w * (1.0 if dg.f_prior_nu is None else 0.5):.0f} %"
+
+
+def _said(dg: Diagnosis, f: dict[str, float]) -> str:
+    """The stationary analysis' f to quote (``f``): 'f = 0.049 [0.044, 0.054]', or by its interval where it holds
+    two readings of nu (the hoop gauge's and the prior's, disagreeing), its median between them."""
+    if dg.f_prior_nu is None:
+        return f"f = {f['q50']:.3f} [{f['q05']:.3f}, {f['q95']:.3f}]"
+    return f"f from {f['q05']:.3f} to {f['q95']:.3f} (the hoop gauge's and the prior's readings of nu)"
+
+
+def _median(dg: Diagnosis, f: dict[str, float]) -> str:
+    """The stationary analysis' f to quote by its median, or by its interval where it holds two readings of nu."""
+    return f"{f['q50']:.3f}" if dg.f_prior_nu is None else f"{f['q05']:.3f} to {f['q95']:.3f} (two readings of nu)"
+
+
 def _f_said(dg: Diagnosis, fx: dict[str, float]) -> str:
     """'f = 0.049 [0.044, 0.054]'; by its interval alone, and why, when it holds two readings of nu
     (``Diagnosis.f_prior_nu``: the hoop gauge and the prior file disagree)."""
@@ -138,7 +157,7 @@ def _f_said(dg: Diagnosis, fx: dict[str, float]) -> str:
 def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     """The sentence of a record whose misfit no single cause explains (candidates, or unexplained)."""
     fm = headline(dg)[1]
-    shares = ", ".join(f"{_words_of(dg, k)} {100 * w:.0f} %" for k, w in dg.mixture_weights.items()
+    shares = ", ".join(f"{_words_of(dg, k)} {_percent(dg, w)}" for k, w in dg.mixture_weights.items()
                        if k != STATIONARY)
     v = dg.verdict
     if v.kind == "unconfirmed":
@@ -152,14 +171,14 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         what = (f"Unexplained misfit{where}: no cause of the catalogue explains it clearly, over the whole record "
                 "and better than every other.")
     if STATIONARY in dg.mixture_weights:  # half the stationary analysis' f (candidates_mixture)
-        half = 100 * dg.mixture_weights[STATIONARY]
-        return (f"{what} {_f_said(dg, fm)} from the stationary analysis "
-                f"({half:.0f} %) and the candidates weighted by how well each predicts the record ({shares}): the f "
-                f"to quote, wide enough for whichever of them is right; {f_without['q50']:.3f} from the stationary "
-                "analysis alone.")
+        which = "the stationary analysis" if dg.f_prior_nu is None else "the stationary analysis with the hoop gauge"
+        return (f"{what} {_f_said(dg, fm)} from {which} "
+                f"({_percent(dg, dg.mixture_weights[STATIONARY])}) and the candidates weighted by how well each "
+                f"predicts the record ({shares}): the f to quote, wide enough for whichever of them is right; "
+                f"{_median(dg, f_without)} from the stationary analysis alone.")
     return (f"{what} {_f_said(dg, fm)} from the candidates weighted by how well "
             f"each predicts the record ({shares}; the f to quote, wide enough for whichever of them is right), "
-            f"{f_without['q50']:.3f} from the stationary analysis.")
+            f"{_median(dg, f_without)} from the stationary analysis.")
 
 
 def delay_clause(dg: Diagnosis) -> str:

@@ -204,13 +204,16 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
 
 def posterior_method_of(dg: Diagnosis) -> str | None:
     """How the draws of the f the record quotes were obtained: the final model's route (:data:`POSTERIOR_NOTE`)
-    or, where f is a stacking mixture, what each member's draws are."""
+    or, where f is a stacking mixture, what each member's draws are; where the f to quote also holds the stationary
+    f from nu's prior alone (``Diagnosis.f_prior_nu``), that half too."""
+    prior = ("" if dg.f_prior_nu is None else
+             "; in equal parts with the stationary posterior's draws with nu from the prior file alone")
     if dg.mixture_f is None:
-        return dg.posterior_method
+        return None if dg.posterior_method is None else dg.posterior_method + prior
     return (("stacking mixture: the final model's draws from its exact posterior where it is a member, the other "
              "members' normal approximations" if dg.causes else
              "stacking mixture of the candidates' normal approximations")
-            + (", half of it the stationary posterior's draws" if STATIONARY in dg.mixture_weights else ""))
+            + (", half of it the stationary posterior's draws" if STATIONARY in dg.mixture_weights else "") + prior)
 
 
 def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:

@@ -112,7 +112,7 @@ def summary_table(campaign: str, test_id: str, allv: dict[str, VariableSummary],
     """The table the terminal ends with (``both``: the headline is two readings, this table the hoop gauge's)."""
     units = {"p_mean": ("MPa", 1e-6), "tau_mean": ("MPa", 1e-6), "V": ("m/s", 1.0)}
     lines = [f"{campaign} {test_id}: posterior (90 % credible intervals), given the output bars' header values"
-             + (", with the hoop gauge (the headline holds it and nu from the prior alone)" if both else ""),
+             + (", with the hoop gauge (the headline also holds f with nu from the prior file alone)" if both else ""),
              f"{'quantity':<10} {'unit':<5} {'q50':>10} {'q05':>10} {'q95':>10} {'mean':>10} {'sd':>10}"]
     for name in ("f", "nu", "kappa", "hoop_gain", "ratio", "p_mean", "tau_mean", "V"):
         if name not in allv:

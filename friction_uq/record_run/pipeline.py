@@ -258,7 +258,7 @@ def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck
                    page: bool) -> None:
     """The terminal's headline, warnings and summary table (``page``: a report was written to point at)."""
     from ..report.pdf import first_whole_record_page
-    from ..report.quote import f_from_diagnosis, quote_line
+    from ..report.quote import quote_line
 
     print(quote_line(post.f_quoted, diag, len(warns), hoop=post.samples.hoop, both=_both(post)))
     for w in warns:
@@ -270,4 +270,4 @@ def _print_summary(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck
         lines.append(doc["discrepancy"]["sentence"])
     print(summary_table(s.record.campaign, s.record.test_id, dict(post.summary) | {"V": post.V}, post.convergence,
                         outputs, seconds, post.conflict, lines,
-                        both=post.hoop_or_prior is not None and not f_from_diagnosis(diag)))
+                        both=post.hoop_or_prior is not None))

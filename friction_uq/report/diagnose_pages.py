@@ -87,7 +87,9 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     fb = dg.baseline.f_summary()
     lines = [sentence, "",
              "The posteriors below are given the output bars' header values; the f to quote (the sentence's, and the "
-             "first line of page 1) also carries the bars' calibration.",
+             "first line of page 1) also carries the bars' calibration"
+             + (", and holds the stationary f from nu's prior alone for half (the hoop gauge and the prior file "
+                "disagree)." if dg.f_prior_nu is not None else "."),
              f"f, stationary phase (eq. 17{' + hoop' if hoop else '; the hoop gauge left out'}): "
              f"{f_without['q50']:.4f} [{f_without['q05']:.4f}, {f_without['q95']:.4f}]",
              f"f, baseline over the whole record: {fb['q50']:.4f} [{fb['q05']:.4f}, {fb['q95']:.4f}] "
@@ -110,7 +112,8 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     if dg.mixture_f is not None:
         fm = np.quantile(dg.mixture_f, [0.05, 0.5, 0.95])
         lines.insert(7, f"f, stacking mixture ({', '.join(f'{k} {w:.2f}' for k, w in dg.mixture_weights.items())}): "
-                        f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (given the headers; the sentence's f to quote adds the bars' calibration)")
+                        f"{fm[1]:.4f} [{fm[0]:.4f}, {fm[2]:.4f}] (given the headers; the sentence's f to quote adds the bars' calibration"
+                        f"{' and the stationary f from the prior nu for half' if dg.f_prior_nu is not None else ''})")
     lines += ["", "Rule: a cause is named only of a misfit the whole-record check found, when its dELPD over the "
                   "round's reference is > 4 and > 2 SE with the 5 % of blocks most in its favour left out (the "
                   "whole record's sum is larger still), and rules out every other mechanism (by the same margin, "

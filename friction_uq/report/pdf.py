@@ -127,12 +127,15 @@ def _summary_lines(r: ReportInputs) -> list[str]:
     stationary = "The stationary analysis: "
     if named is None and r.hoop_or_prior is not None:  # the first line holds this reading and the prior's nu's
         stationary = "The stationary analysis with the hoop gauge (one of the two readings the first line holds): "
+    hoop = "" if r.hoop_or_prior is None else " with the hoop gauge"  # the first line also holds the prior's nu's
     if named is not None and r.diagnosis.named_causes:
-        stationary = f"The stationary analysis without the named causes (page {whole_record_page(r) + 2} for them): "
+        stationary = (f"The stationary analysis{hoop} without the named causes (page {whole_record_page(r) + 2} for "
+                      "them): ")
     elif named is not None:  # nothing named: a mixture of the candidates (and, from run, of this analysis)
-        half = "half the draws of the f to quote; " if STATIONARY in r.diagnosis.mixture_weights else ""
-        stationary = (f"The stationary analysis ({half}page {whole_record_page(r) + 2} for the candidates that "
-                      "diagnose could not tell apart): ")
+        share = "half" if r.diagnosis.f_prior_nu is None else "a quarter"
+        half = f"{share} the draws of the f to quote; " if STATIONARY in r.diagnosis.mixture_weights else ""
+        stationary = (f"The stationary analysis{hoop} ({half}page {whole_record_page(r) + 2} for the candidates "
+                      "that diagnose could not tell apart): ")
     lines = [f"WARNING: {w}" for w in r.warnings] + [
         stationary + f"f = {f.q50:.4f}, 90 % credible interval [{f.q05:.4f}, {f.q95:.4f}] "
         f"(posterior mean {f.mean:.4f}, sd {f.sd:.4f}; given the output bars' header values, whose calibration "

@@ -54,8 +54,9 @@ def _diagnosed_source(diagnosis, label: str) -> str:
         if named:  # a cause named, a later round's candidates left open
             return f"the {label}: the causes diagnose named ({named}) and candidates it could not tell apart"
         if STATIONARY in diagnosis.mixture_weights:  # nothing named: half the stationary analysis' f
-            return (f"the stationary analysis and the candidates diagnose could not tell apart, in equal parts "
-                    f"({label})")
+            which = "the stationary analysis" if diagnosis.f_prior_nu is None else \
+                "the stationary analysis with the hoop gauge"
+            return f"{which} and the candidates diagnose could not tell apart, in equal parts ({label})"
         return f"the {label}, candidates diagnose could not tell apart"
     if diagnosis.within_tolerance:  # a later round's mechanism kept in the model, not named
         named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
