@@ -42,6 +42,7 @@ def page_corner(samples: PosteriorSamples, dt: xr.DataTree, *, number: int = 5) 
             data, fig=fig, labels=[LABELS.get(n, n) for n in names], quantiles=[0.05, 0.5, 0.95],
             show_titles=True, title_fmt=".4f", title_kwargs={"fontsize": 9}, label_kwargs={"fontsize": 10},
             hist_kwargs={"density": True}, plot_datapoints=False, fill_contours=True, levels=(0.5, 0.9),
+            quiet=True,  # a posterior piled at a bound (nu at 0.5) gave "WARNING:root:Too few points ..." on stderr
         )
         axes = np.array(fig.axes).reshape(len(names), len(names))
         prior = dt["prior"] if "prior" in dt.children else None
