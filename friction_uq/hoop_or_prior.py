@@ -16,7 +16,9 @@ fitted through nu, which stops at 0.5, and is fitted through f, whose prior is t
 is the two posteriors in equal parts: its interval holds f whichever of the two is wrong. Both are kept and said
 (the JSON's ``hoop_or_prior``, a warning naming the two values and the hoop gauge's scale against the prior's
 nu). The trigger is the check's own; how often it fires on records the likelihood did not make, and what it
-does to f there, is in docs/trust.md.
+does to f there, is in docs/trust.md. Under ``diagnose`` every whole-record model reads nu through the hoop gauge
+too: the diagnosed f to quote then holds the reading from the prior's nu alone for half
+(:attr:`HoopOrPrior.f_prior_draws`, friction_uq.discrepancy.diagnosed_f).
 """
 
 from __future__ import annotations
