@@ -288,15 +288,15 @@ def test_with_two_readings_of_nu_the_shares_said_are_of_the_whole_f_to_quote():
     is now halved, the stationary f said by its interval, and the posterior method names the prior's half."""
     from dataclasses import replace
 
-    from friction_uq.discrepancy.diagnosis_words import _median, _percent, _said
+    from friction_uq.discrepancy.diagnosis_words import BOTH_READINGS, _f_said, _median, _percent
     from friction_uq.discrepancy.outcome import posterior_method_of
 
     one, two = _diagnosed(), _diagnosed(np.full(10, 0.045))
     one, two = (replace(d, posterior_method="importance") for d in (one, two))
     assert _percent(one, 0.3) == "30 %" and _percent(two, 0.3) == "15 %" and _percent(two, 0.5) == "25 %"
     fs = {"q05": 0.038, "q50": 0.071, "q95": 0.099}
-    assert _said(one, fs) == "f = 0.071 [0.038, 0.099]" and _median(one, fs) == "0.071"
-    assert "0.071" not in _said(two, fs) + _median(two, fs) and _median(two, fs).startswith("0.038 to 0.099")
+    assert _f_said(one, fs, BOTH_READINGS) == "f = 0.071 [0.038, 0.099]" and _median(one, fs) == "0.071"
+    assert "0.071" not in _f_said(two, fs, BOTH_READINGS) + _median(two, fs) and _median(two, fs).startswith("0.038 to 0.099")
     assert posterior_method_of(one) == "importance"
     assert posterior_method_of(two) == ("importance; in equal parts with the stationary posterior's draws with nu "
                                         "from the prior file alone")

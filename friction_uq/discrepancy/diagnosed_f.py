@@ -113,6 +113,12 @@ def readings_of_nu(dg: Diagnosis) -> dict[str, float] | None:
     return {"diagnosed": float(np.median(_diagnosed_draws(dg))), "prior": float(np.median(dg.f_prior_nu))}
 
 
+def stationary_member(dg: Diagnosis) -> str:
+    """The name of a mixture's stationary member in words: the stationary analysis, with the hoop gauge where the
+    f to quote also holds the reading from nu's prior alone (``Diagnosis.f_prior_nu``)."""
+    return "the stationary analysis" if dg.f_prior_nu is None else "the stationary analysis with the hoop gauge"
+
+
 def quoted_of(dg: Diagnosis, model_form: float = WHOLE_RECORD_MODEL_FORM) -> dict[str, float]:
     """The diagnosed f to quote (:func:`f_draws_to_quote`) with the output bars' calibration and the whole-record
     models' form (``model_form``; 0: the calibration alone, as before the form was folded in)."""

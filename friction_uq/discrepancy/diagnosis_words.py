@@ -9,7 +9,7 @@ import numpy as np
 
 from .candidates_mixture import STATIONARY, open_rounds
 from .cause_words import cause_words, f_steps
-from .diagnosed_f import further, headline, member_name, mixture_label, unresolved
+from .diagnosed_f import further, headline, member_name, mixture_label, stationary_member, unresolved
 from .diagnosis import Diagnosis
 from .extended import Variant
 from .round_clauses import (by_weight_clause, remaining_clause, superfluous_clause, swapped_clause,
@@ -61,12 +61,12 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     if not dg.causes and dg.misfits and not dg.misfits[0].detected:
         return (f"The simulated test reproduces every gauge within what two simulators of the same test differ by: "
                 f"nothing to explain (closest cause: {dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- "
-                f"{dg.ranking[0].se:.1f} nats, docs/glossary.md); {_said(dg, f_without)} "
+                f"{dg.ranking[0].se:.1f} nats, docs/glossary.md); {_f_said(dg, f_without, BOTH_READINGS)} "
                 f"stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     if not dg.causes:
         return (f"No cause of the catalogue explains the record clearly better than the simple model (closest: "
                 f"{dg.ranking[0].fit.label}, evidence {dg.ranking[0].delpd:.1f} +- {dg.ranking[0].se:.1f} "
-                f"nats, docs/glossary.md); {_said(dg, f_without)} "
+                f"nats, docs/glossary.md); {_f_said(dg, f_without, BOTH_READINGS)} "
                 f"stands{'; ' + _hoop_finding(dg) if hoop_gain_off(dg) else ''}.")
     steps, order = ordered_steps(dg)
     opening = found(order, steps, dg)
@@ -132,26 +132,24 @@ def _percent(dg: Diagnosis, w: float) -> str:
     return f"{100 * w * (1.0 if dg.f_prior_nu is None else 0.5):.0f} %"
 
 
-def _said(dg: Diagnosis, f: dict[str, float]) -> str:
-    """The stationary analysis' f to quote (``f``): 'f = 0.049 [0.044, 0.054]', or by its interval where it holds
-    two readings of nu (the hoop gauge's and the prior's, disagreeing), its median between them."""
-    if dg.f_prior_nu is None:
-        return f"f = {f['q50']:.3f} [{f['q05']:.3f}, {f['q95']:.3f}]"
-    return f"f from {f['q05']:.3f} to {f['q95']:.3f} (the hoop gauge's and the prior's readings of nu)"
-
-
 def _median(dg: Diagnosis, f: dict[str, float]) -> str:
     """The stationary analysis' f to quote by its median, or by its interval where it holds two readings of nu."""
     return f"{f['q50']:.3f}" if dg.f_prior_nu is None else f"{f['q05']:.3f} to {f['q95']:.3f} (two readings of nu)"
 
 
-def _f_said(dg: Diagnosis, fx: dict[str, float]) -> str:
-    """'f = 0.049 [0.044, 0.054]'; by its interval alone, and why, when it holds two readings of nu
-    (``Diagnosis.f_prior_nu``: the hoop gauge and the prior file disagree)."""
+#: Why a diagnosed f to quote is said by its interval (:func:`_f_said`): half of it is the reading from nu's prior.
+PRIOR_HALF = ("half of it the stationary analysis with nu from the prior file alone, the hoop gauge and the prior file "
+              "disagreeing")
+#: Why the stationary analysis' f to quote is: it holds both readings of nu.
+BOTH_READINGS = "the hoop gauge's and the prior's readings of nu"
+
+
+def _f_said(dg: Diagnosis, fx: dict[str, float], why: str = PRIOR_HALF) -> str:
+    """'f = 0.049 [0.044, 0.054]'; by its interval alone, and ``why``, when it holds two readings of nu
+    (``Diagnosis.f_prior_nu``: the hoop gauge and the prior file disagree), its median between them."""
     if dg.f_prior_nu is None:
         return f"f = {fx['q50']:.3f} [{fx['q05']:.3f}, {fx['q95']:.3f}]"
-    return (f"f from {fx['q05']:.3f} to {fx['q95']:.3f} (half of it the stationary analysis with nu from the prior "
-            "file alone, the hoop gauge and the prior file disagreeing)")
+    return f"f from {fx['q05']:.3f} to {fx['q95']:.3f} ({why})"
 
 
 def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
@@ -171,8 +169,7 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
         what = (f"Unexplained misfit{where}: no cause of the catalogue explains it clearly, over the whole record "
                 "and better than every other.")
     if STATIONARY in dg.mixture_weights:  # half the stationary analysis' f (candidates_mixture)
-        which = "the stationary analysis" if dg.f_prior_nu is None else "the stationary analysis with the hoop gauge"
-        return (f"{what} {_f_said(dg, fm)} from {which} "
+        return (f"{what} {_f_said(dg, fm)} from {stationary_member(dg)} "
                 f"({_percent(dg, dg.mixture_weights[STATIONARY])}) and the candidates weighted by how well each "
                 f"predicts the record ({shares}): the f to quote, wide enough for whichever of them is right; "
                 f"{_median(dg, f_without)} from the stationary analysis alone.")

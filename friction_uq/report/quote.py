@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..discrepancy.candidates_mixture import STATIONARY
-from ..discrepancy.diagnosed_f import further, headline, readings_of_nu
+from ..discrepancy.diagnosed_f import further, headline, readings_of_nu, stationary_member
 
 
 def f_to_quote(f_stationary: Mapping[str, float], diagnosis=None, *, hoop: bool = True,
@@ -54,9 +54,8 @@ def _diagnosed_source(diagnosis, label: str) -> str:
         if named:  # a cause named, a later round's candidates left open
             return f"the {label}: the causes diagnose named ({named}) and candidates it could not tell apart"
         if STATIONARY in diagnosis.mixture_weights:  # nothing named: half the stationary analysis' f
-            which = "the stationary analysis" if diagnosis.f_prior_nu is None else \
-                "the stationary analysis with the hoop gauge"
-            return f"{which} and the candidates diagnose could not tell apart, in equal parts ({label})"
+            return (f"{stationary_member(diagnosis)} and the candidates diagnose could not tell apart, in equal "
+                    f"parts ({label})")
         return f"the {label}, candidates diagnose could not tell apart"
     if diagnosis.within_tolerance:  # a later round's mechanism kept in the model, not named
         named = ", ".join(v.label for v in diagnosis.named_causes) or "none"
