@@ -15,7 +15,7 @@ from .force_noise import MeanForces, mean_forces
 from .forces import Forces, compute_forces
 from .physics import cell
 from .errors import NoStationaryPhase, SignalError
-from .gauge_balance import NOISE_SIGMAS, GaugeFinding, gauge_findings
+from .gauge_balance import NOISE_SIGMAS, GaugeFinding, attributed_over_window, gauge_findings
 from .gauge_check import flat_run_findings
 from .gauge_scale import gauge_and_speed, scale_findings
 from .record import Record
@@ -87,6 +87,7 @@ def prepare(
             win = window_from_times(forces, *window)
         except SignalError as exc:
             raise SignalError(f"{record.path}: the window given by hand (--window) {exc}") from None
+    notes = attributed_over_window(notes, forces, record.apparatus, win.slice)
     _refuse_an_output_scale(record, scaled)
     data = stationary_data(
         forces, record.apparatus, win, test_id=record.test_id, campaign=record.campaign,
