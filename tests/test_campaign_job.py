@@ -39,8 +39,9 @@ def test_a_result_reads_back_as_written(tmp_path):
     ({"schema": "other"}, "not a campaign record result \\(key 'schema'"),
     ({"schema_version": SCHEMA_VERSION + 1}, f"key 'schema_version' is {SCHEMA_VERSION + 1}, this friction-uq reads"),
     ({"colour": "red"}, f"unknown key\\(s\\) colour in a schema version {SCHEMA_VERSION} result"),
-    ({"schema_version": 1}, "key 'schema_version' is 1, this friction-uq reads version 3"),  # no window_halves
-    ({"schema_version": 2}, "key 'schema_version' is 2, this friction-uq reads version 3"),  # no warnings
+    ({"schema_version": 1}, "key 'schema_version' is 1, this friction-uq reads version 4"),  # no window_halves
+    ({"schema_version": 2}, "key 'schema_version' is 2, this friction-uq reads version 4"),  # no warnings
+    ({"schema_version": 3}, "key 'schema_version' is 3, this friction-uq reads version 4"),  # no warning_kinds
     ({"status": "maybe"}, "key 'status' is 'maybe', allowed values: done, skipped, failed"),
     ({"window_halves": {"sd": 1}}, "key 'window_halves': key 'log_kappa_change' must be a finite number"),
 ])

@@ -51,7 +51,7 @@ def test_a_diagnosed_campaign_pools_the_diagnosed_f_and_labels_both(tmp_path):
     tests = _tests(diagnosed=True)
     ca = analyse_tests(tests, tally_causes([]), seed=1)
     doc = _doc(ca)
-    assert doc["schema_version"] == SCHEMA_VERSION == 6
+    assert doc["schema_version"] == SCHEMA_VERSION == 7
     pf, ps = doc["pooled"]["f"], doc["pooled_stationary"]["f"]
     assert pf["basis"] == "diagnosed" and ps["basis"] == "stationary"
     assert doc["pooled"]["kappa"]["basis"] == "stationary"

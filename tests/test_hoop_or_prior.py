@@ -68,6 +68,7 @@ def test_a_hoop_gauge_off_its_scale_gives_f_from_both_readings(half_scale_hoop):
     said = [w for w in doc["warnings"] if w.startswith("The tube's hoop gauge and the prior file disagree")]
     assert len(said) == 1 and not any(w.startswith("The prior file and the data disagree") for w in doc["warnings"])
     assert f"from {f['q05']:.4g} to {f['q95']:.4g} (90 %)" in said[0]
+    assert doc["warning_kinds"][doc["warnings"].index(said[0])] == "hoop_or_prior"
 
 
 def test_the_headline_of_two_readings_gives_each_and_no_median_between_them():
@@ -87,7 +88,7 @@ def test_the_campaign_pools_the_f_the_run_quotes(half_scale_hoop):
     doc, nc = half_scale_hoop
     with h5py.File(nc) as h:
         assert h[HOOP_OR_PRIOR_GROUP]["f"].shape[0] > 0
-    r = SimpleNamespace(outputs={"netcdf": nc.name}, label="A-03", campaign="A", window_halves=None, warnings=[],
+    r = SimpleNamespace(outputs={"netcdf": nc.name}, label="A-03", campaign="A", window_halves=None, warnings=[], warning_kinds=[],
                         prior_file=doc["prior_file"], summary={"V": doc["V"]}, path=str(nc))
     post = read_test_posterior(r, nc.parent)
     assert np.quantile(post.f, 0.05) < doc["hoop_or_prior"]["f_prior_nu_alone"]["q50"]
@@ -195,7 +196,7 @@ def test_run_diagnose_on_a_hoop_gauge_at_half_its_scale_quotes_both_readings(tmp
     assert f["q05"] < hp["f_prior_nu_alone"]["q50"] and truth[0] < f["q05"] and f["q95"] < truth[1]
     said = [w for w in doc["warnings"] if w.startswith("The tube's hoop gauge and the prior file disagree")]
     assert len(said) == 1 and f"from {f['q05']:.4g} to {f['q95']:.4g} (90 %)" in said[0]
-    assert doc["schema_version"] == 11
+    assert doc["schema_version"] == 12
 
 
 def test_a_diagnosed_campaign_pools_the_stationary_readings_of_a_test_whose_hoop_gauge_disagrees(tmp_path):
@@ -218,7 +219,7 @@ def test_a_diagnosed_campaign_pools_the_stationary_readings_of_a_test_whose_hoop
                                 f"/{HOOP_OR_PRIOR_GROUP}": xr.Dataset({k: (("draw",), v) for k, v in both.items()})})
     dt.attrs["discrepancy_final_group"] = "discrepancy_clearance"
     dt.to_netcdf(tmp_path / "A_A-03.nc", engine="h5netcdf")
-    r = SimpleNamespace(outputs={"netcdf": "A_A-03.nc"}, label="A A-03", campaign="A", window_halves=None, warnings=[],
+    r = SimpleNamespace(outputs={"netcdf": "A_A-03.nc"}, label="A A-03", campaign="A", window_halves=None, warnings=[], warning_kinds=[],
                         prior_file=prior, summary={"V": {"mean": 9.0, "sd": 0.1}}, path="A-03.h5")
     t = read_test_posterior(r, tmp_path)
     assert t.hoop_disagrees and set(np.unique(t.f_model)) == {0.045, 0.09}

@@ -50,7 +50,9 @@ def test_stick_slip_f_is_eq17_of_the_window_means_and_holds_the_truth(tmp_path):
     assert f.q05 <= truth <= f.q95
     assert any("not stationary" in w for w in res.warnings)
     doc = json.loads(res.outputs["json"].read_text())
-    assert list(doc)[:4] == ["schema", "schema_version", "warnings", "f"] and doc["warnings"] == list(res.warnings)
+    assert list(doc)[:5] == ["schema", "schema_version", "warnings", "warning_kinds", "f"]
+    assert doc["warnings"] == list(res.warnings) and doc["warning_kinds"] == list(res.warning_kinds)
+    assert [k for k, w in zip(res.warning_kinds, res.warnings) if "not stationary" in w] == ["stationarity"]
     # no diagnosis: the f to quote is the stationary f, with the output bars' calibration folded in
     assert doc["f"]["model"] == "stationary"
     assert doc["f"]["given_bar_headers"]["q50"] == doc["f_stationary"]["q50"] == f.q50

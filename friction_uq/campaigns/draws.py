@@ -53,8 +53,9 @@ class RecordPosterior:
     #: the run found the hoop gauge and nu's prior in disagreement (friction_uq.hoop_or_prior): its nu is not a
     #: witness of the campaign's nu
     hoop_disagrees: bool = False
-    #: the run's warnings (its JSON's), each a sentence
+    #: the run's warnings (its JSON's), each a sentence, and each one's kind (none from a result without them)
     warnings: tuple[str, ...] = ()
+    warning_kinds: tuple[str, ...] = ()
 
 
 def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
@@ -95,7 +96,7 @@ def read_test_posterior(r: RecordResult, records_dir: Path) -> RecordPosterior:
                               "not finite at some draws (a draw where its prior has no density cannot be pooled)")
     return RecordPosterior(r.label, str(r.campaign), draws["f"], draws["kappa"], draws["nu"], draws["p_mean"],
                            r.summary["V"], str(r.prior_file), f_model, f_log_prior,
-                           halves, both, tuple(r.warnings))
+                           halves, both, tuple(r.warnings), tuple(r.warning_kinds))
 
 
 def _both_readings(group) -> dict[str, np.ndarray]:

@@ -13,7 +13,7 @@ up to date (same record sha256, same settings, same prior file checksum, same pa
 outputs present and holding the bytes the run JSON names) is not analysed again: the job returns
 the stored result with ``status = "skipped"``; one that cannot be read is analysed again.
 
-Schema version 3 (``schema = "friction-uq/campaign-record"``): ``path``, ``status``
+Schema version 4 (``schema = "friction-uq/campaign-record"``): ``path``, ``status``
 (``done`` | ``skipped`` | ``failed``), ``message``, ``campaign`` (the set-up), ``test_id``,
 ``material``, ``record_sha256``, ``prior_file``, ``prior_sha256``, ``friction_uq_version``,
 ``settings`` (seed, dispersion, hoop, pdf), ``outputs`` (file names in the same folder),
@@ -23,8 +23,9 @@ Schema version 3 (``schema = "friction-uq/campaign-record"``): ``path``, ``statu
 when no diagnosis was made); the campaign tallies them per set-up; ``window_halves``: kappa's change across the
 stationary window as the run JSON gives it (:mod:`friction_uq.window_halves`; null where it could not be read),
 which the campaign's slip law reads; ``warnings``: the run's warnings, as its JSON gives them (the campaign lists
-the tests that have any and pools f without them beside the pooled f). Versions 1 and 2 had no ``window_halves``
-or no ``warnings``: such a stored result is not read back, so its record is analysed again.
+the tests that have any and pools f without them beside the pooled f); ``warning_kinds``: each warning's kind, as
+the run JSON gives them (schema 4). Versions 1 to 3 had no ``window_halves``, no ``warnings`` or no
+``warning_kinds``: such a stored result is not read back, so its record is analysed again.
 """
 
 from __future__ import annotations
@@ -47,7 +48,7 @@ from ..errors import FrictionUQError, LockedError
 from ..window_halves import WindowHalves
 
 SCHEMA = "friction-uq/campaign-record"
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 SUMMARY_VARIABLES = ("f", "kappa", "nu", "V", "p_mean")
 STATUSES = ("done", "skipped", "failed")
 #: Seconds a record waits for its lock in the campaign's folder: only a killed campaign's worker can hold it
@@ -102,6 +103,7 @@ class RecordResult:
     causes: list[str] | None = None
     window_halves: dict[str, Any] | None = None
     warnings: list[str] = field(default_factory=list)
+    warning_kinds: list[str] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -212,7 +214,8 @@ def _from_run_json(doc: dict[str, Any]) -> dict[str, Any]:
     change)."""
     return {"summary": _summary(doc), "converged": bool(doc.get("converged")),
             "causes": [c["name"] for c in doc["discrepancy"]["causes"]] if "discrepancy" in doc else None,
-            "window_halves": doc.get("window_halves"), "warnings": [str(w) for w in doc["warnings"]]}
+            "window_halves": doc.get("window_halves"), "warnings": [str(w) for w in doc["warnings"]],
+            "warning_kinds": [str(k) for k in doc["warning_kinds"]]}
 
 
 def _summary(doc: dict[str, Any]) -> dict[str, dict[str, float]]:

@@ -1,19 +1,20 @@
 """The campaign's outputs: ``campaign.json`` (schema below), ``campaign.nc`` and the text summary.
 
-``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 6``; version 5 had no record's
-``warnings`` nor ``pooled_without_warned``; version 1 had no weights, and its
+``campaign.json`` (``schema = "friction-uq/campaign"``, ``schema_version = 7``; version 6 had no record's
+``warning_kinds``, and counted a misfit whose causes ``diagnose`` named as a warning against the pooled diagnosed f;
+version 5 had no record's ``warnings`` nor ``pooled_without_warned``; version 1 had no weights, and its
 set-up offsets were free; version 2 pooled the stationary f whatever the records carried, and had no ``basis``
 nor ``pooled_stationary``; version 3's pressure law was a straight line in p, its parameters ``f_ref`` and
 ``c_per_p_ref``; version 4 had no slip law, and its ELPDs were of the tests' levels alone, without each
 test's change across its window, so they are not comparable with version 5's): ``records`` (each
 record's path, set-up, test id, ``status`` done | skipped | failed, the refusal ``message``,
-seconds, the ``causes`` its diagnosis named or null, the run's ``warnings``), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
+seconds, the ``causes`` its diagnosis named or null, the run's ``warnings`` and their ``warning_kinds``), ``counts``, ``pooled`` (``f`` and ``kappa``: population mean ``mu`` and between-test
 scatter ``sigma`` with 90 % intervals, each test's effective sample size, the Monte Carlo variance
 of the hyper-log-likelihood, or ``refused`` with the reason; ``basis``: ``diagnosed`` when f is f under each
 test's diagnosed model (every test diagnosed), its prior on f_effective divided out, else ``stationary``),
 ``pooled_stationary`` (``f`` of the stationary analysis, as in ``pooled``, when ``pooled.f`` is the diagnosed f;
-else empty), ``pooled_without_warned`` (``f`` pooled as ``pooled.f`` from the tests whose runs gave no warning,
-or null when none did: :mod:`.warned`), ``friction_law`` (``best``: the law that
+else empty), ``pooled_without_warned`` (``f`` pooled as ``pooled.f`` from the tests whose runs gave no warning
+that ``pooled.f`` leaves open, or null when none did: :mod:`.warned`), ``friction_law`` (``best``: the law that
 carries the stacking weight (one of constant, velocity, pressure, slip, pressure+velocity) or null;
 ``chosen_model``; ``weights``: each law's stacking weight; ``supported``: the fewest laws carrying 90 %
 of it; ``ranking``: every model with ELPD, dELPD and its SE against the top, and its weight;
@@ -50,7 +51,7 @@ from .job import RecordResult
 from .warned import warned_statement
 
 SCHEMA = "friction-uq/campaign"
-SCHEMA_VERSION = 6
+SCHEMA_VERSION = 7
 
 
 #: The law parameters' meanings and units, as the JSON's ``friction_law.meanings`` and the sentences give them.
@@ -134,7 +135,7 @@ def statements(ca: CampaignAnalysis) -> list[str]:
                        f"[{p.sigma['q05']:.2g}, {p.sigma['q95']:.2g}] (90 %; {len(p.tests)} tests, smallest ESS "
                        f"{min(p.ess.values()):.0f}, Monte Carlo variance of the pooled log-likelihood "
                        f"{p.mc_variance:.2g})")
-    if said := warned_statement(ca.tests, ca.pooled_without_warned):
+    if said := warned_statement(ca.tests, ca.pooled.get("f"), ca.pooled_without_warned):
         out.append(said)
     return out
 
@@ -147,7 +148,8 @@ def campaign_doc(results: Sequence[RecordResult], ca: CampaignAnalysis | None, *
         "settings": settings, "counts": counts,
         "records": [{"path": r.path, "campaign": r.campaign, "test_id": r.test_id, "status": r.status,
                      "message": r.message, "seconds": r.seconds, "converged": r.converged, "notes": r.notes,
-                     "causes": r.causes, "warnings": r.warnings}
+                     "causes": r.causes, "warnings": r.warnings,
+                     "warning_kinds": r.warning_kinds}
                     for r in results],
     }
     if ca is None:

@@ -35,7 +35,7 @@ from .alongside import alongside, whole_record_start
 from .outputs import netcdf_bytes, summary_table
 from .run_document import run_document
 from .steps import RunSetup, StationaryPosterior, set_up, stationary_posterior
-from .warnings import run_warnings
+from .warnings import RunWarning, run_warnings
 
 @dataclass(frozen=True)
 class RunResult:
@@ -53,6 +53,7 @@ class RunResult:
     whole_record: WholeRecordCheck | None = None
     diagnosis: object | None = None  # friction_uq.discrepancy.diagnose.Diagnosis
     warnings: tuple[str, ...] = ()  # the checks that failed (friction_uq.record_run.warnings); empty when all pass
+    warning_kinds: tuple[str, ...] = ()  # each warning's kind (friction_uq.record_run.warnings.WARNING_KINDS)
 
 
 def run_file(
@@ -113,19 +114,20 @@ def run_file(
         wrc, record_part = side_job.result() if check else (None, None)
         diag = _record_check(s, post, wrc, diagnose=diagnose, seed=seed, say=voice.say) if wrc is not None else None
         stages["whole_record"] = time.perf_counter() - t
-        warns = _warnings(s, post, wrc, diag)
+        found = _warnings(s, post, wrc, diag)
+        warns, kinds = [w.text for w in found], [w.kind for w in found]
         _complete_datatree(post, s, seed)  # the DataTree is complete: nothing below changes it
         if inputs is not None:
             inputs = dataclasses.replace(inputs, whole_record=wrc, diagnosis=diag, warnings=tuple(warns))
         doc, pdf_bytes, seconds = _write_outputs(s, post, inputs, (record_part, posterior_part), wrc=wrc, diag=diag,
-                                                 warns=warns, notes=voice.said, seed=seed, dispersion=dispersion,
+                                                 warns=warns, kinds=kinds, notes=voice.said, seed=seed, dispersion=dispersion,
                                                  stages=stages, t_start=t_start)
         backend.unlink(missing_ok=True)
     outputs = {k: p for k, p in s.names.items() if k != "pdf" or pdf_bytes is not None}
     if table:
         _print_summary(s, post, wrc, diag, doc, warns, outputs, seconds, page=pdf_bytes is not None)
     return RunResult(s.prepared, post.samples, post.summary, post.convergence, s.lab, outputs, seconds, post.conflict,
-                     tuple(voice.said), stages, post.sensitivity, wrc, diag, tuple(warns))
+                     tuple(voice.said), stages, post.sensitivity, wrc, diag, tuple(warns), tuple(kinds))
 
 
 class _Voice:
@@ -171,7 +173,8 @@ def _announce(s: RunSetup, voice: _Voice, *, check: bool, alongside: bool) -> No
 
 
 def _write_outputs(s: RunSetup, post: StationaryPosterior, inputs: object | None, parts: tuple, *,
-                   wrc: WholeRecordCheck | None, diag: object | None, warns: list[str], notes: list[str], seed: int,
+                   wrc: WholeRecordCheck | None, diag: object | None, warns: list[str], kinds: list[str],
+                   notes: list[str], seed: int,
                    dispersion: bool, stages: dict[str, float], t_start: float) -> tuple[dict, bytes | None, float]:
     """The netCDF (on the other core, its writer loads dask and xarray's backends, ~0.6 s; in line where this
     process may not fork) while this one draws the report's last pages (``inputs`` None: no PDF); then the JSON,
@@ -188,7 +191,7 @@ def _write_outputs(s: RunSetup, post: StationaryPosterior, inputs: object | None
         t = time.perf_counter()
         nc_bytes = nc_job.result()
     seconds = time.perf_counter() - t_start
-    doc = run_document(s, post, seed=seed, seconds=seconds, warns=warns, notes=notes, wrc=wrc, diag=diag,
+    doc = run_document(s, post, seed=seed, seconds=seconds, warns=warns, kinds=kinds, notes=notes, wrc=wrc, diag=diag,
                        dispersion=dispersion, nc_bytes=nc_bytes, pdf_bytes=pdf_bytes)
     js_bytes = json_text(doc).encode()
     write_together({s.names["netcdf"]: nc_bytes, s.names["pdf"]: pdf_bytes, s.names["json"]: js_bytes},
@@ -207,8 +210,9 @@ def _posterior_pages(s: RunSetup, post: StationaryPosterior) -> tuple[object, by
     return inputs, render_posterior_part(inputs)
 
 
-def _warnings(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck | None, diag: object | None) -> list[str]:
-    """The checks that failed, one sentence each (:mod:`.warnings`)."""
+def _warnings(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck | None,
+              diag: object | None) -> list[RunWarning]:
+    """The checks that failed, one sentence each with its kind (:mod:`.warnings`)."""
     lik = s.likelihood
     levels = lik.force if isinstance(lik.force, LevelForceTerm) else LevelForceTerm(s.prepared.data)
     return run_warnings(ppc=post.ppc, excess_spread=levels.excess_spread(), dof=levels.dof, f=post.f_read,

@@ -19,11 +19,12 @@ def _summary_json(v: VariableSummary) -> dict[str, float]:
 
 
 def run_document(s: RunSetup, post: StationaryPosterior, *, seed: int, seconds: float, warns: list[str],
-                 notes: list[str], wrc: WholeRecordCheck | None, diag: object | None, dispersion: bool,
+                 kinds: list[str], notes: list[str], wrc: WholeRecordCheck | None, diag: object | None, dispersion: bool,
                  nc_bytes: bytes, pdf_bytes: bytes | None) -> dict[str, object]:
     """The run's JSON (docs/outputs.md)."""
     summary, conv = post.summary, post.convergence
     doc: dict[str, object] = {"schema": RUN_SCHEMA, "schema_version": RUN_SCHEMA_VERSION, "warnings": warns,
+                              "warning_kinds": kinds,
                               "f": quoted_f(post.f_quoted, post.f_read.to_json(), diag, hoop=post.samples.hoop,
                                             both=None if post.hoop_or_prior is None else post.hoop_or_prior.medians)}
     allv = dict(summary) | {"V": post.V}

@@ -24,6 +24,7 @@ Checks and their limits (``docs/trust.md`` gives the calibration):
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from scipy import stats
 
@@ -231,23 +232,45 @@ def conflict_warning(conflict: PriorDataConflict | None, hoop_or_prior: HoopOrPr
             "quote it with f under the other nu priors (the report's nu page).")
 
 
+#: Each warning's kind (the run JSON's ``warning_kinds``), in the order :func:`run_warnings` gives them. A misfit is
+#: "misfit_diagnosed" when ``diagnose`` named its causes and f is quoted under them (with the rivals the record leaves
+#: open), "misfit" otherwise.
+WARNING_KINDS = ("flat_run", "gauge", "striker_speed", "hoop_silent", "stationarity", "misfit", "misfit_diagnosed",
+                 "convergence", "exact_posterior", "hoop_or_prior", "prior_conflict")
+
+
+@dataclass(frozen=True)
+class RunWarning:
+    """One warning: its kind (:data:`WARNING_KINDS`) and its sentence."""
+
+    kind: str
+    text: str
+
+
+def misfit_kind(diagnosis) -> str:
+    """A misfit's kind: "misfit_diagnosed" when ``diagnose`` named causes (f is then quoted under them), else
+    "misfit" (not diagnosed, or no cause named: f is the stationary analysis' or the candidates' mixture's)."""
+    return "misfit_diagnosed" if diagnosis is not None and diagnosis.causes else "misfit"
+
+
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
                  conv: Convergence, conflict: PriorDataConflict | None,
                  check: WholeRecordCheck | None, findings: Sequence[GaugeFinding] = (),
-                 diagnosis=None, hoop_silent: str | None = None, hoop_or_prior: HoopOrPrior | None = None) -> list[str]:
-    """Every check's warning, in the order a reader should see them; empty when all pass. ``findings``: the gauge
-    checks' (:attr:`friction_uq.analysis.Prepared.findings`), told apart by kind."""
+                 diagnosis=None, hoop_silent: str | None = None,
+                 hoop_or_prior: HoopOrPrior | None = None) -> list[RunWarning]:
+    """Every check's warning with its kind, in the order a reader should see them; empty when all pass.
+    ``findings``: the gauge checks' (:attr:`friction_uq.analysis.Prepared.findings`), told apart by kind."""
     flat = [g.sentence for g in findings if g.kind == "flat"]
     speed = [g.sentence for g in findings if g.kind == "striker"]
     gauges = [g for g in findings if g.kind not in ("flat", "striker")]
-    found: Sequence[str | None] = (
-        flat_run_warning(flat, f), gauge_warning(gauges, f) or equilibrium_warning(lab, f),
-        speed_warning(speed), hoop_silence_warning(hoop_silent, f),
-        stationarity_warning(ppc, excess_spread, dof, f, lab),
-        misfit_warning(check, f, diagnosis),
-        convergence_warning(conv), exact_posterior_warning(diagnosis),
-        None if hoop_or_prior is None else hoop_or_prior.sentence(
-            diagnosed=headline(diagnosis)[1] if f_from_diagnosis(diagnosis) else None),
-        conflict_warning(conflict, hoop_or_prior),
+    found: Sequence[tuple[str, str | None]] = (
+        ("flat_run", flat_run_warning(flat, f)), ("gauge", gauge_warning(gauges, f) or equilibrium_warning(lab, f)),
+        ("striker_speed", speed_warning(speed)), ("hoop_silent", hoop_silence_warning(hoop_silent, f)),
+        ("stationarity", stationarity_warning(ppc, excess_spread, dof, f, lab)),
+        (misfit_kind(diagnosis), misfit_warning(check, f, diagnosis)),
+        ("convergence", convergence_warning(conv)), ("exact_posterior", exact_posterior_warning(diagnosis)),
+        ("hoop_or_prior", None if hoop_or_prior is None else hoop_or_prior.sentence(
+            diagnosed=headline(diagnosis)[1] if f_from_diagnosis(diagnosis) else None)),
+        ("prior_conflict", conflict_warning(conflict, hoop_or_prior)),
     )
-    return [w for w in found if w]
+    return [RunWarning(kind, text) for kind, text in found if text]
