@@ -55,6 +55,12 @@ class Result:
         return list(self.doc.get("warnings", []))
 
     @property
+    def warning_kinds(self) -> list[str]:
+        """Each warning's kind, in the same order (``misfit``, ``misfit_diagnosed``, ``gauge``, ...: docs/outputs.md);
+        empty for a JSON of schema version 11 or older, which did not write them."""
+        return list(self.doc.get("warning_kinds", []))
+
+    @property
     def test_id(self) -> str:
         return str(self.doc.get("test_id", ""))
 

@@ -45,6 +45,7 @@ def test_read_result_reads_the_json_and_refuses_others(tmp_path):
     (tmp_path / "A_A-03.json").write_text(json.dumps(doc))
     res = fu.read_result(tmp_path / "A_A-03.nc")  # the stem, the .nc or the .json
     assert res.f["q50"] == 0.05 and res.warnings == ["w"] and res.test_id == "A-03"
+    assert res.warning_kinds == []  # schema 3 wrote none
     with pytest.raises(FrictionUQError, match=r"A_A-03.json: its netCDF file .* is missing"):
         res.datatree()
     (tmp_path / "A_A-03.nc").write_bytes(b"not a netCDF file")
