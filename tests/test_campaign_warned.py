@@ -111,7 +111,31 @@ def test_a_misfits_kind_says_whether_diagnose_named_its_causes():
 
     from friction_uq.record_run.warnings import WARNING_KINDS, misfit_kind
 
+    def dg(causes=(), mixture_of=None):
+        final = SimpleNamespace(label="baseline+clearance")
+        return SimpleNamespace(causes=causes, mixture_of=mixture_of, mixture_f=None if mixture_of is None else Z,
+                               mixture_weights={"baseline+clearance": 0.5, "baseline+clearance+dispersion": 0.5},
+                               final=final, rounds=[[]])
+
     assert misfit_kind(None) == "misfit"  # not diagnosed
-    assert misfit_kind(SimpleNamespace(causes=())) == "misfit"  # unexplained, candidates or none: nothing named
-    assert misfit_kind(SimpleNamespace(causes=("clearance",))) == "misfit_diagnosed"
-    assert {"misfit", "misfit_diagnosed"} <= set(WARNING_KINDS)
+    assert misfit_kind(dg()) == "misfit"  # unexplained or none: nothing named
+    assert misfit_kind(dg(("clearance",))) == "misfit_diagnosed"  # "f under them ... is the f to quote"
+    # f from a stacking mixture, "quote that, with this warning": a candidate fitted in turn whose rivals stay
+    # open, a cause named beside open rivals or beside further causes the record leans to
+    for mixed in ("candidates", "rivals", "further", "superfluous"):
+        assert misfit_kind(dg(("clearance",), mixed)) == "misfit", mixed
+    assert {"misfit", "misfit_diagnosed", "gauge", "gauge_unchecked", "equilibrium"} <= set(WARNING_KINDS)
+
+
+def test_the_tests_spared_are_said_even_when_no_other_test_warned_and_counts_say_of_how_many():
+    misfit = ["The simulated test misses ... `diagnose` names clearance: f under them is ..."]
+    tests = [_test("A A-01", 0.05, diagnosed=0.05), _test("A A-02", 0.05, diagnosed=0.05),
+             _test("A A-03", 0.05, misfit, ["misfit_diagnosed"], diagnosed=0.05)]
+    ca = analyse_tests(tests, tally_causes([]), seed=1)
+    assert ca.pooled_without_warned is None
+    said = warned_statement(tests, ca.pooled["f"], None)
+    assert said == ("1 test (A A-03) warned only of a misfit whose causes `diagnose` named, and its f under them is "
+                    "what is pooled; no other test's run warned")
+    tests[1] = _test("A A-02", 0.05, misfit + ["The force ratio is not stationary ..."],
+                     ["misfit_diagnosed", "stationarity"], diagnosed=0.05)
+    assert "(how many warnings: A A-02 (1 of 2);" in warned_statement(tests, ca.pooled["f"], None)

@@ -16,7 +16,8 @@ from scipy.signal import lfilter
 from friction_uq.analysis import RATIO_WINDOW_NOTE, identify, prepare
 from friction_uq.force_noise import COLOUR_CEILING, MeanForces, colour_upper, mean_forces, wave_mean_sd
 from friction_uq.diagnostics import VariableSummary
-from friction_uq.gauge_balance import NOISE_CANNOT_TELL, NOISE_SIGMAS, GaugeFinding, balance_departure, loading_mask
+from friction_uq.gauge_balance import (NOISE_CANNOT_TELL, NOISE_SIGMAS, GaugeFinding, balance_departure, loading_mask,
+                                       one_gauge_alone)
 from friction_uq.gauge_check import record_gauge_check
 from friction_uq.record_run.warnings import equilibrium_warning, gauge_warning
 from friction_uq.record import read_record
@@ -140,7 +141,6 @@ def test_a_window_found_from_the_ratio_alone_blames_no_gauge_when_none_is() -> N
 def test_a_balance_off_says_what_each_gauge_alone_would_read_and_make_of_f() -> None:
     """The external output force is a tenth of the input force: its gauge at twice its scale puts the balance 10 %
     high, which was said "a gain off by about 10 %" beside f twice the truth. Each gauge's share is said, with f."""
-    from friction_uq.gauge_balance import one_gauge_alone
 
     said = one_gauge_alone(MeanForces(1000.0, 900.0, 200.0, 5.0, 5.0, 5.0))  # the external reading 2 x its 100 N
     assert "the input gauge reading 0.91 times what it carries (f as it is)" in said
@@ -165,14 +165,35 @@ def test_a_balance_off_says_each_gauges_share_over_the_window(tmp_path) -> None:
         fh["signals/external_output_bar"][...] = fh["signals/external_output_bar"][...] * 2.0
     prepared = prepare(read_record(path))
     said = [g.sentence for g in prepared.findings if g.kind == "balance"]
-    assert len(said) == 1 and "over the stationary window it is" in said[0]
     means = mean_forces(prepared.forces, prepared.record.apparatus, prepared.window.slice)
+    assert len(said) == 1 and f"over the stationary window, where they sum to {means.balance * 100:.0f} %, it is" in said[0]
     gain = means.F_eo / (means.F_i - means.F_io)
     assert abs(gain / 2.0 - 1.0) <= 0.005 / (0.5 * means.F_eo / means.F_i)
     assert f"or the external output gauge {gain:.2g} times" in said[0]
     moved = float(said[0].split("the true f ")[-1].split(" times")[0])
     r = means.F_eo / means.F_io
     assert moved == pytest.approx(math.log1p(r / 2.0) / math.log1p(r), abs=0.02)
+
+
+def test_a_balance_off_over_the_loading_alone_keeps_the_loadings_shares(tmp_path) -> None:
+    """A-03 with its internal gauge read 200 samples late (a reviewer's case): over the loading the forces sum to 92 %,
+    over the stationary window to 100 %, which no gain leaves. The window's shares were each gauge at 1 times; the
+    loading's are said, with the window's sum, as are the window's own where the window departs the other way."""
+    path = tmp_path / "late.h5"
+    shutil.copyfile(A03, path)
+    with h5py.File(path, "r+") as fh:
+        fh["signals/internal_output_bar"][...] = np.roll(fh["signals/internal_output_bar"][()], 200)
+    prepared = prepare(read_record(path))
+    said = [g.sentence for g in prepared.findings if g.kind == "balance"]
+    assert len(said) == 1 and "which a gain would not leave" in said[0] and "so over the loading it is" in said[0]
+    from friction_uq.gauge_balance import balance_sentence
+
+    loading = MeanForces(1000.0, 800.0, 100.0, 5.0, 5.0, 5.0)  # 90 %
+    assert "over the stationary window, where they sum to 88 %" in balance_sentence(
+        loading, MeanForces(1000.0, 780.0, 100.0, 5.0, 5.0, 5.0))
+    other_way = balance_sentence(loading, MeanForces(1000.0, 980.0, 100.0, 5.0, 5.0, 5.0))  # 108 %: not the same
+    assert "over the stationary window they sum to 108 %" in other_way and other_way.endswith(
+        "over the loading it is " + one_gauge_alone(loading))
 
 
 @pytest.mark.parametrize(("means", "said"), [

@@ -44,29 +44,39 @@ def pooled_without_warned(tests: Sequence[RecordPosterior], pooled_f: Pooled | N
     reason)."""
     if pooled_f is None or not (marked := warned(tests, pooled_f.basis)):
         return None
-    kept = [t for t in tests if t not in marked]
+    left_out = {id(t) for t in marked}
+    kept = [t for t in tests if id(t) not in left_out]
     return pool(f_draws(kept, pooled_f.basis), "f", basis=pooled_f.basis)
 
 
 def _spared(tests: Sequence[RecordPosterior], basis: str) -> str:
-    """'; N tests warned only of a misfit whose causes diagnose named ...', or ''."""
+    """'N tests (...) warned only of a misfit whose causes `diagnose` named ...', or ''."""
     spared = [t for t in tests if t.warnings and not open_warnings(t, basis)]
     if not spared:
         return ""
     many = len(spared) > 1
-    return (f"; {len(spared)} {'tests' if many else 'test'} ({', '.join(t.label for t in spared)}) warned only of a "
+    return (f"{len(spared)} {'tests' if many else 'test'} ({', '.join(t.label for t in spared)}) warned only of a "
             f"misfit whose causes `diagnose` named, and {'their' if many else 'its'} f under them is what is pooled")
 
 
+def _count(t: RecordPosterior, basis: str) -> str:
+    """A warned test as the statement lists it: its open warnings' count, 'of' all its warnings where some are
+    answered."""
+    n, total = len(open_warnings(t, basis)), len(t.warnings)
+    return f"{t.label} ({n})" if n == total else f"{t.label} ({n} of {total})"
+
+
 def warned_statement(tests: Sequence[RecordPosterior], pooled_f: Pooled | None, without: Pooled | None) -> str | None:
-    """'tests whose runs warned (how many warnings): A A-03 (2), B B-02 (1) ...; pooled f without them: ...'; None
-    when no run warned of anything the pooled f's basis leaves open."""
+    """'tests whose runs warned (how many warnings): A A-03 (2), B B-02 (1 of 2) ...; pooled f without them: ...'
+    (where a test's misfit is answered by the diagnosed f pooled, its count is of the others, 'of' all its warnings);
+    the tests spared alone where only those warned; None when no run warned."""
     basis = pooled_f.basis if pooled_f is not None else "stationary"
     marked = warned(tests, basis)
+    spared = _spared(tests, basis)
     if not marked:
-        return None
-    listed = ", ".join(f"{t.label} ({len(open_warnings(t, basis))})" for t in marked)
-    why = "each run's JSON and report say why; the campaign's JSON lists them" + _spared(tests, basis)
+        return f"{spared}; no other test's run warned" if spared else None
+    listed = ", ".join(_count(t, basis) for t in marked)
+    why = "each run's JSON and report say why; the campaign's JSON lists them" + (f"; {spared}" if spared else "")
     if len(marked) == len(tests):
         return (f"every test's run warned (how many warnings: {listed}; {why}): the pooled f rests on warned tests "
                 "alone")

@@ -232,11 +232,12 @@ def conflict_warning(conflict: PriorDataConflict | None, hoop_or_prior: HoopOrPr
             "quote it with f under the other nu priors (the report's nu page).")
 
 
-#: Each warning's kind (the run JSON's ``warning_kinds``), in the order :func:`run_warnings` gives them. A misfit is
-#: "misfit_diagnosed" when ``diagnose`` named its causes and f is quoted under them (with the rivals the record leaves
-#: open), "misfit" otherwise.
-WARNING_KINDS = ("flat_run", "gauge", "striker_speed", "hoop_silent", "stationarity", "misfit", "misfit_diagnosed",
-                 "convergence", "exact_posterior", "hoop_or_prior", "prior_conflict")
+#: Each warning's kind (the run JSON's ``warning_kinds``), in the order :func:`run_warnings` gives them: "gauge" (the
+#: balance or a channel's scale blames a gauge), "gauge_unchecked" (a balance off that the gauges' noise could make),
+#: "equilibrium" (the window's balance, where the loading's passed); a misfit is "misfit_diagnosed" when ``diagnose``
+#: named its causes and f under them is the f to quote (:func:`misfit_kind`), "misfit" otherwise.
+WARNING_KINDS = ("flat_run", "gauge", "gauge_unchecked", "equilibrium", "striker_speed", "hoop_silent", "stationarity",
+                 "misfit", "misfit_diagnosed", "convergence", "exact_posterior", "hoop_or_prior", "prior_conflict")
 
 
 @dataclass(frozen=True)
@@ -248,9 +249,20 @@ class RunWarning:
 
 
 def misfit_kind(diagnosis) -> str:
-    """A misfit's kind: "misfit_diagnosed" when ``diagnose`` named causes (f is then quoted under them), else
-    "misfit" (not diagnosed, or no cause named: f is the stationary analysis' or the candidates' mixture's)."""
-    return "misfit_diagnosed" if diagnosis is not None and diagnosis.causes else "misfit"
+    """A misfit's kind: "misfit_diagnosed" where the warning says f under the causes ``diagnose`` named is the f to
+    quote (:func:`_next_step`'s last case: causes in the model, no stacking mixture of rivals or further causes),
+    else "misfit" (not diagnosed; no cause named; or f from a mixture, to be quoted with the warning)."""
+    answered = diagnosis is not None and diagnosis.causes and not further(diagnosis) and diagnosis.mixture_f is None
+    return "misfit_diagnosed" if answered else "misfit"
+
+
+def _gauge_kind(gauges: Sequence[GaugeFinding], lab: Identification, f: VariableSummary) -> tuple[str, str | None]:
+    """The gauge check's warning over the loading with its kind, or else the window's balance (eq. 5)."""
+    said = gauge_warning(gauges, f)
+    if said is None:
+        return "equilibrium", equilibrium_warning(lab, f)
+    found = [g for g in gauges if g.kind != "window"]
+    return ("gauge_unchecked" if found and all(g.kind == "unchecked" for g in found) else "gauge"), said
 
 
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
@@ -264,7 +276,7 @@ def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSu
     speed = [g.sentence for g in findings if g.kind == "striker"]
     gauges = [g for g in findings if g.kind not in ("flat", "striker")]
     found: Sequence[tuple[str, str | None]] = (
-        ("flat_run", flat_run_warning(flat, f)), ("gauge", gauge_warning(gauges, f) or equilibrium_warning(lab, f)),
+        ("flat_run", flat_run_warning(flat, f)), _gauge_kind(gauges, lab, f),
         ("striker_speed", speed_warning(speed)), ("hoop_silent", hoop_silence_warning(hoop_silent, f)),
         ("stationarity", stationarity_warning(ppc, excess_spread, dof, f, lab)),
         (misfit_kind(diagnosis), misfit_warning(check, f, diagnosis)),
