@@ -150,7 +150,7 @@ def attributed_over_window(findings: Sequence[GaugeFinding], forces: Forces, app
                            window: slice) -> tuple[GaugeFinding, ...]:
     """``findings`` with a balance finding's shares read over the stationary window, where it is out of balance the
     same way (:func:`balance_sentence`). Over the loading the sample's and the plug's inertia take 1-2 % of the input
-    force on a sound record (its sum 98.4-99.9 % on the bundled 1-D records, 98.9-100.3 % on 20 clean records of
+    force on a sound record (its sum 98.4-99.9 % on the bundled 1-D records, 99.0-100.3 % on 20 clean records of
     the axisymmetric and perturbed 1-D simulations), over the window less than 1 % (99.2-100.4 %). The external
     output force is a tenth of the input force, so that percent is a tenth of its gauge's factor, and of f: eq. 17
     reads the window."""

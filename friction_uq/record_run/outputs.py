@@ -55,7 +55,7 @@ def reproducible(dt):
 
 
 #: The run's JSON: its schema name and version (12: ``warning_kinds``, each warning's kind beside it, a misfit
-#: ``misfit_diagnosed`` where ``diagnose`` named its causes; 11: a diagnosed ``f`` holds, where the hoop gauge and nu's prior
+#: ``misfit_diagnosed`` where f under the causes ``diagnose`` named is the f to quote; 11: a diagnosed ``f`` holds, where the hoop gauge and nu's prior
 #: disagree, the diagnosed f and the stationary f from nu's prior alone in equal parts, their medians in
 #: ``f.readings_of_nu``; 10: ``hoop_or_prior``, f with the hoop gauge and from nu's prior
 #: alone when the two disagree, ``f`` then the two in equal parts; 9: ``discrepancy.shared_delay``, the delay on one gauge the candidates
