@@ -97,7 +97,7 @@ def test_a_diagnosed_campaign_counts_a_misfit_whose_causes_were_named_as_answere
     assert ca.pooled_without_warned.tests == ["A A-01", "A A-02", "A A-03"]
     said = [s for s in campaign_doc([], ca, seed=1, settings={})["statements"] if "warned" in s]
     assert len(said) == 1 and said[0].startswith("tests whose runs warned (how many warnings: A A-04 (1); "), said
-    assert "1 test (A A-03) warned only of a misfit whose causes `diagnose` named" in said[0]
+    assert "1 test (A A-03) warned only of a misfit whose causes diagnose named" in said[0]
     tests[2].hoop_disagrees = True  # its stationary readings are pooled, not f under the causes named
     assert [t.label for t in warned(tests, "diagnosed")] == ["A A-03", "A A-04"]
     stationary = [_test("A A-03", 0.04, misfit, ["misfit_diagnosed"])]  # a campaign without --diagnose's basis
@@ -134,7 +134,7 @@ def test_the_tests_spared_are_said_even_when_no_other_test_warned_and_counts_say
     ca = analyse_tests(tests, tally_causes([]), seed=1)
     assert ca.pooled_without_warned is None
     said = warned_statement(tests, ca.pooled["f"], None)
-    assert said == ("1 test (A A-03) warned only of a misfit whose causes `diagnose` named, and its f under them is "
+    assert said == ("1 test (A A-03) warned only of a misfit whose causes diagnose named, and its f under them is "
                     "what is pooled; no other test's run warned")
     tests[1] = _test("A A-02", 0.05, misfit + ["The force ratio is not stationary ..."],
                      ["misfit_diagnosed", "stationarity"], diagnosed=0.05)

@@ -50,13 +50,13 @@ def pooled_without_warned(tests: Sequence[RecordPosterior], pooled_f: Pooled | N
 
 
 def _spared(tests: Sequence[RecordPosterior], basis: str) -> str:
-    """'N tests (...) warned only of a misfit whose causes `diagnose` named ...', or ''."""
+    """'N tests (...) warned only of a misfit whose causes diagnose named ...', or ''."""
     spared = [t for t in tests if t.warnings and not open_warnings(t, basis)]
     if not spared:
         return ""
     many = len(spared) > 1
     return (f"{len(spared)} {'tests' if many else 'test'} ({', '.join(t.label for t in spared)}) warned only of a "
-            f"misfit whose causes `diagnose` named, and {'their' if many else 'its'} f under them is what is pooled")
+            f"misfit whose causes diagnose named, and {'their' if many else 'its'} f under them is what is pooled")
 
 
 def _count(t: RecordPosterior, basis: str) -> str:
