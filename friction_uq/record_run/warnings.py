@@ -159,6 +159,12 @@ def equilibrium_warning(lab: Identification, f: VariableSummary) -> str | None:
             "gauges' calibration (`friction-uq inspect`).")
 
 
+def _no_gauge_blamed(findings: Sequence[GaugeFinding]) -> bool:
+    """The gauge check found only balances the gauges' noise could make (kind "unchecked"), beside the window note."""
+    found = [g for g in findings if g.kind != "window"]
+    return bool(found) and all(g.kind == "unchecked" for g in found)
+
+
 def gauge_warning(findings: Sequence[GaugeFinding], f: VariableSummary) -> str | None:
     """What the gauge check found over the loading (:mod:`friction_uq.gauge_balance`): a gauge that disagrees, or a
     balance off by more than its tolerance that the gauges' noise could make (kind "unchecked": no gauge blamed);
@@ -166,8 +172,7 @@ def gauge_warning(findings: Sequence[GaugeFinding], f: VariableSummary) -> str |
     notes = [g.sentence for g in findings]
     if not notes:
         return None
-    found = [g for g in findings if g.kind != "window"]
-    if found and all(g.kind == "unchecked" for g in found):
+    if _no_gauge_blamed(findings):
         return (f"The force balance cannot check the gauges on this record: {'; '.join(notes)}. {_f_text(f)} rests "
                 "on the output gauges' ratio, whose gains it then leaves unchecked.")
     return (f"A gauge disagrees with the others: {'; '.join(notes)}. {_f_text(f)} rests on the output gauges' "
@@ -261,8 +266,7 @@ def _gauge_kind(gauges: Sequence[GaugeFinding], lab: Identification, f: Variable
     said = gauge_warning(gauges, f)
     if said is None:
         return "equilibrium", equilibrium_warning(lab, f)
-    found = [g for g in gauges if g.kind != "window"]
-    return ("gauge_unchecked" if found and all(g.kind == "unchecked" for g in found) else "gauge"), said
+    return ("gauge_unchecked" if _no_gauge_blamed(gauges) else "gauge"), said
 
 
 def run_warnings(*, ppc: RatioPPC, excess_spread: float, dof: int, f: VariableSummary, lab: Identification,
