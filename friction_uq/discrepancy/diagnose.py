@@ -15,6 +15,9 @@ each round's verdict with the naming rule of :mod:`.verdict`.
   explains by that rule is *unexplained*: the candidates are listed with their stacking weights and f is
   their mixture's; a mechanism that passes without such a misfit is *unconfirmed*: not named, f from the
   mixture of it and the reference;
+* a first round that no mechanism explains alone, whose two leading candidates explain it together, names both
+  (:mod:`.joint_round`): the first joins the model, and the next round must name the second by the rule, or the round
+  is read as unexplained after all;
 * after a named cause the search goes on with it in the model (the reference becomes baseline + cause),
   for at most four causes, so that a record with several effects gets them in order of evidence; it stops
   at the first round that names nothing. A later round whose reference the whole-record check no longer flags
@@ -46,6 +49,7 @@ from .block_loo import elpd_difference
 from .exact_model import exact_posterior
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .front_delay import round_shared_delay
+from .joint_round import admitted, confirms, joint_job, leads
 from .misfit import MisfitDecision, decide, misfit_detected
 from .record_likelihood import HOOP_GAIN_SD
 from .candidates_mixture import (Resolve, draw_mixture, further_members, mixture, open_rounds, rival_mixture,
@@ -234,27 +238,71 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
         fitted += len(jobs)
         ranked = rank(st.reference, fits, misfit=st.misfits[-1].detected)
         st.rounds.append(ranked)
-        verdict = NAMING.judge(st.reference, ranked, misfit=st.misfits[-1].detected, seed=seed + k, first=k == 0)
-        if verdict.named is not None and k == 0:
-            st.not_sep, st.other_channels, st.separate_by = separability(verdict)
-        if verdict.kind not in ("named", "candidates"):
+        verdict, best = _verdict(dg, st, ranked, k, max_causes=max_causes, seed=seed, say=say)
+        pair_of = st.verdicts[-1].joint if k > 0 else None
+        if pair_of is not None and not confirms(verdict, ranked, pair_of.partner):
+            say(f"round {k + 1}: {pair_of.partner} not named on top of {st.causes[-1].label}: round {k} stays "
+                "unexplained")
+            _unjoin(st, k - 1)
+            break
+        if best is None:
             st.verdicts.append(verdict)
             say(f"round {k + 1}: {verdict.kind}")
             break
-        # candidates: the best goes into the model all the same; a rival that is a second cause passes again in a
-        # later round, one that is an alternative does not (then f is the mixture of the two, below)
-        best = next(r for r in ranked if r.fit.label == verdict.named)
-        resolved = dg.resolved(best.fit)
-        if verdict.kind == "named" and k > 0 and not st.misfits[-1].detected and \
-                best.fit.variants[-1].mechanism.measurement_chain:
-            verdict = replace(verdict, within_tolerance=not NAMING.matters_for_f(st.reference.f_effective,
-                                                                                 resolved.f_effective))
         st.verdicts.append(verdict)
         say(f"round {k + 1}: {verdict.kind} ({verdict.named}" + (", in the model within the check's tolerance, not "
-            "named" if verdict.within_tolerance else "") + ")")
+            "named" if verdict.within_tolerance else "") + (f", {verdict.joint.partner} to be named next with it"
+                                                             if verdict.joint is not None else "") + ")")
         st.causes.append(best.fit.variants[-1])
-        st.reference = resolved
+        st.reference = dg.resolved(best.fit)
     return st
+
+
+def _verdict(dg: Diagnoser, st: _Search, ranked: tuple[Ranked, ...], k: int, *, max_causes: int, seed: int,
+             say: Callable[[str], None]) -> tuple[Verdict, Ranked | None]:
+    """Round ``k``'s verdict by the naming rule (a first round's pair where neither alone explains the misfit:
+    :func:`_joint`), and the candidate that joins the model (None when none does). A named entry of the measurement
+    chain in a later round whose reference the whole-record check no longer flags is kept within the check's
+    tolerance unless it matters for f (module docstring)."""
+    misfit = st.misfits[-1].detected
+    verdict = NAMING.judge(st.reference, ranked, misfit=misfit, seed=seed + k, first=k == 0)
+    if k == 0 and k + 1 < max_causes and (pair := leads(verdict, ranked)) is not None:
+        verdict = _joint(dg, st.reference, ranked, verdict, pair, say)
+    if verdict.named is not None and k == 0 and verdict.joint is None:
+        st.not_sep, st.other_channels, st.separate_by = separability(verdict)
+    if verdict.kind not in ("named", "candidates"):
+        return verdict, None
+    # candidates: the best goes into the model all the same; a rival that is a second cause passes again in a
+    # later round, one that is an alternative does not (then f is the mixture of the two, below)
+    best = next(r for r in ranked if r.fit.label == verdict.named)
+    if verdict.kind == "named" and k > 0 and not misfit and best.fit.variants[-1].mechanism.measurement_chain:
+        resolved = dg.resolved(best.fit)
+        verdict = replace(verdict, within_tolerance=not NAMING.matters_for_f(st.reference.f_effective,
+                                                                             resolved.f_effective))
+    return verdict, best
+
+
+def _joint(dg: Diagnoser, reference: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict, pair: tuple,
+           say: Callable[[str], None]) -> Verdict:
+    """An unexplained round's verdict, or, when its two leading candidates fitted together explain the misfit
+    (:mod:`.joint_round`), the first of them named with the second to be named by the next round."""
+    a, b = pair
+    job = joint_job(a, b)
+    say(f"round 1 unexplained: {job[2]} fitted together")
+    joint = dg.fit_many([job], cut=False)[0]
+    evidence = admitted(joint, reference, a, b, ranked, NAMING)
+    if evidence is None:
+        return verdict
+    return replace(verdict, kind="named", named=a.fit.label, joint=evidence)
+
+
+def _unjoin(st: _Search, k: int) -> None:
+    """Round ``k``'s pair not confirmed by the next round: the round read as it was (unexplained), the first of the
+    pair out of the model, the next round's ranking and misfit decision dropped. Only a first round names a pair:
+    its reference is the baseline."""
+    st.verdicts[k] = replace(st.verdicts[k], kind="unexplained", named=None, joint=None)
+    del st.causes[k:], st.rounds[k + 1:], st.misfits[k + 1:]
+    st.reference = st.base
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

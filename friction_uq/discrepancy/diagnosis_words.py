@@ -12,7 +12,7 @@ from .cause_words import cause_words, f_steps
 from .diagnosed_f import further, headline, member_name, mixture_label, stationary_member, unresolved
 from .diagnosis import Diagnosis
 from .extended import Variant
-from .round_clauses import (by_weight_clause, remaining_clause, superfluous_clause, swapped_clause,
+from .round_clauses import (by_weight_clause, joint_clause, remaining_clause, superfluous_clause, swapped_clause,
                             within_tolerance_clause)
 from .whole_record import CHANNEL_LABELS
 
@@ -114,7 +114,7 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     return (f"{lead} {_f_said(dg, fx)} {quote}, {_median(dg, f_without)} from "
             f"the stationary analysis {'alone' if STATIONARY in dg.mixture_weights else 'without them'}. Why: "
             f"{_describe(dg)}; the {evidence}'s evidence is "
-            f"{first.delpd:.0f} +- {first.se:.0f} nats.{by_weight_clause(dg)}{swapped_clause(dg)}{sep}{delay_clause(dg)}"
+            f"{first.delpd:.0f} +- {first.se:.0f} nats.{joint_clause(dg)}{by_weight_clause(dg)}{swapped_clause(dg)}{sep}{delay_clause(dg)}"
             f"{remaining_clause(dg)}"
             f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
 

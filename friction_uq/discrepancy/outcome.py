@@ -70,7 +70,10 @@ RULE_TEXT = ("a cause is named only of a misfit the whole-record check found, wh
              "fitted in turn is named when, with the later causes in the model, it rules out each rival its round "
              "left open by the same rule, and the model without it, which the whole-record check must then flag "
              "(where its round left no rival open, by the rule alone; swaps); else it is superfluous and not "
-             "named; a later round whose reference the whole-record check does not flag names an entry of the "
+             "named; on an unexplained first round the two candidates with the most evidence (each decisive over "
+             "the record, two mechanisms) are fitted together, and named together (named_together) when the pair "
+             "passes the rule against the reference and against each alone, rules out every other extended model "
+             "by dELPD, and the next round names the second on top of the first by the rule; a later round whose reference the whole-record check does not flag names an entry of the "
              "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
              f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
              "the entry stays in the model within the check's tolerance (within_tolerance), not named")
@@ -101,6 +104,16 @@ def to_json(dg: Diagnosis, f_without: dict[str, float], f_without_quoted: dict[s
     }
 
 
+def named_together(dg: Diagnosis) -> list[dict[str, object]]:
+    """The JSON's ``named_together``: each pair of causes named together (:mod:`.joint_round`), their round unexplained
+    by either alone; the two fitted together against the round's reference and each alone (dELPD, SE; and without the
+    5 % of blocks most in the pair's favour); the second named by the next round on top of the first."""
+    return [{"round": k + 1, "causes": [dg.causes[k].label, v.joint.partner],
+             "against": {m: {"delpd": d, "se": se, "delpd_rest": dt, "se_rest": st}
+                         for m, (d, se, dt, st) in v.joint.against.items()}}
+            for k, v in enumerate(dg.verdicts[:len(dg.causes)]) if v.joint is not None]
+
+
 def _verdict_json(dg: Diagnosis) -> dict[str, object]:
     """What the rounds found: the verdict, the causes, the candidates and the rankings."""
     cause = dg.cause
@@ -128,6 +141,7 @@ def _verdict_json(dg: Diagnosis) -> dict[str, object]:
         # candidates fitted in turn the later causes made superfluous (the model without them not ruled out, or, where
         # their round left a rival open, not flagged by the whole-record check): not named
         "superfluous": list(dg.superfluous),
+        "named_together": named_together(dg),
         # entries of the measurement chain a later round kept in the model while the whole-record check no longer
         # flagged its reference, and that move f by less than the whole-record models' form term: not named
         "within_tolerance": list(dg.within_tolerance),

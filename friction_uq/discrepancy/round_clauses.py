@@ -1,14 +1,14 @@
-"""The clauses the sentence (:mod:`.diagnosis_words`) adds of the later rounds: a cause preferred by the stacking
-weight, a candidate fitted in turn that the later causes made superfluous, a mechanism kept in the model within the
-whole-record check's tolerance, the rivals the swap check ruled out, and a misfit left after the causes. Each is ''
-when it has nothing to say."""
+"""The clauses the sentence (:mod:`.diagnosis_words`) adds of the later rounds: two causes named together, a cause
+preferred by the stacking weight, a candidate fitted in turn that the later causes made superfluous, a mechanism kept
+in the model within the whole-record check's tolerance, the rivals the swap check ruled out, and a misfit left after
+the causes. Each is '' when it has nothing to say."""
 
 from __future__ import annotations
 
 from .cause_words import cause_words, f_steps
 from .diagnosis import Diagnosis
 from .rival_swaps import WITHOUT
-from .verdict import FORM_SHIFT
+from .verdict import DROP_FRACTION, FORM_SHIFT
 from .whole_record import CHANNEL_LABELS
 
 
@@ -109,3 +109,23 @@ def remaining_clause(dg: Diagnosis) -> str:
     listed = [by[label] for label in last.members if label in by]  # not a model the record rules out
     return (f" A misfit remains with them{where} that no further cause explains clearly"
             f"{' (candidates: ' + ', '.join(listed) + ')' if listed else ''}.")
+
+
+def joint_clause(dg: Diagnosis) -> str:
+    """' X and Y were named together: ...' for a round whose two leading candidates, neither passing the naming rule
+    alone, explain its misfit together and whose next round named the second on top of the first
+    (:mod:`.joint_round`); '' when none."""
+    out = []
+    for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
+        if v.joint is None or k + 1 >= len(dg.causes):
+            continue
+        a, b = dg.causes[k].label, v.joint.partner
+        e = [v.joint.against[m] for m in ("reference", a, b)]
+        whole = [f"{d:.0f} +- {se:.0f}" for d, se, _, _ in e]
+        rest = [f"{dt:.0f} +- {st:.0f}" for _, _, dt, st in e]
+        out.append(f" {a} and {b} were named together: in round {k + 1} neither alone explained the misfit by the naming "
+                   f"rule; fitted together they lead the model of that round by {whole[0]} nats, {a} alone by {whole[1]} "
+                   f"and {b} alone by {whole[2]} ({rest[0]}, {rest[1]} and {rest[2]} without the "
+                   f"{100 * DROP_FRACTION:.0f} % of blocks most in their favour), rule out every other mechanism, and "
+                   f"round {k + 2} named {b} on top of {a} by the rule.")
+    return "".join(out)

@@ -58,6 +58,7 @@ from scipy.stats import norm
 from ..quoted import WHOLE_RECORD_MODEL_FORM
 from ..stats import RULE, WeightRule, stacking_weights
 from ..stats.trimmed import points_to_drop
+from .joint_round import JointEvidence
 
 #: The share of a record's blocks that the spread test leaves out (the most favourable to the mechanism):
 #: set on clean records of the axisymmetric simulation and of the perturbed 1-D one against records with one
@@ -133,6 +134,9 @@ class Verdict:
     #: (:meth:`NamingRule.matters_for_f`): it stays in the model (the later rounds and the swap check see it), and is
     #: not named
     within_tolerance: bool = False
+    #: the round was unexplained, and its two leading candidates fitted together explain it (:mod:`.joint_round`):
+    #: ``named`` is the first of them, named with the next round's cause (the partner); None otherwise
+    joint: JointEvidence | None = None
 
     @property
     def supported(self) -> list[str]:

@@ -54,7 +54,8 @@ def reproducible(dt):
 
 
 
-#: The run's JSON: its schema name and version (12: ``warning_kinds``, each warning's kind beside it, a misfit
+#: The run's JSON: its schema name and version (13: ``discrepancy.named_together``, two causes named together where
+#: neither alone explained the misfit; 12: ``warning_kinds``, each warning's kind beside it, a misfit
 #: ``misfit_diagnosed`` where f under the causes ``diagnose`` named is the f to quote; 11: a diagnosed ``f`` holds, where the hoop gauge and nu's prior
 #: disagree, the diagnosed f and the stationary f from nu's prior alone in equal parts, their medians in
 #: ``f.readings_of_nu``; 10: ``hoop_or_prior``, f with the hoop gauge and from nu's prior
@@ -68,7 +69,7 @@ def reproducible(dt):
 #: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
-RUN_SCHEMA_VERSION = 12
+RUN_SCHEMA_VERSION = 13
 
 
 def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],

@@ -10,6 +10,7 @@ Page B: per gauge, the residual of the baseline and of the extended model over t
 from __future__ import annotations
 
 import textwrap
+from types import SimpleNamespace
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -45,6 +46,13 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
             decisive = c.decisive if c is not None else r.decisive
             colours.append("tab:red" if (c.passes if c is not None else decisive) else
                            "tab:orange" if decisive else "0.6")
+        joint = dg.verdicts[k].joint if k < len(dg.verdicts) else None
+        if joint is not None:  # a pair named together: the two fitted together against the round's reference
+            d, se, _, _ = joint.against["reference"]
+            rows.append(SimpleNamespace(delpd=d, se=se))
+            labels.append(f"{k + 1}: {dg.causes[k].label} + {joint.partner} together")
+            named.append(True)
+            colours.append("tab:red")
         seps.append(len(rows))
     y = np.arange(len(rows))[::-1]
     d = np.array([r.delpd for r in rows])
@@ -127,7 +135,11 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
                   "left open, by the rule alone); else it is superfluous and not named. A later round whose "
                   "reference the check no longer flags names an entry of the measurement chain only if it moves f "
                   f"by more than {100 * FORM_SHIFT:.1f} % (the whole-record models' form); else it stays in the "
-                  "model, not named."]
+                  "model, not named." + (" Two mechanisms neither of which passes alone in an unexplained first "
+                                         "round are named together when, fitted together, they pass against the "
+                                         "round's reference and each alone, rule out every other mechanism, and the "
+                                         "next round names the second on top of the first."
+                                         if any(v.joint is not None for v in dg.verdicts) else "")]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")

@@ -1,0 +1,92 @@
+"""Two causes named together where neither alone explains the misfit.
+
+With two effects in a record, each one's model still misses what the other makes, and its evidence can sit at the
+other's fronts: no mechanism passes the naming rule alone and the first round is *unexplained*, though each effect
+alone would be named (a bars' dispersion with a clearance of the sample in its tube). On such a round the two
+candidates with the most evidence (each decisive against the reference over the record, two different mechanisms)
+are fitted together. The pair is admitted (:func:`admitted`) when the joint model
+
+* passes the naming rule against the round's reference: decisive, and decisive with the blocks that favour it most
+  left out (spread over the record);
+* passes it against each of the two alone (each is needed, and not at a few blocks);
+* rules out every other candidate of the round by dELPD (:meth:`.verdict.NamingRule.ruling`'s "elpd": over the
+  record, or without the blocks most in its favour against that candidate).
+
+The first of the two (by its evidence alone) then joins the model as the round's cause (:attr:`.verdict.Verdict.joint`),
+and the next round must name the second by the ordinary rule, every other mechanism fitted on top of the first as in
+any round; if it does not, the round is read as it was (unexplained, f the candidates' mixture) and the search stops
+(``diagnose._search``). Only a first round is read so: the rule is measured there (``benchmarks/bench_joint_round.py``,
+docs/trust.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from ..stats import RULE
+from ..stats.trimmed import points_to_drop
+from .block_loo import elpd_difference
+
+
+@dataclass(frozen=True)
+class JointEvidence:
+    """The joint model of a round's two leading candidates against the round's reference and each of the two alone:
+    label ("reference", or a candidate's variant label) -> (dELPD, SE over the record, dELPD, SE without the blocks
+    most in the joint model's favour); ``partner`` the second candidate's variant label, named by the next round."""
+
+    partner: str
+    against: Mapping[str, tuple[float, float, float, float]]
+
+
+def leads(verdict, ranked: Sequence) -> tuple | None:
+    """The two candidates (:class:`~.diagnosis.Ranked`) with the most evidence against the reference of an unexplained
+    round, each decisive over the record by the package's rule, of two different mechanisms; None when fewer than two
+    are."""
+    if verdict.kind != "unexplained":
+        return None
+    out: list = []
+    for r in ranked:  # by dELPD
+        mech = r.fit.variants[-1].mechanism.name
+        if r.decisive and all(x.fit.variants[-1].mechanism.name != mech for x in out):
+            out.append(r)
+        if len(out) == 2:
+            return tuple(out)
+    return None
+
+
+def joint_job(a, b) -> tuple[tuple, dict[str, float], str]:
+    """The fit job (variants, start, label) of the two leading candidates together: from the first's mode, the
+    second's own parameters from its mode."""
+    fa, fb = a.fit, b.fit
+    start = dict(fa.fit.mode) | {k: x for k, x in fb.fit.mode.items() if k not in fa.fit.mode}
+    return (fa.variants[-1], fb.variants[-1]), start, f"{fa.label}+{fb.label}"
+
+
+def admitted(joint, reference, a, b, ranked: Sequence, rule) -> JointEvidence | None:
+    """The joint model's evidence when it admits the pair (module docstring), else None. ``reference``: the round's;
+    ``a``, ``b``: :func:`leads`; ``ranked``: the round's candidates; ``rule``: the :class:`~.verdict.NamingRule`."""
+    drop = points_to_drop(len(reference.elpd.pointwise), rule.drop_fraction)
+    against = {}
+    for label, other in (("reference", reference), (a.fit.variants[-1].label, a.fit),
+                         (b.fit.variants[-1].label, b.fit)):
+        d, se = elpd_difference(joint.elpd, other.elpd)
+        dt, st = elpd_difference(joint.elpd, other.elpd, drop=drop)
+        if not (RULE.decisive(d, se) and RULE.decisive(dt, st)):
+            return None
+        against[label] = (d, se, dt, st)
+    pair = {a.fit.label, b.fit.label}
+    for r in ranked:
+        if r.fit.label not in pair and rule.ruling(joint.elpd, r.fit.elpd, weight=1.0, drop=drop,
+                                                   carried=True) != "elpd":
+            return None
+    return JointEvidence(b.fit.variants[-1].label, against)
+
+
+def confirms(verdict, ranked: Sequence, partner: str) -> bool:
+    """Whether the round after a pair's first cause names its partner (variant label ``partner``) by the ordinary
+    rule, with no rival left open and not merely kept within the check's tolerance."""
+    if verdict.kind != "named" or verdict.within_tolerance:
+        return False
+    best = next(r for r in ranked if r.fit.label == verdict.named)
+    return best.fit.variants[-1].label == partner

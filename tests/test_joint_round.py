@@ -1,0 +1,155 @@
+"""Two causes named together where neither alone explains the misfit (friction_uq.discrepancy.joint_round): the
+rounds of ``diagnose`` on stand-in fits whose block ELPDs are set by hand."""
+
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from friction_uq.discrepancy import diagnose as dmod
+from friction_uq.discrepancy import round_clauses
+from friction_uq.discrepancy.block_loo import Elpd
+from friction_uq.discrepancy.extended import Variant
+from friction_uq.discrepancy.mechanisms import MECHANISMS
+from friction_uq.discrepancy.outcome import named_together
+
+N = 300
+A_BLOCKS = np.arange(0, 100, 10)  # where the first effect's model gains alone (its fronts)
+B_BLOCKS = np.arange(5, 105, 10)  # the second's
+
+
+def _noise(seed: int) -> np.ndarray:
+    return np.random.default_rng(seed).normal(0.0, 0.3, N)
+
+
+def _at(blocks, gain: float) -> np.ndarray:
+    out = np.zeros(N)
+    out[blocks] = gain
+    return out
+
+
+@dataclass
+class _Fit:
+    """The parts of a ModelFit the rounds read."""
+
+    label: str
+    variants: tuple
+    elpd: object
+    f_effective: np.ndarray
+    predicted: dict = field(default_factory=dict)
+    fit: object = field(default_factory=lambda: SimpleNamespace(mode={"f": 0.05}))
+
+
+class _Diagnoser:
+    """A stand-in Diagnoser: each model's blocks by its label (``blocks``; a label not given: its reference's plus
+    noise), f the same for all."""
+
+    gauges = ("input_bar", "internal_output_bar", "external_output_bar", "tube_hoop")
+    in_baseline = ()
+
+    def __init__(self, blocks):
+        self.blocks, self.made = blocks, []
+        self.base = _Fit("baseline", (), Elpd(_noise(0), float("nan")), np.full(50, 0.05))
+
+    def predictive(self, fit):
+        return {}
+
+    def resolved(self, fit):
+        return fit
+
+    def fit_many(self, jobs, workers=1, cut=True):
+        out = []
+        for variants, _, label in jobs:
+            self.made.append(label)
+            parent = "+".join(v.label for v in variants[:-1])
+            ref = self.blocks.get(parent, self.base.elpd.pointwise) if parent else self.base.elpd.pointwise
+            pts = self.blocks.get(label, ref + _noise(len(self.made)) * 0.1)
+            out.append(_Fit(label, variants, Elpd(np.asarray(pts, float), float("nan")), np.full(50, 0.05)))
+        return out
+
+
+def _search(monkeypatch, blocks, flagged=(True, True)):
+    """The rounds on ``blocks``; the whole-record check flags the rounds' references as ``flagged`` says, then no
+    more."""
+    flags = iter(flagged)
+    monkeypatch.setattr(dmod, "compare_whole_record", lambda prep, predicted: None)
+    monkeypatch.setattr(dmod, "decide", lambda comparison: SimpleNamespace(detected=next(flags, False)))
+    monkeypatch.setattr(dmod, "candidates", lambda exclude=(), gauges=None: [
+        Variant(MECHANISMS[m]) for m in ("dispersion", "clearance", "plug_friction") if m not in exclude])
+    dg = _Diagnoser(blocks)
+    st = dmod._search(dg, None, dmod._Search(dg.base, dg.base), max_causes=4, workers=1, seed=0,
+                      say=lambda msg: None, t0=0.0)
+    return dg, st
+
+
+def _pair_blocks(second_round_rival=None):
+    """Each effect's model alone gains 200 nats at its own ten blocks and nothing elsewhere (decisive, not spread:
+    the round is unexplained); together they gain there and 1 nat on every block (spread)."""
+    base = _noise(0)
+    a, b = base + _at(A_BLOCKS, 200.0), base + _at(B_BLOCKS, 200.0)
+    joint = base + _at(A_BLOCKS, 200.0) + _at(B_BLOCKS, 200.0) + 1.0
+    out = {"dispersion": a, "clearance": b, "plug_friction": base + _noise(9) * 0.1,
+           "dispersion+clearance": joint, "clearance+dispersion": joint}
+    if second_round_rival is not None:
+        out["dispersion+plug_friction"] = joint + second_round_rival
+    return out
+
+
+def _diagnosis(dg, st):
+    return dmod.Diagnosis(baseline=dg.base, rounds=tuple(st.rounds), misfits=tuple(st.misfits),
+                          causes=tuple(st.causes), not_separable=(), separate_by=None, final=st.reference,
+                          verdicts=tuple(st.verdicts))
+
+
+def test_two_effects_neither_of_which_explains_the_misfit_alone_are_named_together(monkeypatch):
+    dg, st = _search(monkeypatch, _pair_blocks())
+    first = st.verdicts[0]
+    assert [c.passes for c in first.candidates[:2]] == [False, False]  # neither alone passes the rule
+    assert [v.kind for v in st.verdicts] == ["named", "named", "none"]
+    assert first.joint is not None and first.joint.partner == "clearance"
+    assert [v.label for v in st.causes] == ["dispersion", "clearance"]
+    dgn = _diagnosis(dg, st)
+    assert [v.label for v in dgn.named_causes] == ["dispersion", "clearance"]
+    said = round_clauses.joint_clause(dgn)
+    assert said.startswith(" dispersion and clearance were named together: in round 1 neither alone"), said
+    d, se, dt, st_ = first.joint.against["reference"]
+    assert f"by {d:.0f} +- {se:.0f} nats" in said and f"{dt:.0f} +- {st_:.0f}" in said
+    js = named_together(dgn)
+    assert js[0]["round"] == 1 and js[0]["causes"] == ["dispersion", "clearance"]
+    assert set(js[0]["against"]) == {"reference", "dispersion", "clearance"}
+
+
+def test_a_pair_the_next_round_does_not_confirm_leaves_the_round_unexplained(monkeypatch):
+    """With the first in the model, a rival explains the record as well as the second: round 2 does not name the
+    partner, so round 1 is read as it was and nothing is named."""
+    dg, st = _search(monkeypatch, _pair_blocks(second_round_rival=_noise(5) * 0.05))
+    assert "dispersion+clearance" in dg.made  # the pair was fitted and admitted, then not confirmed
+    assert [v.kind for v in st.verdicts] == ["unexplained"]
+    assert st.verdicts[0].joint is None and st.verdicts[0].named is None
+    assert st.causes == [] and len(st.rounds) == 1 and len(st.misfits) == 1 and st.reference is st.base
+    assert round_clauses.joint_clause(_diagnosis(dg, st)) == ""
+
+
+@pytest.mark.parametrize("gain", [1500.0, 1900.0])
+def test_a_pair_that_does_not_rule_out_a_third_candidate_is_not_admitted(monkeypatch, gain):
+    """A third mechanism, not decisive alone, gains at one block almost as much as the pair over the whole record:
+    the pair does not rule it out by dELPD, so the round stays unexplained and no second round is fitted."""
+    blocks = _pair_blocks()
+    blocks["plug_friction"] = _noise(0) + _at([200], gain)
+    dg, st = _search(monkeypatch, blocks)
+    assert "dispersion+clearance" in dg.made and not st.verdicts[0].candidates[2].decisive
+    assert [v.kind for v in st.verdicts] == ["unexplained"] and st.verdicts[0].joint is None
+    assert not any(m.startswith("dispersion+") and m != "dispersion+clearance" for m in dg.made)
+    # without it the same pair is named
+    blocks["plug_friction"] = _noise(0) + _at([200], 0.0)
+    _, st = _search(monkeypatch, blocks)
+    assert [v.kind for v in st.verdicts][:2] == ["named", "named"]
+
+
+def test_a_single_cause_that_passes_alone_is_named_without_a_joint_fit(monkeypatch):
+    base = _noise(0)
+    dg, st = _search(monkeypatch, {"dispersion": base + 1.0, "clearance": base + _noise(3) * 0.1})
+    assert st.verdicts[0].kind == "named" and st.verdicts[0].joint is None
+    assert "dispersion+clearance" not in dg.made or st.rounds[1]  # fitted only as round 2's candidate
+    assert [v.label for v in st.causes] == ["dispersion"]
