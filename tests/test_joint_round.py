@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from friction_uq.discrepancy import diagnose as dmod
-from friction_uq.discrepancy import round_clauses
+from friction_uq.discrepancy import diagnosis_words, round_clauses
 from friction_uq.discrepancy.block_loo import Elpd
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
@@ -112,9 +112,14 @@ def test_two_effects_neither_of_which_explains_the_misfit_alone_are_named_togeth
     dgn = _diagnosis(dg, st)
     assert [v.label for v in dgn.named_causes] == ["dispersion", "clearance"]
     said = round_clauses.joint_clause(dgn)
-    assert said.startswith(" dispersion and clearance were named together: in round 1 neither alone"), said
-    d, se, dt, st_ = first.joint.against["reference"]
-    assert f"by {d:.0f} +- {se:.0f} nats" in said and f"{dt:.0f} +- {st_:.0f}" in said
+    assert said.startswith(" Named together: dispersion and clearance. In round 1 neither alone"), said
+    d, se, dt, st_ = first.joint.against["clearance"]
+    assert f"clearance alone by {d:.0f} +- {se:.0f} (" in said and f"and {dt:.0f} +- {st_:.0f} without" in said
+    assert "round 2 named clearance on top of dispersion" in said
+    d, se, _, _ = first.joint.against["reference"]  # the evidence that named them, not the first's alone
+    assert diagnosis_words._evidence_said(dgn, "first cause", st.rounds[0][0]) == (
+        f"the first two causes' evidence, fitted together, is {d:.0f} +- {se:.0f} nats")
+    assert dg.made.count("dispersion+clearance") == 2  # the pair, then round 2's fit of the partner from its mode
     js = named_together(dgn)
     assert js[0]["round"] == 1 and js[0]["causes"] == ["dispersion", "clearance"]
     assert set(js[0]["against"]) == {"reference", "dispersion", "clearance"}
@@ -124,7 +129,7 @@ def test_a_pair_the_next_round_does_not_confirm_leaves_the_round_unexplained(mon
     """With the first in the model, a rival explains the record as well as the second: round 2 does not name the
     partner, so round 1 is read as it was and nothing is named."""
     dg, st = _search(monkeypatch, _pair_blocks(second_round_rival=_noise(5) * 0.05))
-    assert "dispersion+clearance" in dg.made  # the pair was fitted and admitted, then not confirmed
+    assert "dispersion+clearance" in dg.made and "dispersion+plug_friction" in dg.made  # admitted, round 2 fitted
     assert [v.kind for v in st.verdicts] == ["unexplained"]
     assert st.verdicts[0].joint is None and st.verdicts[0].named is None
     assert st.causes == [] and len(st.rounds) == 1 and len(st.misfits) == 1 and st.reference is st.base
@@ -151,5 +156,36 @@ def test_a_single_cause_that_passes_alone_is_named_without_a_joint_fit(monkeypat
     base = _noise(0)
     dg, st = _search(monkeypatch, {"dispersion": base + 1.0, "clearance": base + _noise(3) * 0.1})
     assert st.verdicts[0].kind == "named" and st.verdicts[0].joint is None
-    assert "dispersion+clearance" not in dg.made or st.rounds[1]  # fitted only as round 2's candidate
+    assert dg.made.count("dispersion+clearance") == 1  # as round 2's candidate only
     assert [v.label for v in st.causes] == ["dispersion"]
+
+
+def test_no_pair_is_tried_where_no_next_round_could_name_the_second(monkeypatch):
+    monkeypatch.setattr(dmod, "compare_whole_record", lambda prep, predicted: None)
+    monkeypatch.setattr(dmod, "decide", lambda comparison: SimpleNamespace(detected=True))
+    monkeypatch.setattr(dmod, "candidates", lambda exclude=(), gauges=None: [
+        Variant(MECHANISMS[m]) for m in ("dispersion", "clearance", "plug_friction") if m not in exclude])
+    dg = _Diagnoser(_pair_blocks())
+    st = dmod._search(dg, None, dmod._Search(dg.base, dg.base), max_causes=1, workers=1, seed=0,
+                      say=lambda msg: None, t0=0.0)
+    assert [v.kind for v in st.verdicts] == ["unexplained"] and "dispersion+clearance" not in dg.made
+
+
+def test_two_friction_laws_are_never_paired(monkeypatch):
+    """One model holds one friction law: with the velocity and the slip law leading, the pair is the velocity law and
+    the next mechanism (a joint model of two laws cannot be built, and no later round could name the second)."""
+    blocks = _pair_blocks()
+    blocks = {"velocity_friction": blocks["dispersion"], "slip_friction": blocks["dispersion"] + 0.01,
+              "clearance": blocks["clearance"] - 1e-3, "velocity_friction+clearance": blocks["dispersion+clearance"]}
+    monkeypatch.setattr(dmod, "compare_whole_record", lambda prep, predicted: None)
+    flags = iter([True, True])
+    monkeypatch.setattr(dmod, "decide", lambda comparison: SimpleNamespace(detected=next(flags, False)))
+    monkeypatch.setattr(dmod, "candidates", lambda exclude=(), gauges=None: [
+        Variant(MECHANISMS[m]) for m in ("velocity_friction", "slip_friction", "clearance")
+        if m not in exclude and not (m.endswith("_friction") and any(e.endswith("_friction") for e in exclude))])
+    dg = _Diagnoser(blocks)
+    st = dmod._search(dg, None, dmod._Search(dg.base, dg.base), max_causes=4, workers=1, seed=0,
+                      say=lambda msg: None, t0=0.0)
+    assert [r.fit.label for r in st.rounds[0]][:2] == ["slip_friction", "velocity_friction"]
+    assert not any("slip_friction+velocity" in m or "velocity_friction+slip" in m for m in dg.made)
+    assert "slip_friction+clearance" in dg.made  # the leading law with the next mechanism that one model can hold

@@ -124,6 +124,10 @@ class _Search:
     not_sep: tuple[str, ...] = ()
     other_channels: tuple[str, ...] = ()
     separate_by: str | None = None
+    #: a first round's pair (:mod:`.joint_round`): the joint fit's mode, where the next round's fit of the pair starts,
+    #: and the round's verdict without the pair, restored if the next round does not name the second
+    pair_mode: dict[str, float] | None = None
+    alone: Verdict | None = None
 
 
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
@@ -225,7 +229,9 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
             st.base = st.reference
         st.misfits.append(decide(compare_whole_record(prep, st.reference.predicted)))
         used = dg.in_baseline + tuple(v.mechanism.name for v in st.causes)
-        jobs = [(tuple(st.causes) + (cand,), dict(st.reference.fit.mode),
+        pair = st.verdicts[-1].joint if k > 0 else None  # the partner's fit starts where the pair's joint fit ended
+        jobs = [(tuple(st.causes) + (cand,), dict(st.pair_mode if pair and cand.label == pair.partner
+                                                  else st.reference.fit.mode),
                  "+".join([v.label for v in st.causes] + [cand.label]))
                 for cand in candidates(exclude=used, gauges=dg.gauges)]
         per_model = fit_seconds / fitted if fitted else None
@@ -239,9 +245,8 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
         ranked = rank(st.reference, fits, misfit=st.misfits[-1].detected)
         st.rounds.append(ranked)
         verdict, best = _verdict(dg, st, ranked, k, max_causes=max_causes, seed=seed, say=say)
-        pair_of = st.verdicts[-1].joint if k > 0 else None
-        if pair_of is not None and not confirms(verdict, ranked, pair_of.partner):
-            say(f"round {k + 1}: {pair_of.partner} not named on top of {st.causes[-1].label}: round {k} stays "
+        if pair is not None and not confirms(verdict, ranked, pair.partner):
+            say(f"round {k + 1}: {pair.partner} not named on top of {st.causes[-1].label}: round {k} stays "
                 "unexplained")
             _unjoin(st, k - 1)
             break
@@ -267,7 +272,8 @@ def _verdict(dg: Diagnoser, st: _Search, ranked: tuple[Ranked, ...], k: int, *, 
     misfit = st.misfits[-1].detected
     verdict = NAMING.judge(st.reference, ranked, misfit=misfit, seed=seed + k, first=k == 0)
     if k == 0 and k + 1 < max_causes and (pair := leads(verdict, ranked)) is not None:
-        verdict = _joint(dg, st.reference, ranked, verdict, pair, say)
+        st.alone = verdict
+        verdict, st.pair_mode = _joint(dg, st.reference, ranked, verdict, pair, say)
     if verdict.named is not None and k == 0 and verdict.joint is None:
         st.not_sep, st.other_channels, st.separate_by = separability(verdict)
     if verdict.kind not in ("named", "candidates"):
@@ -283,26 +289,28 @@ def _verdict(dg: Diagnoser, st: _Search, ranked: tuple[Ranked, ...], k: int, *, 
 
 
 def _joint(dg: Diagnoser, reference: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict, pair: tuple,
-           say: Callable[[str], None]) -> Verdict:
+           say: Callable[[str], None]) -> tuple[Verdict, dict[str, float] | None]:
     """An unexplained round's verdict, or, when its two leading candidates fitted together explain the misfit
-    (:mod:`.joint_round`), the first of them named with the second to be named by the next round."""
+    (:mod:`.joint_round`), the first of them named with the second to be named by the next round; and the joint
+    fit's mode where the pair is admitted (None otherwise)."""
     a, b = pair
     job = joint_job(a, b)
     say(f"round 1 unexplained: {job[2]} fitted together")
     joint = dg.fit_many([job], cut=False)[0]
     evidence = admitted(joint, reference, a, b, ranked, NAMING)
     if evidence is None:
-        return verdict
-    return replace(verdict, kind="named", named=a.fit.label, joint=evidence)
+        say(f"round 1: {job[2]} not admitted (docs/methods.md, two causes named together)")
+        return verdict, None
+    return replace(verdict, kind="named", named=a.fit.label, joint=evidence), dict(joint.fit.mode)
 
 
 def _unjoin(st: _Search, k: int) -> None:
     """Round ``k``'s pair not confirmed by the next round: the round read as it was (unexplained), the first of the
     pair out of the model, the next round's ranking and misfit decision dropped. Only a first round names a pair:
     its reference is the baseline."""
-    st.verdicts[k] = replace(st.verdicts[k], kind="unexplained", named=None, joint=None)
+    st.verdicts[k] = st.alone
     del st.causes[k:], st.rounds[k + 1:], st.misfits[k + 1:]
-    st.reference = st.base
+    st.reference, st.pair_mode = st.base, None
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

@@ -113,10 +113,19 @@ def sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     fx = headline(dg)[1]
     return (f"{lead} {_f_said(dg, fx)} {quote}, {_median(dg, f_without)} from "
             f"the stationary analysis {'alone' if STATIONARY in dg.mixture_weights else 'without them'}. Why: "
-            f"{_describe(dg)}; the {evidence}'s evidence is "
-            f"{first.delpd:.0f} +- {first.se:.0f} nats.{joint_clause(dg)}{by_weight_clause(dg)}{swapped_clause(dg)}{sep}{delay_clause(dg)}"
+            f"{_describe(dg)}; {_evidence_said(dg, evidence, first)}.{joint_clause(dg)}{by_weight_clause(dg)}{swapped_clause(dg)}{sep}{delay_clause(dg)}"
             f"{remaining_clause(dg)}"
             f"{f' Calibration: {_hoop_finding(dg)}.' if hoop_gain_off(dg) else ''}")
+
+
+def _evidence_said(dg: Diagnosis, evidence: str, first) -> str:
+    """"the first cause's evidence is D +- SE nats" (``first``: its ranking entry); for a first round's pair named
+    together (:mod:`.joint_round`), the pair's, which is what named them: each alone did not pass."""
+    joint = dg.verdicts[0].joint if dg.verdicts and dg.causes else None
+    if joint is not None and dg.cause is dg.causes[0]:
+        d, se, _, _ = joint.against["reference"]
+        return f"the first two causes' evidence, fitted together, is {d:.0f} +- {se:.0f} nats"
+    return f"the {evidence}'s evidence is {first.delpd:.0f} +- {first.se:.0f} nats"
 
 
 def _evidence_of(dg: Diagnosis, cause: Variant):

@@ -41,18 +41,23 @@ class JointEvidence:
 
 def leads(verdict, ranked: Sequence) -> tuple | None:
     """The two candidates (:class:`~.diagnosis.Ranked`) with the most evidence against the reference of an unexplained
-    round, each decisive over the record by the package's rule, of two different mechanisms; None when fewer than two
-    are."""
+    round, each decisive over the record by the package's rule, of two different mechanisms that one model can hold
+    (not two of one group: one friction law at a time); None when fewer than two are."""
     if verdict.kind != "unexplained":
         return None
     out: list = []
     for r in ranked:  # by dELPD
-        mech = r.fit.variants[-1].mechanism.name
-        if r.decisive and all(x.fit.variants[-1].mechanism.name != mech for x in out):
+        m = r.fit.variants[-1].mechanism
+        if r.decisive and all(_together(x.fit.variants[-1].mechanism, m) for x in out):
             out.append(r)
         if len(out) == 2:
             return tuple(out)
     return None
+
+
+def _together(m, n) -> bool:
+    """Whether one model holds mechanisms ``m`` and ``n``: two different ones, not of one group."""
+    return m.name != n.name and (m.group is None or m.group != n.group)
 
 
 def joint_job(a, b) -> tuple[tuple, dict[str, float], str]:

@@ -112,20 +112,21 @@ def remaining_clause(dg: Diagnosis) -> str:
 
 
 def joint_clause(dg: Diagnosis) -> str:
-    """' X and Y were named together: ...' for a round whose two leading candidates, neither passing the naming rule
-    alone, explain its misfit together and whose next round named the second on top of the first
-    (:mod:`.joint_round`); '' when none."""
+    """' Named together: X and Y; ...' for a round whose two leading candidates, neither passing the naming rule alone,
+    explain its misfit together and whose next round named the second on top of the first (:mod:`.joint_round`); ''
+    when none."""
     out = []
     for k, v in enumerate(dg.verdicts[:len(dg.causes)]):
         if v.joint is None or k + 1 >= len(dg.causes):
             continue
         a, b = dg.causes[k].label, v.joint.partner
-        e = [v.joint.against[m] for m in ("reference", a, b)]
-        whole = [f"{d:.0f} +- {se:.0f}" for d, se, _, _ in e]
-        rest = [f"{dt:.0f} +- {st:.0f}" for _, _, dt, st in e]
-        out.append(f" {a} and {b} were named together: in round {k + 1} neither alone explained the misfit by the naming "
-                   f"rule; fitted together they lead the model of that round by {whole[0]} nats, {a} alone by {whole[1]} "
-                   f"and {b} alone by {whole[2]} ({rest[0]}, {rest[1]} and {rest[2]} without the "
-                   f"{100 * DROP_FRACTION:.0f} % of blocks most in their favour), rule out every other mechanism, and "
-                   f"round {k + 2} named {b} on top of {a} by the rule.")
+        ea, eb = v.joint.against[a], v.joint.against[b]
+        alone = {c.variant: c for c in v.candidates}
+        out.append(f" Named together: {a} and {b}. In round {k + 1} neither alone explained the misfit by the naming "
+                   f"rule ({a} {alone[a].delpd:.0f} +- {alone[a].se:.0f} nats, {b} {alone[b].delpd:.0f} +- "
+                   f"{alone[b].se:.0f}, each not decisive without the {100 * DROP_FRACTION:.0f} % of blocks most in its "
+                   f"favour); fitted together they lead {a} alone by {ea[0]:.0f} +- {ea[1]:.0f} nats and {b} alone by "
+                   f"{eb[0]:.0f} +- {eb[1]:.0f} ({ea[2]:.0f} +- {ea[3]:.0f} and {eb[2]:.0f} +- {eb[3]:.0f} without "
+                   f"their best blocks), rule out every other mechanism, and round {k + 2} named {b} on top of {a} by "
+                   f"the rule.")
     return "".join(out)
