@@ -177,7 +177,7 @@ def test_more_lead_in_the_blocks_left_out_never_reopens_a_rival_ruled_out_withou
 
 
 def test_two_mechanisms_the_record_does_not_separate_are_candidates_and_a_gain_on_another_gauge_is_named():
-    from friction_uq.discrepancy.diagnose import separability
+    from friction_uq.discrepancy.separability import separability
     from friction_uq.discrepancy.verdict import NamingRule
 
     base = _fit("reference", None, _noise())

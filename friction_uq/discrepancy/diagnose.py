@@ -56,6 +56,7 @@ from .candidates_mixture import (Resolve, draw_mixture, further_members, mixture
                                  superfluous_mixture)
 from .diagnosis import Diagnosis, Ranked
 from .rival_swaps import Swap, check_swaps, swap_jobs
+from .separability import separability
 from .verdict import NamingRule, Verdict
 from .whole_record import WholeRecord, compare_whole_record
 
@@ -66,48 +67,10 @@ MAX_CAUSES = 4
 #: Processes fitting one round's extended models by default.
 MAX_WORKERS = 4
 
-#: What would separate two mechanisms that one record cannot.
-SEPARATE_BY = {
-    frozenset({"velocity_friction", "pressure_friction"}):
-        "tests at another striker speed on another internal output bar (p and V rise together in one set-up)",
-    frozenset({"velocity_friction", "slip_friction"}):
-        "a test at another striker speed (slip and speed grow together through one test)",
-    frozenset({"pressure_friction", "slip_friction"}):
-        "a test at another striker speed (the load and the slip grow together through one test)",
-    frozenset({"clearance", "end_friction"}):
-        "the hoop gauge's start (a clearance delays it) or a test with another sample length",
-    frozenset({"channel_timing", "bandwidth"}):
-        "the amplifier's response to a sharp step (a calibration pulse through the channel) and the digitisers' "
-        "trigger times",
-    frozenset({"gauge_gain", "bar_modulus"}):
-        "the bar's wave speed timed on the bar itself (a striker on the bar alone), and a shunt calibration of the "
-        "gauge",
-    frozenset({"channel_timing", "bar_modulus"}):
-        "the bar's wave speed timed on the bar itself and the gauge's distance measured again",
-    frozenset({"bandwidth", "dispersion"}):
-        "the amplifier's response to a sharp step (dispersion is the bar's, the same on every amplifier)",
-}
-DEFAULT_SEPARATION = "another test of the campaign (another striker speed or another internal output bar)"
-
 
 def rank(reference: ModelFit, fits: list[ModelFit], *, misfit: bool = False) -> tuple[Ranked, ...]:
     out = [Ranked(f, *elpd_difference(f.elpd, reference.elpd), misfit=misfit) for f in fits]
     return tuple(sorted(out, key=lambda r: -r.delpd))
-
-
-def separability(verdict: Verdict) -> tuple[tuple[str, ...], tuple[str, ...], str | None]:
-    """Who explains the record about as well as the named model (the verdict's rivals): the mechanisms not
-    separable from it (with it first; empty when none), the other gauges on which the same mechanism does (a
-    gauge_gain: the mechanism is named, its gauge is not certain), and what would separate the mechanisms."""
-    by = {c.label: c for c in verdict.candidates}
-    best = by[verdict.named]
-    close = [by[label] for label in verdict.rivals]
-    channels = tuple(c.channel for c in close if c.mechanism == best.mechanism and c.channel)
-    others = [c.mechanism for c in close if c.mechanism != best.mechanism]
-    if not others:
-        return (), channels, None
-    names = tuple(dict.fromkeys([best.mechanism, *others]))
-    return names, channels, SEPARATE_BY.get(frozenset(names[:2]), DEFAULT_SEPARATION)
 
 
 @dataclass

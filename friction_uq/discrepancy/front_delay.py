@@ -16,7 +16,7 @@ Three faults of the catalogue (:mod:`.chain_faults`) move one output gauge's fro
 
 Where a round's candidates are all of these and each puts the largest delay on the same gauge, with the same sign,
 the record shows that delay, not which of them makes it: ``diagnose`` says so (:class:`SharedDelay`), beside what
-would tell them apart (:data:`.diagnose.SEPARATE_BY`). The delays are read from each fit's posterior medians.
+would tell them apart (:data:`.separability.SEPARATE_BY`). The delays are read from each fit's posterior medians.
 """
 
 from __future__ import annotations
