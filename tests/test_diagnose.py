@@ -6,7 +6,6 @@ many records with varied f, nu, striker speed and seed is ``benchmarks/bench_dia
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from types import MappingProxyType, SimpleNamespace
 
 import numpy as np
@@ -24,6 +23,7 @@ from friction_uq.record import read_record
 from friction_uq.simulate import simulate_to_file
 from friction_uq.simulate.config import ChannelSpec
 from simulated import noisy_config
+from stand_ins import StandInFit
 
 REQUIRED = ("velocity_friction", "pressure_friction", "slip_friction", "clearance", "plug_friction", "gauge_gain",
             "dispersion", "end_friction")
@@ -805,16 +805,7 @@ def test_a_further_mechanism_of_the_last_round_stands_for_the_final_model_in_the
     assert w0 == pytest.approx({STATIONARY: 0.5, "clearance": 0.43, "zero_drift": 0.07})
 
 
-@dataclass
-class _Fit:
-    """The parts of a :class:`~friction_uq.discrepancy.extended.ModelFit` that the rounds read."""
-
-    label: str
-    variants: tuple
-    elpd: object
-    f_effective: np.ndarray
-    predicted: dict = field(default_factory=dict)
-    fit: object = field(default_factory=lambda: SimpleNamespace(mode={"f": 0.05}))
+_Fit = StandInFit
 
 
 class _RoundsDiagnoser:

@@ -1,7 +1,6 @@
 """Two causes named together where neither alone explains the misfit (friction_uq.discrepancy.joint_round): the
 rounds of ``diagnose`` on stand-in fits whose block ELPDs are set by hand."""
 
-from dataclasses import dataclass, field
 from types import SimpleNamespace
 
 import numpy as np
@@ -13,6 +12,7 @@ from friction_uq.discrepancy.block_loo import Elpd
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
 from friction_uq.discrepancy.outcome import named_together
+from stand_ins import StandInFit
 
 N = 300
 A_BLOCKS = np.arange(0, 100, 10)  # where the first effect's model gains alone (its fronts)
@@ -29,16 +29,7 @@ def _at(blocks, gain: float) -> np.ndarray:
     return out
 
 
-@dataclass
-class _Fit:
-    """The parts of a ModelFit the rounds read."""
-
-    label: str
-    variants: tuple
-    elpd: object
-    f_effective: np.ndarray
-    predicted: dict = field(default_factory=dict)
-    fit: object = field(default_factory=lambda: SimpleNamespace(mode={"f": 0.05}))
+_Fit = StandInFit
 
 
 class _Diagnoser:
