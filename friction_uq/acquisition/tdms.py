@@ -41,19 +41,32 @@ class _Said(logging.Handler):
 
 
 @contextmanager
-def _open(path: Path, describing: list[str] | None = None) -> Iterator[Any]:
-    """The TDMS file with its metadata read and its data left on disk. npTDMS's warnings (a damaged segment, an unknown
-    scaling) are not printed: a refusal while the file is open names the first of them, and a read that succeeds
-    with one is refused; ``describing`` (a listing's lines, ``--show``) gets it as a line instead."""
-    check_size(path)
-    nptdms = need("nptdms", path)
+def _captured(nptdms: Any) -> Iterator[list[str]]:
+    """npTDMS's warnings while the block runs, kept (the list yielded) and not printed: its console handler, which it
+    puts on each of its loggers, is silenced and restored after."""
     log, said = logging.getLogger("nptdms"), _Said()  # npTDMS's module loggers propagate to it
     console = getattr(getattr(getattr(nptdms, "log", None), "log_manager", None), "console_handler", None)
     level = console.level if console is not None else None
-    if console is not None:  # the handler npTDMS puts on each of its loggers, printing to stderr
+    if console is not None:
         console.setLevel(logging.CRITICAL + 1)
     log.addHandler(said)
     try:
+        yield said.said
+    finally:
+        log.removeHandler(said)
+        if console is not None:
+            console.setLevel(level)
+
+
+@contextmanager
+def _open(path: Path, describing: list[str] | None = None) -> Iterator[Any]:
+    """The TDMS file with its metadata read and its data left on disk. npTDMS's warnings (a damaged segment, an unknown
+    scaling) are not printed (:func:`_captured`): a refusal while the file is open names the first of them, and a
+    read that succeeds with one is refused; ``describing`` (a listing's lines, ``--show``) gets it as a line
+    instead."""
+    check_size(path)
+    nptdms = need("nptdms", path)
+    with _captured(nptdms) as said:
         try:
             with np.errstate(all="ignore"):
                 f = nptdms.TdmsFile.open(str(path))  # type: ignore[attr-defined]
@@ -62,20 +75,16 @@ def _open(path: Path, describing: list[str] | None = None) -> Iterator[Any]:
         try:
             yield f
         except ScopeFileError as exc:
-            if said.said:
-                raise ScopeFileError(f"{exc}; npTDMS warned: {_short(said.said[0])}") from None
+            if said:
+                raise ScopeFileError(f"{exc}; npTDMS warned: {_short(said[0])}") from None
             raise
         finally:
             f.close()
-        if said.said and describing is None:  # the samples read may not be the file's (cut short, scaling unknown)
-            raise ScopeFileError(f"{path}: npTDMS warned while reading it: {_short(said.said[0])}; the samples read "
+        if said and describing is None:  # the samples read may not be those recorded (cut short, scaling unknown)
+            raise ScopeFileError(f"{path}: npTDMS warned while reading it: {_short(said[0])}; the samples read "
                                  "may not be those recorded (a truncated file, a scaling npTDMS does not know)")
-        if said.said and describing is not None:
-            describing.append(f"  npTDMS warned: {_short(said.said[0])} (an import would refuse this file)")
-    finally:
-        log.removeHandler(said)
-        if console is not None:
-            console.setLevel(level)
+        if said:
+            describing.append(f"  npTDMS warned: {_short(said[0])} (an import would refuse this file)")
 
 
 def _short(text: str, limit: int = 120) -> str:
