@@ -131,3 +131,18 @@ def test_workers_below_one_is_refused(folder, tmp_path, capsys):
         main(["campaign", str(folder), "--out", str(tmp_path / "c"), "--workers", "0"])
     assert exc.value.code == 2
     assert "workers must be at least 1, got 0" in capsys.readouterr().err
+
+
+def test_test_ids_in_another_script_keep_their_letters_and_do_not_collide(tmp_path):
+    """A lab's ids "Essai-é1" and "Essai-è1" write files of their own names (they had both become "Essai-_1" and the
+    campaign refused them as one name); a decomposed accent is the composed one; what a file name cannot hold is '_'."""
+    from friction_uq.record_run import safe_stem
+
+    assert safe_stem("A", "Essai-é1") == "A_Essai-é1" != safe_stem("A", "Essai-è1")
+    assert safe_stem("A", "Essai-e\u03011") == "A_Essai-é1"  # the same id typed with a combining accent
+    assert safe_stem("B", "x/y:z*? 1") == "B_x_y_z___1" and safe_stem(".", "t") == "_t"
+    app = paper_apparatus()
+    for tid in ("Essai-é1", "Essai-è1"):
+        write_closed_form_record(tmp_path / f"{tid}.h5", ClosedFormTest(), seed=len(tid) + ord(tid[-2]),
+                                 apparatus=app, test_id=tid, campaign="A")
+    check_headers([read_header(p) for p in find_records([tmp_path])])  # two names: nothing refused

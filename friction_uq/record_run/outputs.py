@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import re
+import unicodedata
 from pathlib import Path
 
 from ..diagnostics import Convergence, VariableSummary
@@ -13,8 +14,10 @@ from ..prior_sensitivity import PriorDataConflict
 
 
 def safe_stem(campaign: str, test_id: str) -> str:
-    """``<campaign>_<test_id>`` with anything but letters, digits, '.', '-' and '_' replaced by '_'."""
-    return re.sub(r"[^A-Za-z0-9._-]", "_", f"{campaign}_{test_id}").lstrip(".")
+    """``<campaign>_<test_id>`` in Unicode's composed form (NFC), with anything but letters and digits (of any script:
+    a lab's "Essai-é1" keeps its accent, and differs from "Essai-è1"), '.', '-' and '_' replaced by '_', and no
+    leading dot."""
+    return re.sub(r"[^\w.-]", "_", unicodedata.normalize("NFC", f"{campaign}_{test_id}")).lstrip(".")
 
 
 
