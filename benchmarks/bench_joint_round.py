@@ -45,26 +45,15 @@ from bench_pairs import PAIRS_1D, PAIRS_AXISYMMETRIC, make_pair  # noqa: E402
 from verdict_records import groups, make, write  # noqa: E402
 
 from friction_uq.analysis import prepare  # noqa: E402
-from friction_uq.discrepancy.block_loo import elpd_difference  # noqa: E402
 from friction_uq.discrepancy.diagnose import NAMING, diagnose  # noqa: E402
-from friction_uq.discrepancy.joint_round import admitted, joint_job, leads  # noqa: E402
+from friction_uq.discrepancy.joint_round import admitted, joint_evidence, joint_job, leads  # noqa: E402
 from friction_uq.discrepancy.extended import Diagnoser  # noqa: E402
 from friction_uq.discrepancy.misfit import misfit_detected  # noqa: E402
-from friction_uq.discrepancy.verdict import RULE, points_to_drop  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
 from friction_uq.likelihood import Likelihood  # noqa: E402
 from friction_uq.prior_loader import default_prior_path, load_priors  # noqa: E402
 from friction_uq.record import read_record  # noqa: E402
 from friction_uq.sampler import LogPosterior, start_ball  # noqa: E402
-
-
-def evidence(fit, other, drop: int) -> dict:
-    """``fit`` against ``other``: dELPD and SE over the record and without the ``drop`` blocks most in its favour,
-    and whether each is decisive by the package's rule."""
-    d, se = elpd_difference(fit.elpd, other.elpd)
-    dt, st = elpd_difference(fit.elpd, other.elpd, drop=drop)
-    return {"d": d, "se": se, "d_rest": dt, "se_rest": st, "decisive": bool(RULE.decisive(d, se)),
-            "spread": bool(RULE.decisive(dt, st))}
 
 
 def first_round(path: str, priors, seed: int):
@@ -97,9 +86,8 @@ def joint_test(prep, dg, maker) -> dict | None:
         return {"applies": False, "why": "fewer than two decisive candidates one model can hold"}
     a, b = pair
     joint = maker.fit_many([joint_job(a, b)], workers=2, cut=False)[0]
-    drop = points_to_drop(len(dg.baseline.elpd.pointwise), NAMING.drop_fraction)
-    against = {"reference": evidence(joint, dg.baseline, drop), a.fit.label: evidence(joint, a.fit, drop),
-               b.fit.label: evidence(joint, b.fit, drop)}
+    against = {k: dict(zip(("d", "se", "d_rest", "se_rest"), e))
+               for k, e in joint_evidence(joint, dg.baseline, a, b, NAMING).against.items()}
     passes = admitted(joint, dg.baseline, a, b, dg.rounds[0], NAMING) is not None
     resolved = maker.resolved(joint)
     fq = np.quantile(resolved.f_effective, [0.05, 0.5, 0.95])

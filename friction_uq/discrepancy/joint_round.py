@@ -68,24 +68,30 @@ def joint_job(a, b) -> tuple[tuple, dict[str, float], str]:
     return (fa.variants[-1], fb.variants[-1]), start, f"{fa.label}+{fb.label}"
 
 
-def admitted(joint, reference, a, b, ranked: Sequence, rule) -> JointEvidence | None:
-    """The joint model's evidence when it admits the pair (module docstring), else None. ``reference``: the round's;
-    ``a``, ``b``: :func:`leads`; ``ranked``: the round's candidates; ``rule``: the :class:`~.verdict.NamingRule`."""
+def joint_evidence(joint, reference, a, b, rule) -> JointEvidence:
+    """The joint model against the round's ``reference`` and each of ``a``, ``b`` (:func:`leads`) alone: dELPD and SE
+    over the record and without the blocks most in its favour (the naming rule's ``drop_fraction``)."""
     drop = points_to_drop(len(reference.elpd.pointwise), rule.drop_fraction)
-    against = {}
-    for label, other in (("reference", reference), (a.fit.variants[-1].label, a.fit),
-                         (b.fit.variants[-1].label, b.fit)):
-        d, se = elpd_difference(joint.elpd, other.elpd)
-        dt, st = elpd_difference(joint.elpd, other.elpd, drop=drop)
-        if not (RULE.decisive(d, se) and RULE.decisive(dt, st)):
-            return None
-        against[label] = (d, se, dt, st)
+    against = {label: (*elpd_difference(joint.elpd, other.elpd), *elpd_difference(joint.elpd, other.elpd, drop=drop))
+               for label, other in (("reference", reference), (a.fit.variants[-1].label, a.fit),
+                                    (b.fit.variants[-1].label, b.fit))}
+    return JointEvidence(b.fit.variants[-1].label, against)
+
+
+def admitted(joint, reference, a, b, ranked: Sequence, rule) -> JointEvidence | None:
+    """The joint model's evidence (:func:`joint_evidence`) when it admits the pair (module docstring), else None.
+    ``reference``: the round's; ``a``, ``b``: :func:`leads`; ``ranked``: the round's candidates; ``rule``: the
+    :class:`~.verdict.NamingRule`."""
+    evidence = joint_evidence(joint, reference, a, b, rule)
+    if not all(RULE.decisive(d, se) and RULE.decisive(dt, st) for d, se, dt, st in evidence.against.values()):
+        return None
+    drop = points_to_drop(len(reference.elpd.pointwise), rule.drop_fraction)
     pair = {a.fit.label, b.fit.label}
     for r in ranked:
         if r.fit.label not in pair and rule.ruling(joint.elpd, r.fit.elpd, weight=1.0, drop=drop,
                                                    carried=True) != "elpd":
             return None
-    return JointEvidence(b.fit.variants[-1].label, against)
+    return evidence
 
 
 def confirms(verdict, ranked: Sequence, partner: str) -> bool:

@@ -73,7 +73,8 @@ RULE_TEXT = ("a cause is named only of a misfit the whole-record check found, wh
              "named; on an unexplained first round the two candidates with the most evidence (each decisive over "
              "the record, two mechanisms) are fitted together, and named together (named_together) when the pair "
              "passes the rule against the reference and against each alone, rules out every other extended model "
-             "by dELPD, and the next round names the second on top of the first by the rule; a later round whose reference the whole-record check does not flag names an entry of the "
+             "by dELPD, and the next round names the second on top of the first by the rule; a later round whose "
+             "reference the whole-record check does not flag names an entry of the "
              "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
              f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
              "the entry stays in the model within the check's tolerance (within_tolerance), not named")
