@@ -46,7 +46,7 @@ from verdict_records import groups, make, write  # noqa: E402
 
 from friction_uq.analysis import prepare  # noqa: E402
 from friction_uq.discrepancy.diagnose import NAMING, diagnose  # noqa: E402
-from friction_uq.discrepancy.joint_round import admitted, joint_evidence, joint_job, leads  # noqa: E402
+from friction_uq.discrepancy.joint_round import admitted, joint_job, leads  # noqa: E402
 from friction_uq.discrepancy.extended import Diagnoser  # noqa: E402
 from friction_uq.discrepancy.misfit import misfit_detected  # noqa: E402
 from friction_uq.errors import FrictionUQError  # noqa: E402
@@ -86,13 +86,12 @@ def joint_test(prep, dg, maker) -> dict | None:
         return {"applies": False, "why": "fewer than two decisive candidates one model can hold"}
     a, b = pair
     joint = maker.fit_many([joint_job(a, b)], workers=2, cut=False)[0]
-    against = {k: dict(zip(("d", "se", "d_rest", "se_rest"), e))
-               for k, e in joint_evidence(joint, dg.baseline, a, b, NAMING).against.items()}
-    passes = admitted(joint, dg.baseline, a, b, dg.rounds[0], NAMING) is not None
+    evidence, refused = admitted(joint, dg.baseline, a, b, dg.rounds[0], NAMING)
+    against = {k: dict(zip(("d", "se", "d_rest", "se_rest"), e)) for k, e in evidence.against.items()}
     resolved = maker.resolved(joint)
     fq = np.quantile(resolved.f_effective, [0.05, 0.5, 0.95])
     return {"applies": True, "pair": [a.fit.variants[-1].label, b.fit.variants[-1].label], "against": against,
-            "passes": passes, "still_flagged": bool(misfit_detected(prep, maker.predictive(joint))),
+            "passes": refused is None, "refused": refused, "still_flagged": bool(misfit_detected(prep, maker.predictive(joint))),
             "f": [float(x) for x in fq]}
 
 
@@ -154,7 +153,7 @@ def main() -> None:
             f"{'+'.join(out['pair'])}: " + "; ".join(f"vs {k} {e['d']:.0f}+-{e['se']:.0f} (rest {e['d_rest']:.0f}"
                                                      f"+-{e['se_rest']:.0f})" for k, e in out["against"].items())
             + f"; flagged {out['still_flagged']}; f {out['f'][1]:.4f} [{out['f'][0]:.4f}, {out['f'][2]:.4f}]"
-            + f"; {'ADMITTED' if out['passes'] else 'not admitted'}"))
+            + f"; {'ADMITTED' if out['passes'] else 'not admitted: ' + out['refused']}"))
         print(f"{name} ({note}): first round {v.kind}{' ' + v.named if v.named else ''}; truth f "
               f"{row['truth_f']:.4f}; joint: {said}; {row['seconds']:.0f} s", flush=True)
         if a.jsonl:

@@ -196,7 +196,7 @@ def test_run_diagnose_on_a_hoop_gauge_at_half_its_scale_quotes_both_readings(tmp
     assert f["q05"] < hp["f_prior_nu_alone"]["q50"] and truth[0] < f["q05"] and f["q95"] < truth[1]
     said = [w for w in doc["warnings"] if w.startswith("The tube's hoop gauge and the prior file disagree")]
     assert len(said) == 1 and f"from {f['q05']:.4g} to {f['q95']:.4g} (90 %)" in said[0]
-    assert doc["schema_version"] == 13
+    assert doc["schema_version"] == 14
 
 
 def test_a_diagnosed_campaign_pools_the_stationary_readings_of_a_test_whose_hoop_gauge_disagrees(tmp_path):

@@ -11,7 +11,7 @@ from friction_uq.discrepancy import diagnosis_words, round_clauses
 from friction_uq.discrepancy.block_loo import Elpd
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
-from friction_uq.discrepancy.outcome import named_together
+from friction_uq.discrepancy.outcome import named_together, pair_tried
 from stand_ins import StandInFit
 
 N = 300
@@ -90,7 +90,7 @@ def _pair_blocks(second_round_rival=None):
 def _diagnosis(dg, st):
     return dmod.Diagnosis(baseline=dg.base, rounds=tuple(st.rounds), misfits=tuple(st.misfits),
                           causes=tuple(st.causes), not_separable=(), separate_by=None, final=st.reference,
-                          verdicts=tuple(st.verdicts))
+                          verdicts=tuple(st.verdicts), pair_tried=st.pair_tried)
 
 
 def test_two_effects_neither_of_which_explains_the_misfit_alone_are_named_together(monkeypatch):
@@ -114,6 +114,10 @@ def test_two_effects_neither_of_which_explains_the_misfit_alone_are_named_togeth
     js = named_together(dgn)
     assert js[0]["round"] == 1 and js[0]["causes"] == ["dispersion", "clearance"]
     assert set(js[0]["against"]) == {"reference", "dispersion", "clearance"}
+    tried = pair_tried(dgn)
+    assert tried["named_together"] and tried["refused"] is None and tried["causes"] == ["dispersion", "clearance"]
+    assert tried["against"] == js[0]["against"]
+    assert round_clauses.pair_refused_clause(dgn) == ""
 
 
 def test_a_pair_the_next_round_does_not_confirm_leaves_the_round_unexplained(monkeypatch):
@@ -124,7 +128,14 @@ def test_a_pair_the_next_round_does_not_confirm_leaves_the_round_unexplained(mon
     assert [v.kind for v in st.verdicts] == ["unexplained"]
     assert st.verdicts[0].joint is None and st.verdicts[0].named is None
     assert st.causes == [] and len(st.rounds) == 1 and len(st.misfits) == 1 and st.reference is st.base
-    assert round_clauses.joint_clause(_diagnosis(dg, st)) == ""
+    dgn = _diagnosis(dg, st)
+    assert round_clauses.joint_clause(dgn) == ""
+    # the trial is kept, with what round 2 found instead of the partner
+    why = st.pair_tried.refused
+    assert why == "round 2 did not name clearance on top of dispersion: clearance and its rivals stayed candidates"
+    assert round_clauses.pair_refused_clause(dgn) == f" Fitted together, dispersion and clearance do not explain it " \
+                                                      f"either: {why}."
+    assert pair_tried(dgn)["named_together"] is False and pair_tried(dgn)["refused"] == why
 
 
 @pytest.mark.parametrize("gain", [1500.0, 1900.0])
@@ -137,10 +148,26 @@ def test_a_pair_that_does_not_rule_out_a_third_candidate_is_not_admitted(monkeyp
     assert "dispersion+clearance" in dg.made and not st.verdicts[0].candidates[2].decisive
     assert [v.kind for v in st.verdicts] == ["unexplained"] and st.verdicts[0].joint is None
     assert not any(m.startswith("dispersion+") and m != "dispersion+clearance" for m in dg.made)
+    assert st.pair_tried.refused == "does not rule out plug_friction"
     # without it the same pair is named
     blocks["plug_friction"] = _noise(0) + _at([200], 0.0)
     _, st = _search(monkeypatch, blocks)
     assert [v.kind for v in st.verdicts][:2] == ["named", "named"]
+
+
+def test_a_pair_carried_by_a_few_blocks_over_one_of_the_two_is_refused_and_says_why(monkeypatch):
+    """Fitted together the two gain only at their own fronts: over the reference at twenty blocks, over the first
+    alone at the second's ten, fewer than the 5 % of blocks the rule leaves out."""
+    blocks = _pair_blocks()
+    joint = _noise(0) + _at(A_BLOCKS, 200.0) + _at(B_BLOCKS, 200.0)
+    blocks["dispersion+clearance"] = blocks["clearance+dispersion"] = joint
+    dg, st = _search(monkeypatch, blocks)
+    assert [v.kind for v in st.verdicts] == ["unexplained"] and st.causes == []
+    why = st.pair_tried.refused
+    assert why.startswith("against dispersion alone, carried by a few blocks ("), why
+    assert "without the 5 % most in its favour)" in why
+    assert round_clauses.pair_refused_clause(_diagnosis(dg, st)).startswith(
+        " Fitted together, dispersion and clearance do not explain it either: against dispersion alone")
 
 
 def test_a_single_cause_that_passes_alone_is_named_without_a_joint_fit(monkeypatch):

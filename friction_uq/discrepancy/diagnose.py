@@ -49,7 +49,7 @@ from .block_loo import elpd_difference
 from .exact_model import exact_posterior
 from .extended import Diagnoser, ModelFit, Variant, candidates
 from .front_delay import round_shared_delay
-from .joint_round import admitted, confirms, joint_job, leads
+from .joint_round import PairTrial, admitted, confirms, joint_job, leads, not_confirmed
 from .misfit import MisfitDecision, decide, misfit_detected
 from .record_likelihood import HOOP_GAIN_SD
 from .candidates_mixture import (Resolve, draw_mixture, further_members, mixture, open_rounds, rival_mixture,
@@ -91,6 +91,8 @@ class _Search:
     #: and the round's verdict without the pair, restored if the next round does not name the second
     pair_mode: dict[str, float] | None = None
     alone: Verdict | None = None
+    #: the pair fitted together, named or not, and why not
+    pair_tried: PairTrial | None = None
 
 
 def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], float], start: Mapping[str, float], *,
@@ -161,7 +163,7 @@ def diagnose(prep: Prepared, log_prior_f_nu: Callable[[Mapping[str, float]], flo
                      posterior_method=method, posterior_converged=converged, context=dg.context, seed=seed,
                      verdicts=tuple(verdicts), mixture_f=mix, mixture_weights=mix_w, mixture_source=mix_src, swaps=swaps,
                      swap_models=checked, mixture_of=mixture_of, shared_delay=shared,
-                     hoop_calibration=dg.hoop_calibration)
+                     hoop_calibration=dg.hoop_calibration, pair_tried=st.pair_tried)
 
 
 def _mixture_after_causes(final: ModelFit, rounds: list, verdicts: list, causes: list, swaps: tuple, checked: tuple,
@@ -209,9 +211,9 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
         st.rounds.append(ranked)
         verdict, best = _verdict(dg, st, ranked, k, max_causes=max_causes, seed=seed, say=say)
         if pair is not None and not confirms(verdict, ranked, pair.partner):
-            say(f"round {k + 1}: {pair.partner} not named on top of {st.causes[-1].label}: round {k} stays "
-                "unexplained")
-            _unjoin(st, k - 1)
+            why = not_confirmed(verdict, ranked, pair.partner, st.causes[-1].label, k + 1)
+            say(f"{why}; round {k} stays unexplained")
+            _unjoin(st, k - 1, why)
             break
         if best is None:
             st.verdicts.append(verdict)
@@ -236,7 +238,7 @@ def _verdict(dg: Diagnoser, st: _Search, ranked: tuple[Ranked, ...], k: int, *, 
     verdict = NAMING.judge(st.reference, ranked, misfit=misfit, seed=seed + k, first=k == 0)
     if k == 0 and k + 1 < max_causes and (pair := leads(verdict, ranked)) is not None:
         st.alone = verdict
-        verdict, st.pair_mode = _joint(dg, st.reference, ranked, verdict, pair, say)
+        verdict, st.pair_mode, st.pair_tried = _joint(dg, st.reference, ranked, verdict, pair, say)
     if verdict.named is not None and k == 0 and verdict.joint is None:
         st.not_sep, st.other_channels, st.separate_by = separability(verdict)
     if verdict.kind not in ("named", "candidates"):
@@ -252,28 +254,30 @@ def _verdict(dg: Diagnoser, st: _Search, ranked: tuple[Ranked, ...], k: int, *, 
 
 
 def _joint(dg: Diagnoser, reference: ModelFit, ranked: tuple[Ranked, ...], verdict: Verdict, pair: tuple,
-           say: Callable[[str], None]) -> tuple[Verdict, dict[str, float] | None]:
-    """An unexplained round's verdict, or, when its two leading candidates fitted together explain the misfit
-    (:mod:`.joint_round`), the first of them named with the second to be named by the next round; and the joint
-    fit's mode where the pair is admitted (None otherwise)."""
+           say: Callable[[str], None]) -> tuple[Verdict, dict[str, float] | None, PairTrial]:
+    """An unexplained round's verdict, or, when its two leading candidates fitted together explain it
+    (:mod:`.joint_round`), the first of them named with the second to be named by the next round; the joint fit's
+    mode where the pair is admitted (None otherwise); and the trial, with why it was refused."""
     a, b = pair
     job = joint_job(a, b)
     say(f"round 1 unexplained: {job[2]} fitted together")
     joint = dg.fit_many([job], cut=False)[0]
-    evidence = admitted(joint, reference, a, b, ranked, NAMING)
-    if evidence is None:
-        say(f"round 1: {job[2]} not admitted (docs/methods.md, two causes named together)")
-        return verdict, None
-    return replace(verdict, kind="named", named=a.fit.label, joint=evidence), dict(joint.fit.mode)
+    evidence, refused = admitted(joint, reference, a, b, ranked, NAMING)
+    trial = PairTrial(1, (a.fit.variants[-1].label, evidence.partner), evidence, refused)
+    if refused is not None:
+        say(f"round 1: {job[2]} not admitted, {refused} (docs/methods.md, two causes named together)")
+        return verdict, None, trial
+    return replace(verdict, kind="named", named=a.fit.label, joint=evidence), dict(joint.fit.mode), trial
 
 
-def _unjoin(st: _Search, k: int) -> None:
-    """Round ``k``'s pair not confirmed by the next round: the round read as it was (unexplained), the first of the
-    pair out of the model, the next round's ranking and misfit decision dropped. Only a first round names a pair:
-    its reference is the baseline."""
+def _unjoin(st: _Search, k: int, why: str) -> None:
+    """Round ``k``'s pair not confirmed by the next round (``why``): the round read as it was (unexplained), the
+    first of the pair out of the model, the next round's ranking and misfit decision dropped. Only a first round
+    names a pair: its reference is the baseline."""
     st.verdicts[k] = st.alone
     del st.causes[k:], st.rounds[k + 1:], st.misfits[k + 1:]
     st.reference, st.pair_mode = st.base, None
+    st.pair_tried = replace(st.pair_tried, refused=why)
 
 
 def residual_rms(a: WholeRecord, b: WholeRecord) -> dict[str, dict[str, tuple[float, float]]]:

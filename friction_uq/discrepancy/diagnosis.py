@@ -12,6 +12,7 @@ from ..stats import RULE
 from .candidates_mixture import named_causes, open_rivals, open_rounds
 from .extended import ModelFit, Variant
 from .front_delay import SharedDelay
+from .joint_round import PairTrial
 from .mechanisms import Context
 from .misfit import MisfitDecision
 from .record_likelihood import HOOP_GAIN_SD
@@ -102,6 +103,9 @@ class Diagnosis:
     #: reads nu through the hoop gauge as well, so the f to quote holds the diagnosed f and these in equal parts
     #: (:func:`.diagnosed_f.f_draws_to_quote`); None otherwise
     f_prior_nu: np.ndarray | None = None
+    #: the first round's two leading candidates fitted together where neither alone explained its misfit, named
+    #: together or not, and why not (:mod:`.joint_round`); None when no pair was tried
+    pair_tried: PairTrial | None = None
 
     @property
     def verdict(self) -> Verdict | None:

@@ -12,8 +12,8 @@ from .cause_words import cause_words, f_steps
 from .diagnosed_f import further, headline, member_name, mixture_label, stationary_member, unresolved
 from .diagnosis import Diagnosis
 from .extended import Variant
-from .round_clauses import (by_weight_clause, joint_clause, remaining_clause, superfluous_clause, swapped_clause,
-                            within_tolerance_clause)
+from .round_clauses import (by_weight_clause, joint_clause, pair_refused_clause, remaining_clause, superfluous_clause,
+                            swapped_clause, within_tolerance_clause)
 from .whole_record import CHANNEL_LABELS
 
 #: A hoop gain this far from 1 (its most probable value under its 5 % prior) is reported as a calibration finding
@@ -176,7 +176,7 @@ def _mixture_sentence(dg: Diagnosis, f_without: dict[str, float]) -> str:
     else:
         where = _where(dg)
         what = (f"Unexplained misfit{where}: no cause of the catalogue explains it clearly, over the whole record "
-                "and better than every other.")
+                f"and better than every other.{pair_refused_clause(dg)}")
     if STATIONARY in dg.mixture_weights:  # half the stationary analysis' f (candidates_mixture)
         return (f"{what} {_f_said(dg, fm)} from {stationary_member(dg)} "
                 f"({_percent(dg, dg.mixture_weights[STATIONARY])}) and the candidates weighted by how well each "

@@ -16,7 +16,8 @@ The first of the two (by its evidence alone) then joins the model as the round's
 and the next round must name the second by the ordinary rule, every other mechanism fitted on top of the first as in
 any round; if it does not, the round is read as it was (unexplained, f the candidates' mixture) and the search stops
 (``diagnose._search``). Only a first round is read so: the rule is measured there (``benchmarks/bench_joint_round.py``,
-docs/trust.md).
+docs/trust.md). A pair tried and not named leaves its evidence and the reason (:class:`PairTrial`): a reader of an
+unexplained verdict is told that the two fitted together did not explain it either, and why.
 """
 
 from __future__ import annotations
@@ -37,6 +38,17 @@ class JointEvidence:
 
     partner: str
     against: Mapping[str, tuple[float, float, float, float]]
+
+
+@dataclass(frozen=True)
+class PairTrial:
+    """A first round's two leading candidates fitted together: their variant labels (the first, then its partner), the
+    joint model's evidence, and why the two were not named together (None: they were)."""
+
+    round: int
+    causes: tuple[str, str]
+    evidence: JointEvidence
+    refused: str | None = None
 
 
 def leads(verdict, ranked: Sequence) -> tuple | None:
@@ -78,20 +90,25 @@ def joint_evidence(joint, reference, a, b, rule) -> JointEvidence:
     return JointEvidence(b.fit.variants[-1].label, against)
 
 
-def admitted(joint, reference, a, b, ranked: Sequence, rule) -> JointEvidence | None:
-    """The joint model's evidence (:func:`joint_evidence`) when it admits the pair (module docstring), else None.
-    ``reference``: the round's; ``a``, ``b``: :func:`leads`; ``ranked``: the round's candidates; ``rule``: the
-    :class:`~.verdict.NamingRule`."""
+def admitted(joint, reference, a, b, ranked: Sequence, rule) -> tuple[JointEvidence, str | None]:
+    """The joint model's evidence (:func:`joint_evidence`) and why it does not admit the pair (module docstring; None
+    when it does). ``reference``: the round's; ``a``, ``b``: :func:`leads`; ``ranked``: the round's candidates;
+    ``rule``: the :class:`~.verdict.NamingRule`."""
     evidence = joint_evidence(joint, reference, a, b, rule)
-    if not all(RULE.decisive(d, se) and RULE.decisive(dt, st) for d, se, dt, st in evidence.against.values()):
-        return None
+    for label, (d, se, dt, st) in evidence.against.items():
+        other = "the round's reference model" if label == "reference" else f"{label} alone"
+        if not RULE.decisive(d, se):
+            return evidence, f"not decisive against {other} ({d:.0f} +- {se:.0f} nats)"
+        if not RULE.decisive(dt, st):
+            return evidence, (f"against {other}, carried by a few blocks ({d:.0f} +- {se:.0f} nats; {dt:.0f} +- "
+                              f"{st:.0f} without the {100 * rule.drop_fraction:.0f} % most in its favour)")
     drop = points_to_drop(len(reference.elpd.pointwise), rule.drop_fraction)
     pair = {a.fit.label, b.fit.label}
     for r in ranked:
         if r.fit.label not in pair and rule.ruling(joint.elpd, r.fit.elpd, weight=1.0, drop=drop,
                                                    carried=True) != "elpd":
-            return None
-    return evidence
+            return evidence, f"does not rule out {r.fit.variants[-1].label}"
+    return evidence, None
 
 
 def confirms(verdict, ranked: Sequence, partner: str) -> bool:
@@ -101,3 +118,14 @@ def confirms(verdict, ranked: Sequence, partner: str) -> bool:
         return False
     best = next(r for r in ranked if r.fit.label == verdict.named)
     return best.fit.variants[-1].label == partner
+
+
+def not_confirmed(verdict, ranked: Sequence, partner: str, first: str, k: int) -> str:
+    """Why round ``k`` (1-based; ``ranked``: its candidates), the one after a pair's first cause ``first``, did not
+    confirm its ``partner`` (:func:`confirms`): what that round found instead."""
+    best = next((r.fit.variants[-1].label for r in ranked if r.fit.label == verdict.named), verdict.named)
+    found = {"named": f"it named {best}", "candidates": f"{best} and its rivals stayed candidates",
+             "unexplained": "its misfit stayed unexplained", "unconfirmed": "the check no longer flagged a misfit"}
+    said = (f"{best} stayed in the model within the check's tolerance, not named"
+            if verdict.within_tolerance else found.get(verdict.kind, "no mechanism passed the naming rule"))
+    return f"round {k} did not name {partner} on top of {first}: {said}"

@@ -73,7 +73,8 @@ RULE_TEXT = ("a cause is named only of a misfit the whole-record check found, wh
              "named; on an unexplained first round the two candidates with the most evidence (each decisive over "
              "the record, two mechanisms) are fitted together, and named together (named_together) when the pair "
              "passes the rule against the reference and against each alone, rules out every other extended model "
-             "by dELPD, and the next round names the second on top of the first by the rule; a later round whose "
+             "by dELPD, and the next round names the second on top of the first by the rule (pair_tried: the pair "
+             "and, where it was not named, why); a later round whose "
              "reference the whole-record check does not flag names an entry of the "
              "measurement chain (a gain, a zero drift, a timing, a bandwidth, a bar's modulus) only if it moves "
              f"f's median by more than the whole-record models' form term allows ({100 * FORM_SHIFT:.1f} %), else "
@@ -115,6 +116,18 @@ def named_together(dg: Diagnosis) -> list[dict[str, object]]:
             for k, v in enumerate(dg.verdicts[:len(dg.causes)]) if v.joint is not None]
 
 
+def pair_tried(dg: Diagnosis) -> dict[str, object] | None:
+    """The JSON's ``pair_tried``: the first round's two leading candidates fitted together where neither alone
+    explained its misfit (:mod:`.joint_round`), their evidence as in ``named_together``, whether they were named
+    together and, if not, why; None when no pair was tried."""
+    t = dg.pair_tried
+    if t is None:
+        return None
+    return {"round": t.round, "causes": list(t.causes), "named_together": t.refused is None, "refused": t.refused,
+            "against": {m: {"delpd": d, "se": se, "delpd_rest": dt, "se_rest": st}
+                        for m, (d, se, dt, st) in t.evidence.against.items()}}
+
+
 def _verdict_json(dg: Diagnosis) -> dict[str, object]:
     """What the rounds found: the verdict, the causes, the candidates and the rankings."""
     cause = dg.cause
@@ -143,6 +156,8 @@ def _verdict_json(dg: Diagnosis) -> dict[str, object]:
         # their round left a rival open, not flagged by the whole-record check): not named
         "superfluous": list(dg.superfluous),
         "named_together": named_together(dg),
+        # the pair fitted together on an unexplained first round, named or refused (and why)
+        "pair_tried": pair_tried(dg),
         # entries of the measurement chain a later round kept in the model while the whole-record check no longer
         # flagged its reference, and that move f by less than the whole-record models' form term: not named
         "within_tolerance": list(dg.within_tolerance),

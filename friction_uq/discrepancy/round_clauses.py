@@ -130,3 +130,12 @@ def joint_clause(dg: Diagnosis) -> str:
                    f"their best blocks), rule out every other mechanism, and round {k + 2} named {b} on top of {a} by "
                    f"the rule.")
     return "".join(out)
+
+
+def pair_refused_clause(dg: Diagnosis) -> str:
+    """' Fitted together, X and Y do not explain it either: ...' where the first round's two leading candidates were
+    fitted together and not named (:mod:`.joint_round`), and the round stayed unexplained; '' otherwise."""
+    t = dg.pair_tried
+    if t is None or t.refused is None or dg.causes:
+        return ""
+    return f" Fitted together, {t.causes[0]} and {t.causes[1]} do not explain it either: {t.refused}."

@@ -57,7 +57,8 @@ def reproducible(dt):
 
 
 
-#: The run's JSON: its schema name and version (13: ``discrepancy.named_together``, two causes named together where
+#: The run's JSON: its schema name and version (14: ``discrepancy.pair_tried``, the pair fitted together on an
+#: unexplained first round, named or refused and why; 13: ``discrepancy.named_together``, two causes named together where
 #: neither alone explained the misfit; 12: ``warning_kinds``, each warning's kind beside it, a misfit
 #: ``misfit_diagnosed`` where f under the causes ``diagnose`` named is the f to quote; 11: a diagnosed ``f`` holds, where the hoop gauge and nu's prior
 #: disagree, the diagnosed f and the stationary f from nu's prior alone in equal parts, their medians in
@@ -72,7 +73,7 @@ def reproducible(dt):
 #: ``fitted_in_turn`` and ``open_candidates``; 2: ``f`` is the f to quote, the stationary analysis' f is
 #: ``f_stationary``; version 1 had the stationary f as ``f`` and the f to quote as ``f_headline``: docs/outputs.md).
 RUN_SCHEMA = "friction-uq/run-result"
-RUN_SCHEMA_VERSION = 13
+RUN_SCHEMA_VERSION = 14
 
 
 def quoted_f(f_stationary: dict[str, float], f_stationary_posterior: dict[str, float],

@@ -53,6 +53,13 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
             labels.append(f"{k + 1}: {dg.causes[k].label} + {joint.partner} together")
             named.append(True)
             colours.append("tab:red")
+        tried = dg.pair_tried
+        if tried is not None and tried.refused is not None and tried.round == k + 1:  # fitted together, not named
+            d, se, dt, st = tried.evidence.against["reference"]
+            rows.append(SimpleNamespace(delpd=d, se=se))
+            labels.append(f"{k + 1}: {' + '.join(tried.causes)} together (not named)")
+            named.append(False)
+            colours.append("tab:red" if RULE.decisive(dt, st) else "tab:orange" if RULE.decisive(d, se) else "0.6")
         seps.append(len(rows))
     y = np.arange(len(rows))[::-1]
     d = np.array([r.delpd for r in rows])
@@ -139,7 +146,7 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
                                          "round are named together when, fitted together, they pass against the "
                                          "round's reference and each alone, rule out every other mechanism, and the "
                                          "next round names the second on top of the first."
-                                         if any(v.joint is not None for v in dg.verdicts) else "")]
+                                         if dg.pair_tried is not None else "")]
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")
