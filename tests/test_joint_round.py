@@ -164,10 +164,10 @@ def test_a_pair_carried_by_a_few_blocks_over_one_of_the_two_is_refused_and_says_
     dg, st = _search(monkeypatch, blocks)
     assert [v.kind for v in st.verdicts] == ["unexplained"] and st.causes == []
     why = st.pair_tried.refused
-    assert why.startswith("against dispersion alone, carried by a few blocks ("), why
+    assert why.startswith("their gain over dispersion alone is carried by a few blocks ("), why
     assert "without the 5 % most in its favour)" in why
     assert round_clauses.pair_refused_clause(_diagnosis(dg, st)).startswith(
-        " Fitted together, dispersion and clearance do not explain it either: against dispersion alone")
+        " Fitted together, dispersion and clearance do not explain it either: their gain over dispersion alone")
 
 
 def test_a_single_cause_that_passes_alone_is_named_without_a_joint_fit(monkeypatch):

@@ -100,8 +100,8 @@ def admitted(joint, reference, a, b, ranked: Sequence, rule) -> tuple[JointEvide
         if not RULE.decisive(d, se):
             return evidence, f"not decisive against {other} ({d:.0f} +- {se:.0f} nats)"
         if not RULE.decisive(dt, st):
-            return evidence, (f"against {other}, carried by a few blocks ({d:.0f} +- {se:.0f} nats; {dt:.0f} +- "
-                              f"{st:.0f} without the {100 * rule.drop_fraction:.0f} % most in its favour)")
+            return evidence, (f"their gain over {other} is carried by a few blocks ({d:.0f} +- {se:.0f} nats; "
+                              f"{dt:.0f} +- {st:.0f} without the {100 * rule.drop_fraction:.0f} % most in its favour)")
     drop = points_to_drop(len(reference.elpd.pointwise), rule.drop_fraction)
     pair = {a.fit.label, b.fit.label}
     for r in ranked:

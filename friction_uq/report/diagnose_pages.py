@@ -24,8 +24,12 @@ from ..discrepancy.whole_record import CHANNEL_LABELS
 from .style import figure
 
 
-#: Characters per line of the ranking page's text column.
-WRAP = 70
+#: The ranking page's text column: its margins from the page's right edge and foot and its gap from the ranking
+#: (fractions of the page), and the spacing of its lines (in font sizes).
+RIGHT_MARGIN = 0.02
+BOTTOM_MARGIN = 0.03
+COLUMN_GAP = 0.02
+LINE_SPACING = 1.2
 
 
 def _ranking_axes(ax, dg: Diagnosis) -> None:
@@ -84,9 +88,10 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
               ["decisive with the 5 % of blocks most in its favour left out: spread over the record, whatever\n"
                "its whole-record bar (bold: the cause named in that round)",
                "decisive, but carried by a few blocks (5 % left out: not decisive)", "not decisive", "dELPD = 4"],
-              loc="lower right", fontsize=7)
-    ax.text(0.0, -0.16, "w: stacking weight, the share of the record's predictions the model carries against the "
-            "round's reference and the other mechanisms", transform=ax.transAxes, fontsize=7)
+              # below the axes: inside, it covered the last round's lowest bars (B-02's fourth round)
+              loc="upper left", bbox_to_anchor=(0.0, -0.1), fontsize=7, ncols=2, title_fontsize=7,
+              title="w: stacking weight, the share of the record's predictions the model carries against the "
+                    "round's reference and the other mechanisms", alignment="left")
     ax.set_title("rounds 1, 2, ...: each mechanism added to the model of the round before", fontsize=9)
 
 
@@ -150,13 +155,38 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
     if m0 is not None:
         lines.append(f"Baseline misfit statistic {m0.statistic:.1f} (threshold {m0.threshold:g}): "
                      f"{'detected' if m0.detected else 'not detected'}.")
-    text = "\n".join(textwrap.fill(line, WRAP) if line else line for line in lines)
-    # 8 pt holds about 44 wrapped lines above the page's foot (B-02's 52 ran to its edge); a record with four
-    # causes says more: the type shrinks to fit
-    lines_in = text.count("\n") + 1
-    ax2.text(0.0, 1.0, text, va="top", fontsize=min(8.0, max(5.5, 8.0 * 44 / lines_in)), transform=ax2.transAxes)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
+    column_text(fig, axes[0], lines)
     return fig
+
+
+def column_text(fig: Figure, beside, lines: list[str], *, size: float = 8.0, smallest: float = 5.5) -> None:
+    """``lines`` wrapped into the column from just right of the axes ``beside`` to the page's right margin and from
+    their top to the page's foot (or to their label's and legend's top where those reach under it), at ``size`` pt or, where they would run past the foot, smaller (not below
+    ``smallest``). The column is measured once the page is laid out: the ranking's tick labels decide where it
+    starts, and a fixed count of characters ran past the page's edge where they were long (a refused pair's row)."""
+    renderer = fig.canvas.get_renderer()
+    pos = beside.get_position()
+    left = pos.x1 + COLUMN_GAP
+    width = (1.0 - RIGHT_MARGIN - left) * fig.bbox.width
+    foot = BOTTOM_MARGIN * fig.bbox.height  # or above the axes' label and legend where they reach under the column
+    for art in (beside.xaxis.label, beside.get_legend()):
+        box = art.get_window_extent(renderer) if art is not None else None
+        if box is not None and box.x1 > left * fig.bbox.width:
+            foot = max(foot, box.y1 + COLUMN_GAP * fig.bbox.height)
+    height = pos.y1 * fig.bbox.height - foot
+    sample = " ".join(lines)[:600] or "x"
+    for _ in range(4):
+        probe = fig.text(0.0, 0.0, sample, fontsize=size)
+        per_char = probe.get_window_extent(renderer).width / len(sample)
+        probe.remove()
+        text = "\n".join(textwrap.fill(line, max(20, int(0.95 * width / per_char))) if line else line
+                         for line in lines)
+        needed = (text.count("\n") + 1) * LINE_SPACING * size * fig.dpi / 72.0
+        if needed <= height or size <= smallest:
+            break
+        size = max(smallest, size * height / needed)
+    fig.text(left, pos.y1, text, va="top", fontsize=size, linespacing=LINE_SPACING)
 
 
 def page_extended_fit(dg: Diagnosis, *, test: str) -> Figure:
