@@ -166,8 +166,19 @@ def test_a_pair_carried_by_a_few_blocks_over_one_of_the_two_is_refused_and_says_
     why = st.pair_tried.refused
     assert why.startswith("their gain over dispersion alone is carried by a few blocks ("), why
     assert "without the 5 % most in its favour)" in why
+    assert "; their gain over clearance alone is carried by a few blocks (" in why  # every comparison it fails
+    assert "reference" not in why  # against the reference it passes: twenty blocks, more than the 5 % left out
     assert round_clauses.pair_refused_clause(_diagnosis(dg, st)).startswith(
         " Fitted together, dispersion and clearance do not explain it either: their gain over dispersion alone")
+
+
+def test_a_pair_that_adds_nothing_to_the_first_alone_is_refused_as_not_decisive_against_it(monkeypatch):
+    blocks = _pair_blocks()
+    blocks["dispersion+clearance"] = blocks["clearance+dispersion"] = blocks["dispersion"] + _noise(7) * 1e-3
+    _, st = _search(monkeypatch, blocks)
+    why = st.pair_tried.refused
+    assert why.startswith("their gain over the round's reference model is carried by a few blocks ("), why
+    assert "; not decisive against dispersion alone (0 +- 0 nats); not decisive against clearance alone (" in why
 
 
 def test_a_single_cause_that_passes_alone_is_named_without_a_joint_fit(monkeypatch):

@@ -95,13 +95,17 @@ def admitted(joint, reference, a, b, ranked: Sequence, rule) -> tuple[JointEvide
     when it does). ``reference``: the round's; ``a``, ``b``: :func:`leads`; ``ranked``: the round's candidates;
     ``rule``: the :class:`~.verdict.NamingRule`."""
     evidence = joint_evidence(joint, reference, a, b, rule)
+    failed = []  # every comparison the pair fails, in the order reference, a, b
     for label, (d, se, dt, st) in evidence.against.items():
         other = "the round's reference model" if label == "reference" else f"{label} alone"
         if not RULE.decisive(d, se):
-            return evidence, f"not decisive against {other} ({d:.0f} +- {se:.0f} nats)"
-        if not RULE.decisive(dt, st):
-            return evidence, (f"their gain over {other} is carried by a few blocks ({d:.0f} +- {se:.0f} nats; "
-                              f"{dt:.0f} +- {st:.0f} without the {100 * rule.drop_fraction:.0f} % most in its favour)")
+            failed.append(f"not decisive against {other} ({_whole(d)} +- {_whole(se)} nats)")
+        elif not RULE.decisive(dt, st):
+            failed.append(f"their gain over {other} is carried by a few blocks ({_whole(d)} +- {_whole(se)} nats; "
+                          f"{_whole(dt)} +- {_whole(st)} without the {100 * rule.drop_fraction:.0f} % most in its "
+                          "favour)")
+    if failed:
+        return evidence, "; ".join(failed)
     drop = points_to_drop(len(reference.elpd.pointwise), rule.drop_fraction)
     pair = {a.fit.label, b.fit.label}
     for r in ranked:
@@ -109,6 +113,12 @@ def admitted(joint, reference, a, b, ranked: Sequence, rule) -> tuple[JointEvide
                                                    carried=True) != "elpd":
             return evidence, f"does not rule out {r.fit.variants[-1].label}"
     return evidence, None
+
+
+def _whole(x: float) -> str:
+    """``x`` to the nat, a negative zero written 0."""
+    out = f"{x:.0f}"
+    return "0" if out == "-0" else out
 
 
 def confirms(verdict, ranked: Sequence, partner: str) -> bool:
