@@ -91,7 +91,8 @@ def joint_test(prep, dg, maker) -> dict | None:
     resolved = maker.resolved(joint)
     fq = np.quantile(resolved.f_effective, [0.05, 0.5, 0.95])
     return {"applies": True, "pair": [a.fit.variants[-1].label, b.fit.variants[-1].label], "against": against,
-            "passes": refused is None, "refused": refused, "still_flagged": bool(misfit_detected(prep, maker.predictive(joint))),
+            "passes": refused is None, "refused": refused,
+            "still_flagged": bool(misfit_detected(prep, maker.predictive(joint))),
             "f": [float(x) for x in fq]}
 
 

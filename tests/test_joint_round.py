@@ -3,6 +3,7 @@ rounds of ``diagnose`` on stand-in fits whose block ELPDs are set by hand."""
 
 from types import SimpleNamespace
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
@@ -12,6 +13,8 @@ from friction_uq.discrepancy.block_loo import Elpd
 from friction_uq.discrepancy.extended import Variant
 from friction_uq.discrepancy.mechanisms import MECHANISMS
 from friction_uq.discrepancy.outcome import named_together, pair_tried
+from friction_uq.report.diagnose_pages import _ranking_axes
+from friction_uq.report.style import figure
 from stand_ins import StandInFit
 
 N = 300
@@ -115,7 +118,8 @@ def test_two_effects_neither_of_which_explains_the_misfit_alone_are_named_togeth
     assert js[0]["round"] == 1 and js[0]["causes"] == ["dispersion", "clearance"]
     assert set(js[0]["against"]) == {"reference", "dispersion", "clearance"}
     tried = pair_tried(dgn)
-    assert tried["named_together"] and tried["refused"] is None and tried["causes"] == ["dispersion", "clearance"]
+    assert tried["named_together"] and tried["admitted"] and tried["refused"] is None
+    assert tried["causes"] == ["dispersion", "clearance"]
     assert tried["against"] == js[0]["against"]
     assert round_clauses.pair_refused_clause(dgn) == ""
 
@@ -132,10 +136,11 @@ def test_a_pair_the_next_round_does_not_confirm_leaves_the_round_unexplained(mon
     assert round_clauses.joint_clause(dgn) == ""
     # the trial is kept, with what round 2 found instead of the partner
     why = st.pair_tried.refused
-    assert why == "round 2 did not name clearance on top of dispersion: clearance and its rivals stayed candidates"
-    assert round_clauses.pair_refused_clause(dgn) == f" Fitted together, dispersion and clearance do not explain it " \
-                                                      f"either: {why}."
-    assert pair_tried(dgn)["named_together"] is False and pair_tried(dgn)["refused"] == why
+    assert why == "round 2 did not name clearance on top of dispersion (clearance and its rivals stayed candidates)"
+    assert round_clauses.pair_refused_clause(dgn) == (" Fitted together, dispersion and clearance pass the naming "
+                                                      f"rule, but {why}.")
+    js = pair_tried(dgn)
+    assert js["admitted"] is True and js["named_together"] is False and js["refused"] == why
 
 
 @pytest.mark.parametrize("gain", [1500.0, 1900.0])
@@ -148,7 +153,14 @@ def test_a_pair_that_does_not_rule_out_a_third_candidate_is_not_admitted(monkeyp
     assert "dispersion+clearance" in dg.made and not st.verdicts[0].candidates[2].decisive
     assert [v.kind for v in st.verdicts] == ["unexplained"] and st.verdicts[0].joint is None
     assert not any(m.startswith("dispersion+") and m != "dispersion+clearance" for m in dg.made)
-    assert st.pair_tried.refused == "does not rule out plug_friction"
+    assert st.pair_tried.refused == "does not rule out plug_friction" and not st.pair_tried.admitted
+    # the ranking page draws the refused pair's row, not bold, beside the round's candidates
+    fig, axes = figure("a ranking", nrows=1, ncols=2)
+    _ranking_axes(axes[0], _diagnosis(dg, st))
+    ticks = axes[0].get_yticklabels()
+    assert ticks[-1].get_text() == "1: dispersion + clearance together (not named)"
+    assert ticks[-1].get_fontweight() == "normal" and len(ticks) == 4
+    plt.close(fig)
     # without it the same pair is named
     blocks["plug_friction"] = _noise(0) + _at([200], 0.0)
     _, st = _search(monkeypatch, blocks)

@@ -212,7 +212,7 @@ def _search(dg: Diagnoser, prep: Prepared, st: _Search, *, max_causes: int, work
         verdict, best = _verdict(dg, st, ranked, k, max_causes=max_causes, seed=seed, say=say)
         if pair is not None and not confirms(verdict, ranked, pair.partner):
             why = not_confirmed(verdict, ranked, pair.partner, st.causes[-1].label, k + 1)
-            say(f"{why}; round {k} stays unexplained")
+            say(f"{why}: round {k} stays unexplained")
             _unjoin(st, k - 1, why)
             break
         if best is None:
@@ -263,7 +263,7 @@ def _joint(dg: Diagnoser, reference: ModelFit, ranked: tuple[Ranked, ...], verdi
     say(f"round 1 unexplained: {job[2]} fitted together")
     joint = dg.fit_many([job], cut=False)[0]
     evidence, refused = admitted(joint, reference, a, b, ranked, NAMING)
-    trial = PairTrial(1, (a.fit.variants[-1].label, evidence.partner), evidence, refused)
+    trial = PairTrial(1, (a.fit.variants[-1].label, evidence.partner), evidence, refused, admitted=refused is None)
     if refused is not None:
         say(f"round 1: {job[2]} not admitted, {refused} (docs/methods.md, two causes named together)")
         return verdict, None, trial

@@ -43,12 +43,14 @@ class JointEvidence:
 @dataclass(frozen=True)
 class PairTrial:
     """A first round's two leading candidates fitted together: their variant labels (the first, then its partner), the
-    joint model's evidence, and why the two were not named together (None: they were)."""
+    joint model's evidence, why the two were not named together (None: they were), and whether the pair passed its
+    own tests (:func:`admitted`; then only the next round's confirmation can have refused it)."""
 
     round: int
     causes: tuple[str, str]
     evidence: JointEvidence
     refused: str | None = None
+    admitted: bool = False
 
 
 def leads(verdict, ranked: Sequence) -> tuple | None:
@@ -132,10 +134,11 @@ def confirms(verdict, ranked: Sequence, partner: str) -> bool:
 
 def not_confirmed(verdict, ranked: Sequence, partner: str, first: str, k: int) -> str:
     """Why round ``k`` (1-based; ``ranked``: its candidates), the one after a pair's first cause ``first``, did not
-    confirm its ``partner`` (:func:`confirms`): what that round found instead."""
+    confirm its ``partner`` (:func:`confirms`): what that round found instead. Round ``k`` is judged as a later round:
+    with no misfit flagged it names nothing ("none")."""
     best = next((r.fit.variants[-1].label for r in ranked if r.fit.label == verdict.named), verdict.named)
     found = {"named": f"it named {best}", "candidates": f"{best} and its rivals stayed candidates",
-             "unexplained": "its misfit stayed unexplained", "unconfirmed": "the check no longer flagged a misfit"}
+             "unexplained": "its misfit stayed unexplained"}
     said = (f"{best} stayed in the model within the check's tolerance, not named"
             if verdict.within_tolerance else found.get(verdict.kind, "no mechanism passed the naming rule"))
-    return f"round {k} did not name {partner} on top of {first}: {said}"
+    return f"round {k} did not name {partner} on top of {first} ({said})"

@@ -118,12 +118,13 @@ def named_together(dg: Diagnosis) -> list[dict[str, object]]:
 
 def pair_tried(dg: Diagnosis) -> dict[str, object] | None:
     """The JSON's ``pair_tried``: the first round's two leading candidates fitted together where neither alone
-    explained its misfit (:mod:`.joint_round`), their evidence as in ``named_together``, whether they were named
-    together and, if not, why; None when no pair was tried."""
+    explained its misfit (:mod:`.joint_round`), their evidence as in ``named_together``, whether the pair passed its
+    own tests (``admitted``), whether they were named together and, if not, why; None when no pair was tried."""
     t = dg.pair_tried
     if t is None:
         return None
-    return {"round": t.round, "causes": list(t.causes), "named_together": t.refused is None, "refused": t.refused,
+    return {"round": t.round, "causes": list(t.causes), "admitted": t.admitted, "named_together": t.refused is None,
+            "refused": t.refused,
             "against": {m: {"delpd": d, "se": se, "delpd_rest": dt, "se_rest": st}
                         for m, (d, se, dt, st) in t.evidence.against.items()}}
 

@@ -134,8 +134,11 @@ def joint_clause(dg: Diagnosis) -> str:
 
 def pair_refused_clause(dg: Diagnosis) -> str:
     """' Fitted together, X and Y do not explain it either: ...' where the first round's two leading candidates were
-    fitted together and not named (:mod:`.joint_round`), and the round stayed unexplained; '' otherwise."""
+    fitted together and refused (:mod:`.joint_round`), or ' ... pass the naming rule, but round 2 did not name Y on
+    top of X (...)' where the next round did not confirm them; the round stayed unexplained. '' otherwise."""
     t = dg.pair_tried
-    if t is None or t.refused is None or dg.causes:
+    if t is None or t.refused is None:
         return ""
+    if t.admitted:
+        return f" Fitted together, {t.causes[0]} and {t.causes[1]} pass the naming rule, but {t.refused}."
     return f" Fitted together, {t.causes[0]} and {t.causes[1]} do not explain it either: {t.refused}."

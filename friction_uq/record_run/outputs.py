@@ -58,8 +58,8 @@ def reproducible(dt):
 
 
 #: The run's JSON: its schema name and version (14: ``discrepancy.pair_tried``, the pair fitted together on an
-#: unexplained first round, named or refused and why; 13: ``discrepancy.named_together``, two causes named together where
-#: neither alone explained the misfit; 12: ``warning_kinds``, each warning's kind beside it, a misfit
+#: unexplained first round, named or refused and why; 13: ``discrepancy.named_together``, two causes named together
+#: where neither alone explained the misfit; 12: ``warning_kinds``, each warning's kind beside it, a misfit
 #: ``misfit_diagnosed`` where f under the causes ``diagnose`` named is the f to quote; 11: a diagnosed ``f`` holds, where the hoop gauge and nu's prior
 #: disagree, the diagnosed f and the stationary f from nu's prior alone in equal parts, their medians in
 #: ``f.readings_of_nu``; 10: ``hoop_or_prior``, f with the hoop gauge and from nu's prior

@@ -24,12 +24,16 @@ from ..discrepancy.whole_record import CHANNEL_LABELS
 from .style import figure
 
 
-#: The ranking page's text column: its margins from the page's right edge and foot and its gap from the ranking
-#: (fractions of the page), and the spacing of its lines (in font sizes).
+#: The ranking page's text column: its margins from the page's right edge and foot, its gap from the ranking and its
+#: least width should the ranking reach that far right (fractions of the page), and the spacing of its lines (in font
+#: sizes).
 RIGHT_MARGIN = 0.02
 BOTTOM_MARGIN = 0.03
 COLUMN_GAP = 0.02
+MIN_COLUMN = 0.25
 LINE_SPACING = 1.2
+#: Points from the ranking's lower edge to its legend's top: below the tick labels and the two-line axis label.
+LEGEND_DROP = 44.0
 
 
 def _ranking_axes(ax, dg: Diagnosis) -> None:
@@ -37,6 +41,7 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
     with the causes named before), the named cause's label in bold; what the colours mean in the legend."""
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
+    from matplotlib.transforms import ScaledTranslation
 
     rows, labels, named, seps, colours = [], [], [], [], []
     for k, rnd in enumerate(dg.rounds):
@@ -88,8 +93,10 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
               ["decisive with the 5 % of blocks most in its favour left out: spread over the record, whatever\n"
                "its whole-record bar (bold: the cause named in that round)",
                "decisive, but carried by a few blocks (5 % left out: not decisive)", "not decisive", "dELPD = 4"],
-              # below the axes: inside, it covered the last round's lowest bars (B-02's fourth round)
-              loc="upper left", bbox_to_anchor=(0.0, -0.1), fontsize=7, ncols=2, title_fontsize=7,
+              # below the axes and their two-line label, a fixed distance in points whatever the axes' height:
+              # inside, it covered the last round's lowest bars (B-02's fourth round)
+              loc="upper left", bbox_to_anchor=(0.0, 0.0), fontsize=7, ncols=2, title_fontsize=7,
+              bbox_transform=ax.transAxes + ScaledTranslation(0.0, -LEGEND_DROP / 72.0, ax.figure.dpi_scale_trans),
               title="w: stacking weight, the share of the record's predictions the model carries against the "
                     "round's reference and the other mechanisms", alignment="left")
     ax.set_title("rounds 1, 2, ...: each mechanism added to the model of the round before", fontsize=9)
@@ -162,30 +169,30 @@ def page_ranking(dg: Diagnosis, *, f_without: dict[str, float], sentence: str, t
 
 def column_text(fig: Figure, beside, lines: list[str], *, size: float = 8.0, smallest: float = 5.5) -> None:
     """``lines`` wrapped into the column from just right of the axes ``beside`` to the page's right margin and from
-    their top to the page's foot (or to their label's and legend's top where those reach under it), at ``size`` pt or, where they would run past the foot, smaller (not below
-    ``smallest``). The column is measured once the page is laid out: the ranking's tick labels decide where it
-    starts, and a fixed count of characters ran past the page's edge where they were long (a refused pair's row)."""
+    their top to the page's foot (or to their label's and legend's top where those reach under it), at ``size`` pt
+    or the largest size down to ``smallest`` at which they fit. Measured once the page is laid out: the ranking's
+    tick labels decide where the column starts (a fixed count of characters ran past the page's edge)."""
+    fig.draw_without_rendering()  # the label and legend where the layout put them, not where they were drawn last
     renderer = fig.canvas.get_renderer()
     pos = beside.get_position()
-    left = pos.x1 + COLUMN_GAP
+    left = min(pos.x1 + COLUMN_GAP, 1.0 - RIGHT_MARGIN - MIN_COLUMN)
     width = (1.0 - RIGHT_MARGIN - left) * fig.bbox.width
-    foot = BOTTOM_MARGIN * fig.bbox.height  # or above the axes' label and legend where they reach under the column
+    foot = BOTTOM_MARGIN * fig.bbox.height
     for art in (beside.xaxis.label, beside.get_legend()):
         box = art.get_window_extent(renderer) if art is not None else None
         if box is not None and box.x1 > left * fig.bbox.width:
             foot = max(foot, box.y1 + COLUMN_GAP * fig.bbox.height)
     height = pos.y1 * fig.bbox.height - foot
-    sample = " ".join(lines)[:600] or "x"
-    for _ in range(4):
+    sample = " ".join(" ".join(lines).split())[:600] or "x"
+    while True:
         probe = fig.text(0.0, 0.0, sample, fontsize=size)
-        per_char = probe.get_window_extent(renderer).width / len(sample)
+        per_char = max(probe.get_window_extent(renderer).width / len(sample), 1e-3)
         probe.remove()
-        text = "\n".join(textwrap.fill(line, max(20, int(0.95 * width / per_char))) if line else line
-                         for line in lines)
-        needed = (text.count("\n") + 1) * LINE_SPACING * size * fig.dpi / 72.0
-        if needed <= height or size <= smallest:
+        wrap = max(20, int(0.95 * width / per_char))
+        text = "\n".join(textwrap.fill(line, wrap) if line else line for line in lines)
+        if (text.count("\n") + 1) * LINE_SPACING * size * fig.dpi / 72.0 <= height or size <= smallest:
             break
-        size = max(smallest, size * height / needed)
+        size = max(smallest, size - 0.25)
     fig.text(left, pos.y1, text, va="top", fontsize=size, linespacing=LINE_SPACING)
 
 
