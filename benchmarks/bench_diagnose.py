@@ -79,7 +79,11 @@ def true_f(cfg, prep) -> float:
     if law == "slip_weakening":
         return p["f_d"] + (p["f_s"] - p["f_d"]) * max(0.0, 1.0 - slip / p["d_c"])
     if law == "hyperbolic":  # p_mean from tau_mean and the truth's f (fixed point)
-        tau = float(np.mean(d.F_eo)) / (2 * math.pi * d.radius * d.length)
+        # the wall's shear from the force the external bar carries: the record reads it through its header's modulus,
+        # which a bar_modulus fault sets apart from the simulated bar's (the fault's own bias is not the wall's f)
+        carried = (cfg.apparatus.external_output_bar.young_modulus
+                   / prep.record.apparatus.external_output_bar.young_modulus)
+        tau = carried * float(np.mean(d.F_eo)) / (2 * math.pi * d.radius * d.length)
         f = p["f0"]
         for _ in range(50):
             f = p["f0"] / (1.0 + tau / f / p["p0"])
