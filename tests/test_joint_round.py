@@ -122,6 +122,11 @@ def test_two_effects_neither_of_which_explains_the_misfit_alone_are_named_togeth
     assert tried["causes"] == ["dispersion", "clearance"]
     assert tried["against"] == js[0]["against"]
     assert round_clauses.pair_refused_clause(dgn) == ""
+    fig, axes = figure("a ranking", nrows=1, ncols=2)  # the page's row for the pair, bold: named
+    _ranking_axes(axes[0], dgn)
+    rows = {t.get_text(): t.get_fontweight() for t in axes[0].get_yticklabels()}
+    assert rows["1: dispersion + clearance together"] == "bold"
+    plt.close(fig)
 
 
 def test_a_pair_the_next_round_does_not_confirm_leaves_the_round_unexplained(monkeypatch):

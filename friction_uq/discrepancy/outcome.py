@@ -110,10 +110,14 @@ def named_together(dg: Diagnosis) -> list[dict[str, object]]:
     """The JSON's ``named_together``: each pair of causes named together (:mod:`.joint_round`), their round unexplained
     by either alone; the two fitted together against the round's reference and each alone (dELPD, SE; and without the
     5 % of blocks most in the pair's favour); the second named by the next round on top of the first."""
-    return [{"round": k + 1, "causes": [dg.causes[k].label, v.joint.partner],
-             "against": {m: {"delpd": d, "se": se, "delpd_rest": dt, "se_rest": st}
-                         for m, (d, se, dt, st) in v.joint.against.items()}}
+    return [{"round": k + 1, "causes": [dg.causes[k].label, v.joint.partner], "against": _against(v.joint)}
             for k, v in enumerate(dg.verdicts[:len(dg.causes)]) if v.joint is not None]
+
+
+def _against(evidence) -> dict[str, dict[str, float]]:
+    """A pair's evidence (:class:`.joint_round.JointEvidence`) against the round's reference and each alone."""
+    return {m: {"delpd": d, "se": se, "delpd_rest": dt, "se_rest": st}
+            for m, (d, se, dt, st) in evidence.against.items()}
 
 
 def pair_tried(dg: Diagnosis) -> dict[str, object] | None:
@@ -124,9 +128,7 @@ def pair_tried(dg: Diagnosis) -> dict[str, object] | None:
     if t is None:
         return None
     return {"round": t.round, "causes": list(t.causes), "admitted": t.admitted, "named_together": t.refused is None,
-            "refused": t.refused,
-            "against": {m: {"delpd": d, "se": se, "delpd_rest": dt, "se_rest": st}
-                        for m, (d, se, dt, st) in t.evidence.against.items()}}
+            "refused": t.refused, "against": _against(t.evidence)}
 
 
 def _verdict_json(dg: Diagnosis) -> dict[str, object]:

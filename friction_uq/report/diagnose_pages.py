@@ -55,19 +55,13 @@ def _ranking_axes(ax, dg: Diagnosis) -> None:
             decisive = c.decisive if c is not None else r.decisive
             colours.append("tab:red" if (c.passes if c is not None else decisive) else
                            "tab:orange" if decisive else "0.6")
-        joint = dg.verdicts[k].joint if k < len(dg.verdicts) else None
-        if joint is not None:  # a pair named together: the two fitted together against the round's reference
-            d, se, _, _ = joint.against["reference"]
-            rows.append(SimpleNamespace(delpd=d, se=se))
-            labels.append(f"{k + 1}: {dg.causes[k].label} + {joint.partner} together")
-            named.append(True)
-            colours.append("tab:red")
         tried = dg.pair_tried
-        if tried is not None and tried.refused is not None and tried.round == k + 1:  # fitted together, not named
+        if tried is not None and tried.round == k + 1:  # the round's pair fitted together, against its reference
             d, se, dt, st = tried.evidence.against["reference"]
             rows.append(SimpleNamespace(delpd=d, se=se))
-            labels.append(f"{k + 1}: {' + '.join(tried.causes)} together (not named)")
-            named.append(False)
+            labels.append(f"{k + 1}: {' + '.join(tried.causes)} together"
+                          + ("" if tried.refused is None else " (not named)"))
+            named.append(tried.refused is None)
             colours.append("tab:red" if RULE.decisive(dt, st) else "tab:orange" if RULE.decisive(d, se) else "0.6")
         seps.append(len(rows))
     y = np.arange(len(rows))[::-1]
