@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from friction_uq.analysis import prepare
-from friction_uq.discrepancy.extended import Diagnoser, Variant
+from friction_uq.discrepancy.extended import Diagnoser, Variant, nominal_starts
 from friction_uq.discrepancy.mechanisms import MECHANISMS
 from friction_uq.discrepancy.nu_cut import CutFit, NuCut, conditional_fit, cut_draws, window_nu
 from friction_uq.discrepancy.fit import WholeRecordFit
@@ -150,7 +150,10 @@ def test_the_windows_nu_takes_no_mechanism_parameter_from_the_joint_fit(record, 
     """The first module reads nu from the stationary windows with the clearance's gap free under its prior: started
     from two gaps (the joint fit's mode is only a start) it finds the same nu, and its interval holds the truth.
     With the gap held at the start (before the thirty-fifth session) nu followed it: 0.3994 +- 0.0082 from the true
-    gap, 0.3948 from half of it, 0.390 from none; free, 0.4029-0.4034 +- 0.0118 from all three."""
+    gap, 0.3948 from half of it, 0.390 from none; free, 0.4029-0.4034 +- 0.0118 from all three. With numpy 2.5,
+    scipy 1.18 and numba 0.68 the search from the true gap stopped in a dip 0.008 above the lowest cost found, nu
+    0.4014 against 0.4028 from half the gap (0.12 sd): diagnose's search now also starts from the clearance's
+    nominal gap (``nominal_starts``), and keeps the lowest."""
     _, log_prior, scales = record
     dg = Diagnoser(gap_record, log_prior, hoop=True, seed=5, base_scales=scales)
     variants = (Variant(MECHANISMS["clearance"]),)
@@ -159,7 +162,7 @@ def test_the_windows_nu_takes_no_mechanism_parameter_from_the_joint_fit(record, 
           **MECHANISMS["clearance"].prior_z()}
     start = {"f": TRUE_F, "nu": TRUE_NU, "sample_modulus": dg.E0}
     cuts = [window_nu(gap_record, model, lp, start | {"gap": gap}, n_draws=2000, rng=np.random.default_rng(3),
-                      prior_scale=sc) for gap in (TRUE_GAP, 0.5 * TRUE_GAP)]
+                      prior_scale=sc, extra_starts=nominal_starts(variants)) for gap in (TRUE_GAP, 0.5 * TRUE_GAP)]
     sd = float(np.std(cuts[0].draws))
     assert abs(cuts[0].centre - cuts[1].centre) < 0.1 * sd
     lo, hi = np.quantile(cuts[0].draws, [0.05, 0.95])

@@ -90,6 +90,14 @@ def _key(mf: ModelFit) -> tuple:
     return (mf.label, tuple(sorted(mf.fit.mode.items())))
 
 
+def nominal_starts(variants: tuple[Variant, ...]) -> tuple[dict[str, float], ...]:
+    """The mechanisms' own nominal start (``Mechanism.start``) as one further start of a search (none for the
+    reference model): a search from the joint fit's mode alone can stop in a shallow dip of a rough surface."""
+    if not variants:
+        return ()
+    return ({p.name: v.mechanism.start[p.name] for v in variants for p in v.mechanism.parameters},)
+
+
 class Diagnoser:
     """Fits and scores extended models of one record (module docstring)."""
 
@@ -230,7 +238,7 @@ class Diagnoser:
         log_prior, scales = self.log_prior(mf.variants), self._scales(mf.variants)
         nu_window = window_nu(self.prep, lik.model, log_prior, dict(mode) | {"sample_modulus": self.E0},
                               n_draws=NU_WINDOW_DRAWS, rng=stream(self.seed, "nu window", label), prior_scale=scales,
-                              hoop_calibration=self.hoop_calibration)
+                              hoop_calibration=self.hoop_calibration, extra_starts=nominal_starts(mf.variants))
         return conditional_fit(lik, log_prior, mode, nu_window, n_draws=self.n_draws,
                                rng=stream(self.seed, "nu cut", label), prior_scale=scales,
                                score_blocks=lik.blocks(self.block))
