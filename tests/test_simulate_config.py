@@ -122,7 +122,8 @@ def test_the_written_record_follows_the_contract(tmp_path: Path) -> None:
         ("[loading]\nstriker_velocity = true\n", "key 'loading.striker_velocity' must be a number, got True"),
         ("[sample]\npoisson_ratio = 0.6\n", "key 'sample.poisson_ratio' must lie in [0.01, 0.49], got 0.6"),
         ("[friction]\nlaw = \"colomb\"\n", "key 'friction.law' is 'colomb', allowed values: coulomb, velocity, "
-                                          "pressure, hyperbolic, slip_weakening"),
+                                          "pressure, hyperbolic, slip_weakening, velocity_stretched, "
+                                          "pressure_saturating, slip_power"),
         ("[friction]\nlaw = \"velocity\"\nf_s = 0.1\nf_d = 0.05\n", "key 'friction.v_c' is missing; law "
                                                                   "'velocity' needs f_s, f_d, v_c"),
         ("[friction]\nlaw = \"coulomb\"\nf = 0.1\nf_s = 0.2\n", "unknown key 'friction.f_s'; allowed keys in "

@@ -152,11 +152,43 @@ def test_dispersion_puts_oscillations_on_the_fronts() -> None:
 def test_every_registered_law_reduces_to_coulomb_in_its_limit() -> None:
     p, f = 80e6, 0.07
     limits = {"coulomb": [f], "velocity": [f, f, 1.0], "pressure": [f, 1e12], "hyperbolic": [f, 1e20],
-              "slip_weakening": [f, f, 1e-3]}
+              "slip_weakening": [f, f, 1e-3], "velocity_stretched": [f, f, 1.0, 2.0],
+              "pressure_saturating": [f, 1e20, 3.0], "slip_power": [f, f, 1e-3, 0.5]}
     assert set(limits) == set(LAWS)
     for name, law in LAWS.items():
         value = shear_strength(law.code, np.array(limits[name]), p, 5.0, 2e-3)
         assert value == pytest.approx(f * p, rel=1e-9), name
+
+
+@pytest.mark.parametrize("p", [1e6, 5e7, 8e7, 3e8])
+@pytest.mark.parametrize("v", [0.0, 2.0, 9.0])
+@pytest.mark.parametrize("d", [0.0, 4e-4, 2e-3])
+def test_each_shaped_family_is_its_simple_law_at_n_one(p, v, d) -> None:
+    pairs = {"velocity_stretched": ("velocity", [0.09, 0.04, 5.0]), "pressure_saturating": ("hyperbolic", [0.08, 7e7]),
+             "slip_power": ("slip_weakening", [0.11, 0.05, 1e-3])}
+    for family, (simple, par) in pairs.items():
+        shaped = shear_strength(LAWS[family].code, np.array(par + [1.0]), p, v, d)
+        assert shaped == pytest.approx(shear_strength(LAWS[simple].code, np.array(par), p, v, d), rel=1e-12), family
+
+
+def test_the_saturating_family_bends_from_coulomb_to_the_shear_cap_as_n_grows() -> None:
+    f0, p0 = 0.08, 6e7
+    code = LAWS["pressure_saturating"].code
+    cap = shear_strength(LAWS["pressure"].code, np.array([f0, f0 * p0]), 2e8, 0.0, 0.0)
+    assert shear_strength(code, np.array([f0, p0, 400.0]), 2e8, 0.0, 0.0) == pytest.approx(cap, rel=1e-3)
+    assert shear_strength(code, np.array([f0, p0, 400.0]), 2e7, 0.0, 0.0) == pytest.approx(f0 * 2e7, rel=1e-3)
+    below = [shear_strength(code, np.array([f0, p0, n]), p0, 0.0, 0.0) for n in (0.5, 1.0, 2.0, 8.0)]
+    assert below == pytest.approx([f0 * p0 * 2.0 ** (-1.0 / n) for n in (0.5, 1.0, 2.0, 8.0)], rel=1e-12)
+    assert np.all(np.diff(below) > 0)  # the larger n, the later the turn
+    assert np.isfinite(shear_strength(code, np.array([f0, 1e3, 1e3]), 1e9, 0.0, 0.0))  # x^n would overflow
+
+
+def test_the_power_slip_family_with_a_long_reach_is_an_exponential_drop() -> None:
+    """max(0, 1 - d/d_c)^n -> exp(-d/d_e) with d_c = n d_e as n grows (an exponential slip-weakening wall)."""
+    d_e, code = 5e-4, LAWS["slip_power"].code
+    for d in (0.0, 2e-4, 1e-3, 3e-3):
+        got = shear_strength(code, np.array([0.1, 0.04, 200 * d_e, 200.0]), 1e8, 0.0, d)
+        assert got == pytest.approx((0.04 + 0.06 * np.exp(-d / d_e)) * 1e8, rel=2e-3)
 
 
 def test_hoop_axial_term_adds_the_poisson_swelling_of_the_tube_load() -> None:

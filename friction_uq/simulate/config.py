@@ -25,7 +25,8 @@ file and the key.
 
     [friction]                  # sample/tube wall; the parameters depend on the law
     law = "coulomb"             # coulomb: f | velocity: f_s f_d v_c | pressure: f tau_max
-    f = 0.05                    # hyperbolic: f0 p0 | slip_weakening: f_s f_d d_c
+    f = 0.05                    # hyperbolic: f0 p0 | slip_weakening: f_s f_d d_c | velocity_stretched: f_s f_d
+                                # v_c n | pressure_saturating: f0 p0 n | slip_power: f_s f_d d_c n (friction.py)
 
     [cell]
     gap = 0.0                   # radial clearance sample/tube, m, [0, 1e-4]

@@ -15,6 +15,16 @@ Laws (docs/physics.md section 5):
 ``hyperbolic``      tau = f0 p / (1 + p / p0)                       (pressure dependent, smooth)
 ``slip_weakening``  tau = [f_d + (f_s - f_d) max(0, 1 - d / d_c)] p (linear weakening over d_c)
 
+and three families that hold a law above as their shape n = 1 and bend it either way (what ``diagnose``'s
+friction mechanisms fit, so that one formula does not decide which family a wall is read as):
+
+``velocity_stretched``   tau = [f_d + (f_s - f_d) exp(-(V / v_c)^n)] p    (n = 1: ``velocity``; n = 2 a sharper
+                         turn; n < 1 a slow, power-like tail)
+``pressure_saturating``  tau = f0 p / (1 + (p / p0)^n)^(1/n)             (n = 1: ``hyperbolic``; n large: the
+                         cap of ``pressure`` at tau_max = f0 p0)
+``slip_power``           tau = [f_d + (f_s - f_d) max(0, 1 - d / d_c)^n] p (n = 1: ``slip_weakening``; n large
+                         with d_c = n d_e: an exponential drop over d_e)
+
 Adding a law touches this module only: one :class:`FrictionLaw` entry in :data:`LAWS` (name,
 code, parameters with units and bounds) and one branch of :func:`shear_strength`. The
 configuration reader, the ``/truth`` group and the documentation read the registry.
@@ -71,6 +81,8 @@ class FrictionLaw:
 
 _F = 5.0  # largest friction coefficient accepted (far beyond any lubricated interface)
 COULOMB, VELOCITY, PRESSURE, HYPERBOLIC, SLIP_WEAKENING = 0, 1, 2, 3, 4
+VELOCITY_STRETCHED, PRESSURE_SATURATING, SLIP_POWER = 5, 6, 7
+_N = Param("n", "-", 0.0, 1e3, "shape of the change (n = 1: the family's simple law)", low_open=True)
 
 LAWS: dict[str, FrictionLaw] = {
     "coulomb": FrictionLaw("coulomb", COULOMB, (
@@ -94,7 +106,37 @@ LAWS: dict[str, FrictionLaw] = {
         Param("f_d", "-", 0.0, _F, "dynamic coefficient after the slip d_c"),
         Param("d_c", "m", 0.0, 1.0, "critical slip distance", low_open=True),
     ), "tau = [f_d + (f_s - f_d) max(0, 1 - d/d_c)] p"),
+    "velocity_stretched": FrictionLaw("velocity_stretched", VELOCITY_STRETCHED, (
+        Param("f_s", "-", 0.0, _F, "coefficient at zero sliding speed"),
+        Param("f_d", "-", 0.0, _F, "coefficient at high sliding speed"),
+        Param("v_c", "m/s", 0.0, 1e3, "characteristic speed", low_open=True),
+        _N,
+    ), "tau = [f_d + (f_s - f_d) exp(-(V/v_c)^n)] p"),
+    "pressure_saturating": FrictionLaw("pressure_saturating", PRESSURE_SATURATING, (
+        Param("f0", "-", 0.0, _F, "coefficient at zero pressure"),
+        Param("p0", "Pa", 0.0, 1e11, "pressure at which f0 p meets the shear cap f0 p0", low_open=True),
+        _N,
+    ), "tau = f0 p / (1 + (p/p0)^n)^(1/n)"),
+    "slip_power": FrictionLaw("slip_power", SLIP_POWER, (
+        Param("f_s", "-", 0.0, _F, "static (initial) coefficient"),
+        Param("f_d", "-", 0.0, _F, "dynamic coefficient after the slip d_c"),
+        Param("d_c", "m", 0.0, 1.0, "slip at which the coefficient reaches f_d", low_open=True),
+        _N,
+    ), "tau = [f_d + (f_s - f_d) max(0, 1 - d/d_c)^n] p"),
 }
+
+
+@njit
+def saturation(x: float, n: float) -> float:
+    """(1 + x^n)^(1/n) for x >= 0, n > 0, written so that neither power overflows (x^n for x > 1 and large n):
+    1 at x = 0, x for x >> 1, their smooth join at x = 1 (2^(1/n)).
+
+    >>> round(saturation(3.0, 1.0), 12), round(saturation(3.0, 1e3), 6), round(saturation(0.5, 1e3), 6)
+    (4.0, 3.0, 1.0)
+    """
+    if x <= 1.0:
+        return (1.0 + x ** n) ** (1.0 / n)
+    return x * (1.0 + x ** (-n)) ** (1.0 / n)
 
 
 @njit
@@ -119,4 +161,11 @@ def shear_strength(code: int, par: np.ndarray, p: float, v: float, d: float) -> 
     if code == SLIP_WEAKENING:
         w = 1.0 - d / par[2]
         return (par[1] + (par[0] - par[1]) * (w if w > 0.0 else 0.0)) * p
+    if code == VELOCITY_STRETCHED:
+        return (par[1] + (par[0] - par[1]) * math.exp(-((v / par[2]) ** par[3]))) * p
+    if code == PRESSURE_SATURATING:
+        return par[0] * p / saturation(p / par[1], par[2])
+    if code == SLIP_POWER:
+        w = 1.0 - d / par[2]
+        return (par[1] + (par[0] - par[1]) * (w ** par[3] if w > 0.0 else 0.0)) * p
     return math.nan  # unknown code: poisons the run instead of failing silently
