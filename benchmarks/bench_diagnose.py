@@ -46,6 +46,7 @@ from friction_uq.prior_loader import default_prior_path, load_priors  # noqa: E4
 from friction_uq.record import read_record  # noqa: E402
 from friction_uq.sampler import LogPosterior, start_ball  # noqa: E402
 from friction_uq.simulate import simulate_to_file  # noqa: E402
+from friction_uq.simulate.simulation import run_any  # noqa: E402
 
 #: Hidden mechanism -> config edit at a detectable strength (and the truth's f at the window).
 HIDDEN = {
@@ -65,6 +66,32 @@ HIDDEN = {
     "end_friction": lambda c, r: dataclasses.replace(c, end_friction=float(r.uniform(0.3, 0.5))),
 }
 
+#: The friction families at shapes other than the catalogue's simple laws (its n = 1): a velocity law turning
+#: sharper or slower than an exponential, a shear cap (the simulator's ``pressure`` law, which no finite shape of
+#: the catalogue's saturating wall is), an exponential slip weakening. Group -> (the family that should be named,
+#: config edit); the strengths are HIDDEN's.
+SHAPES = {
+    "velocity_shape": ("velocity_friction", lambda c, r: dataclasses.replace(
+        c, friction_law="velocity_stretched", friction_params=MappingProxyType(
+            {"f_s": float(r.uniform(0.07, 0.09)), "f_d": float(r.uniform(0.03, 0.04)), "v_c": float(r.uniform(5, 10)),
+             "n": float(r.choice([0.5, 2.5]))}))),
+    "pressure_cap": ("pressure_friction", lambda c, r: _cap(c, float(r.uniform(0.07, 0.1)), float(r.uniform(5e7, 8e7)))),
+    "slip_exponential": ("slip_friction", lambda c, r: _exponential_slip(
+        c, float(r.uniform(0.09, 0.12)), float(r.uniform(0.04, 0.06)), float(r.uniform(3e-4, 1e-3)))),
+}
+
+
+def _cap(c, f: float, p_cap: float):
+    """tau = min(f p, f p_cap): Coulomb below the wall pressure p_cap, the shear strength f p_cap above."""
+    return dataclasses.replace(c, friction_law="pressure", friction_params=MappingProxyType(
+        {"f": f, "tau_max": f * p_cap}))
+
+
+def _exponential_slip(c, f_s: float, f_d: float, d_e: float):
+    """f = f_d + (f_s - f_d) exp(-d / d_e), as the power family's long reach (n = 200, d_c = 200 d_e)."""
+    return dataclasses.replace(c, friction_law="slip_power", friction_params=MappingProxyType(
+        {"f_s": f_s, "f_d": f_d, "d_c": 200.0 * d_e, "n": 200.0}))
+
 
 def true_f(cfg, prep) -> float:
     """The wall's coefficient at the window's mean sliding speed, pressure and slip (as f_effective)."""
@@ -78,6 +105,12 @@ def true_f(cfg, prep) -> float:
         return p["f_d"] + (p["f_s"] - p["f_d"]) * math.exp(-V / p["v_c"])
     if law == "slip_weakening":
         return p["f_d"] + (p["f_s"] - p["f_d"]) * max(0.0, 1.0 - slip / p["d_c"])
+    if law == "velocity_stretched":
+        return p["f_d"] + (p["f_s"] - p["f_d"]) * math.exp(-((V / p["v_c"]) ** p["n"]))
+    if law == "slip_power":
+        return p["f_d"] + (p["f_s"] - p["f_d"]) * max(0.0, 1.0 - slip / p["d_c"]) ** p["n"]
+    if law == "pressure":
+        return capped_wall_f(cfg, prep.window.t0, prep.window.t1)
     if law == "hyperbolic":  # p_mean from tau_mean and the truth's f (fixed point)
         # the wall's shear from the force the external bar carries: the record reads it through its header's modulus,
         # which a bar_modulus fault sets apart from the simulated bar's (the fault's own bias is not the wall's f)
@@ -89,6 +122,17 @@ def true_f(cfg, prep) -> float:
             f = p["f0"] / (1.0 + tau / f / p["p0"])
         return f
     raise ValueError(law)
+
+
+def capped_wall_f(cfg, t0: float, t1: float) -> float:
+    """A shear cap has no coefficient at the window's mean shear stress (that stress is below the cap however much
+    of the wall sits on it): its truth is the wall's mean shear over its mean pressure in the window [t0, t1] (s),
+    from the noise-free simulation of ``cfg`` (equal elements along the wall)."""
+    model = run_any(cfg)
+    w = (model.time >= t0) & (model.time <= t1)
+    s = cfg.apparatus.sample
+    wall = 2.0 * math.pi * s.radius * s.length
+    return float(np.abs(model.wall_friction[w]).sum(axis=1).mean() / (wall * model.wall_pressure[w].mean()))
 
 
 def analyse(path: str, priors, seed: int, max_causes: int):

@@ -33,6 +33,7 @@ from types import SimpleNamespace
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_diagnose import SHAPES  # noqa: E402
 from bench_misfit import SETUPS  # noqa: E402
 
 from friction_uq.discrepancy.candidates_mixture import mixture
@@ -103,7 +104,11 @@ def _shared_delay(rec: dict, v) -> object:
 
 
 def hidden(group: str) -> str | None:
-    return None if group.startswith("clean") else group.removeprefix("axisymmetric_")
+    """The cause a group's records hold (a friction law at another shape: its family)."""
+    if group.startswith("clean"):
+        return None
+    name = group.removeprefix("axisymmetric_")
+    return SHAPES[name][0] if name in SHAPES else name
 
 
 def table(records: list[dict], rule: NamingRule) -> str:

@@ -20,7 +20,10 @@ Groups (f, nu, striker speed, rise time and noise drawn as in ``bench_misfit.py`
   microstrain over the record along an exponential, not the model's straight line), ``bar_modulus`` (one
   output bar's modulus 5-8 % off the header the record carries, its wave speed with it: the test simulated
   with the true bar, the record written with the header's); and the same four on records of the axisymmetric
-  simulation (``axisymmetric_<fault>``).
+  simulation (``axisymmetric_<fault>``);
+* the friction families at other shapes than the catalogue's simple laws (``bench_diagnose.SHAPES``: a velocity
+  law turning sharper or slower than an exponential, a shear cap, an exponential slip weakening), in both
+  simulations (``axisymmetric_<shape>``), drawn after every other group so that those draw as before.
 
 For each record: ``diagnose``'s first round (the baseline against every extended model), written as one
 ``.npz`` per record: each model's pointwise block ELPD and calibration terms, its draws of f_effective and its
@@ -51,7 +54,7 @@ import numpy as np
 from scipy import signal
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_diagnose import HIDDEN, analyse, analyse_as_run, true_f  # noqa: E402
+from bench_diagnose import HIDDEN, SHAPES, analyse, analyse_as_run, true_f  # noqa: E402
 from bench_misfit import clean_config  # noqa: E402
 from bench_trust import write_strains  # noqa: E402
 
@@ -140,7 +143,8 @@ def _shifted(ch: str, dt: float):
 def groups() -> list[str]:
     return (["clean_axisymmetric", "clean_perturbed"] + list(HIDDEN)
             + [f"axisymmetric_{m}" for m in AXISYMMETRIC_MECHANISMS] + list(CHAIN_FAULTS)
-            + [f"axisymmetric_{m}" for m in CHAIN_FAULTS])
+            + [f"axisymmetric_{m}" for m in CHAIN_FAULTS]
+            + list(SHAPES) + [f"axisymmetric_{m}" for m in SHAPES])  # last: the groups before draw as they did
 
 
 def make(group: str, k: int, r: np.random.Generator):
@@ -163,7 +167,7 @@ def make(group: str, k: int, r: np.random.Generator):
             cfg, note = _axisymmetric(cfg), f"axisymmetric, {note}"
     else:
         mech = group.removeprefix("axisymmetric_")
-        cfg = HIDDEN[mech](cfg, r)
+        cfg = SHAPES[mech][1](cfg, r) if mech in SHAPES else HIDDEN[mech](cfg, r)
         note = mech
         if group.startswith("axisymmetric_"):
             cfg, note = _axisymmetric(cfg), f"axisymmetric {mech}"

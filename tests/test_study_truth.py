@@ -35,3 +35,36 @@ def test_a_pressure_walls_truth_reads_the_force_the_external_bar_carries(ratio):
     if ratio != 1.0:  # the record's own force would give another truth: by some per cent of f here
         _, _, as_read = _case(205e9, 205e9)
         assert abs(expected - as_read) > 0.05 * expected
+
+
+def _capped(tau_max_over_f: float):
+    """A capped wall (the simulator's ``pressure`` law) and its noise-free simulation's window."""
+    import dataclasses
+    from types import MappingProxyType
+
+    from bench_diagnose import capped_wall_f
+    from bench_misfit import clean_config
+
+    from friction_uq.simulate.simulation import run_any
+
+    cfg = clean_config(np.random.default_rng(5), "A")
+    f = cfg.friction_params["f"]
+    cfg = dataclasses.replace(cfg, friction_law="pressure",
+                              friction_params=MappingProxyType({"f": f, "tau_max": f * tau_max_over_f}))
+    model = run_any(cfg)
+    t0, t1 = model.time[len(model.time) // 2], model.time[3 * len(model.time) // 4]
+    w = (model.time >= t0) & (model.time <= t1)
+    return f, capped_wall_f(cfg, t0, t1), float(model.wall_pressure[w].mean())
+
+
+def test_a_shear_caps_truth_is_the_walls_mean_shear_over_its_mean_pressure():
+    """A cap the wall never reaches leaves Coulomb's f; a cap at half the mean wall pressure's Coulomb shear brings
+    the truth to the cap over the mean pressure or below it (below where the pressure varies along the wall: the
+    mean of min(f p, tau_max) is at most min(f p_mean, tau_max)), never to the coefficient f the law was given."""
+    f, truth, _ = _capped(1e12)
+    assert truth == pytest.approx(f, rel=0.02)
+    f, _, p_mean = _capped(1.0)  # the window's mean wall pressure, uncapped at first
+    f, truth, p_capped = _capped(0.5 * p_mean)
+    cap = f * 0.5 * p_mean
+    assert truth <= cap / p_capped * (1 + 1e-9)
+    assert truth < 0.75 * f
