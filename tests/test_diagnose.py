@@ -435,8 +435,7 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
     import xarray as xr
 
     dt = xr.DataTree()
-    priors = load_priors(default_prior_path("I1"))
-    outcome.add_to_datatree(dt, dg, priors["f"], priors["nu"])
+    outcome.add_to_datatree(dt, dg, load_priors(default_prior_path("I1"))["f"])
     dt.to_netcdf(tmp_path / "d.nc")
     with xr.open_datatree(tmp_path / "d.nc") as back:
         ll = back["discrepancy_end_friction/log_likelihood"]
