@@ -66,10 +66,10 @@ HIDDEN = {
     "end_friction": lambda c, r: dataclasses.replace(c, end_friction=float(r.uniform(0.3, 0.5))),
 }
 
-#: The friction families at shapes other than the catalogue's simple laws (its n = 1): a velocity law turning
-#: sharper or slower than an exponential, a shear cap (the simulator's ``pressure`` law, which no finite shape of
-#: the catalogue's saturating wall is), an exponential slip weakening. Group -> (the family that should be named,
-#: config edit); the strengths are HIDDEN's.
+#: Walls of the simulator's friction families at shapes other than the catalogue's simple laws (their n = 1): a
+#: velocity law turning sharper or slower than an exponential, a shear cap (the simulator's ``pressure`` law, which
+#: no finite shape of the saturating family is), an exponential slip weakening. Group -> (the family that should be
+#: named, config edit); the strengths are HIDDEN's.
 SHAPES = {
     "velocity_shape": ("velocity_friction", lambda c, r: dataclasses.replace(
         c, friction_law="velocity_stretched", friction_params=MappingProxyType(

@@ -15,8 +15,9 @@ Laws (docs/physics.md section 5):
 ``hyperbolic``      tau = f0 p / (1 + p / p0)                       (pressure dependent, smooth)
 ``slip_weakening``  tau = [f_d + (f_s - f_d) max(0, 1 - d / d_c)] p (linear weakening over d_c)
 
-and three families that hold a law above as their shape n = 1 and bend it either way (what ``diagnose``'s
-friction mechanisms fit, so that one formula does not decide which family a wall is read as):
+and three families that hold a law above as their shape n = 1 and bend it either way: walls of other shapes for the
+studies of ``diagnose`` (whose friction mechanisms are the simple laws; fitting the families instead was measured and
+not applied, docs/trust.md, "Fifty-fifth session"):
 
 ``velocity_stretched``   tau = [f_d + (f_s - f_d) exp(-(V / v_c)^n)] p    (n = 1: ``velocity``; n = 2 a sharper
                          turn; n < 1 a slow, power-like tail)
