@@ -85,15 +85,24 @@ COULOMB, VELOCITY, PRESSURE, HYPERBOLIC, SLIP_WEAKENING = 0, 1, 2, 3, 4
 VELOCITY_STRETCHED, PRESSURE_SATURATING, SLIP_POWER = 5, 6, 7
 _N = Param("n", "-", 0.0, 1e3, "shape of the change (n = 1: the family's simple law)", low_open=True)
 
+#: the parameters a velocity and a slip law share with their families (which add the shape n)
+_VELOCITY_PARAMS = (
+    Param("f_s", "-", 0.0, _F, "coefficient at zero sliding speed"),
+    Param("f_d", "-", 0.0, _F, "coefficient at high sliding speed"),
+    Param("v_c", "m/s", 0.0, 1e3, "characteristic speed", low_open=True),
+)
+_SLIP_PARAMS = (
+    Param("f_s", "-", 0.0, _F, "static (initial) coefficient"),
+    Param("f_d", "-", 0.0, _F, "dynamic coefficient after the slip d_c"),
+    Param("d_c", "m", 0.0, 1.0, "critical slip distance: where the coefficient reaches f_d", low_open=True),
+)
+
 LAWS: dict[str, FrictionLaw] = {
     "coulomb": FrictionLaw("coulomb", COULOMB, (
         Param("f", "-", 0.0, _F, "friction coefficient"),
     ), "tau = f p (eq. 10)"),
-    "velocity": FrictionLaw("velocity", VELOCITY, (
-        Param("f_s", "-", 0.0, _F, "coefficient at zero sliding speed"),
-        Param("f_d", "-", 0.0, _F, "coefficient at high sliding speed"),
-        Param("v_c", "m/s", 0.0, 1e3, "characteristic speed", low_open=True),
-    ), "tau = [f_d + (f_s - f_d) exp(-V/v_c)] p"),
+    "velocity": FrictionLaw("velocity", VELOCITY, _VELOCITY_PARAMS,
+        "tau = [f_d + (f_s - f_d) exp(-V/v_c)] p"),
     "pressure": FrictionLaw("pressure", PRESSURE, (
         Param("f", "-", 0.0, _F, "friction coefficient below the shear limit"),
         Param("tau_max", "Pa", 0.0, 1e10, "shear strength of the interface", low_open=True),
@@ -102,28 +111,17 @@ LAWS: dict[str, FrictionLaw] = {
         Param("f0", "-", 0.0, _F, "coefficient at zero pressure"),
         Param("p0", "Pa", 0.0, 1e11, "pressure at which f has halved", low_open=True),
     ), "tau = f0 p / (1 + p/p0)"),
-    "slip_weakening": FrictionLaw("slip_weakening", SLIP_WEAKENING, (
-        Param("f_s", "-", 0.0, _F, "static (initial) coefficient"),
-        Param("f_d", "-", 0.0, _F, "dynamic coefficient after the slip d_c"),
-        Param("d_c", "m", 0.0, 1.0, "critical slip distance", low_open=True),
-    ), "tau = [f_d + (f_s - f_d) max(0, 1 - d/d_c)] p"),
-    "velocity_stretched": FrictionLaw("velocity_stretched", VELOCITY_STRETCHED, (
-        Param("f_s", "-", 0.0, _F, "coefficient at zero sliding speed"),
-        Param("f_d", "-", 0.0, _F, "coefficient at high sliding speed"),
-        Param("v_c", "m/s", 0.0, 1e3, "characteristic speed", low_open=True),
-        _N,
-    ), "tau = [f_d + (f_s - f_d) exp(-(V/v_c)^n)] p"),
+    "slip_weakening": FrictionLaw("slip_weakening", SLIP_WEAKENING, _SLIP_PARAMS,
+        "tau = [f_d + (f_s - f_d) max(0, 1 - d/d_c)] p"),
+    "velocity_stretched": FrictionLaw("velocity_stretched", VELOCITY_STRETCHED, _VELOCITY_PARAMS + (_N,),
+        "tau = [f_d + (f_s - f_d) exp(-(V/v_c)^n)] p"),
     "pressure_saturating": FrictionLaw("pressure_saturating", PRESSURE_SATURATING, (
         Param("f0", "-", 0.0, _F, "coefficient at zero pressure"),
         Param("p0", "Pa", 0.0, 1e11, "pressure at which f0 p meets the shear cap f0 p0", low_open=True),
         _N,
     ), "tau = f0 p / (1 + (p/p0)^n)^(1/n)"),
-    "slip_power": FrictionLaw("slip_power", SLIP_POWER, (
-        Param("f_s", "-", 0.0, _F, "static (initial) coefficient"),
-        Param("f_d", "-", 0.0, _F, "dynamic coefficient after the slip d_c"),
-        Param("d_c", "m", 0.0, 1.0, "slip at which the coefficient reaches f_d", low_open=True),
-        _N,
-    ), "tau = [f_d + (f_s - f_d) max(0, 1 - d/d_c)^n] p"),
+    "slip_power": FrictionLaw("slip_power", SLIP_POWER, _SLIP_PARAMS + (_N,),
+        "tau = [f_d + (f_s - f_d) max(0, 1 - d/d_c)^n] p"),
 }
 
 
@@ -153,20 +151,17 @@ def shear_strength(code: int, par: np.ndarray, p: float, v: float, d: float) -> 
         return 0.0
     if code == COULOMB:
         return par[0] * p
-    if code == VELOCITY:
-        return (par[1] + (par[0] - par[1]) * math.exp(-v / par[2])) * p
+    if code == VELOCITY or code == VELOCITY_STRETCHED:  # the simple law: its family at n = 1 (x ** 1.0 is x)
+        n = par[3] if code == VELOCITY_STRETCHED else 1.0
+        return (par[1] + (par[0] - par[1]) * math.exp(-((v / par[2]) ** n))) * p
     if code == PRESSURE:
         return min(par[0] * p, par[1])
     if code == HYPERBOLIC:
         return par[0] * p / (1.0 + p / par[1])
-    if code == SLIP_WEAKENING:
+    if code == SLIP_WEAKENING or code == SLIP_POWER:  # the simple law: its family at n = 1
+        n = par[3] if code == SLIP_POWER else 1.0
         w = 1.0 - d / par[2]
-        return (par[1] + (par[0] - par[1]) * (w if w > 0.0 else 0.0)) * p
-    if code == VELOCITY_STRETCHED:
-        return (par[1] + (par[0] - par[1]) * math.exp(-((v / par[2]) ** par[3]))) * p
+        return (par[1] + (par[0] - par[1]) * (w ** n if w > 0.0 else 0.0)) * p
     if code == PRESSURE_SATURATING:
         return par[0] * p / saturation(p / par[1], par[2])
-    if code == SLIP_POWER:
-        w = 1.0 - d / par[2]
-        return (par[1] + (par[0] - par[1]) * (w ** par[3] if w > 0.0 else 0.0)) * p
     return math.nan  # unknown code: poisons the run instead of failing silently
