@@ -1,4 +1,4 @@
-"""Two hidden effects at once through every round of ``diagnose`` (slow: about 5 min): records of the pairs study
+"""Two hidden effects at once through every round of ``diagnose`` (slow and long: about 13 min, -m long): records of the pairs study
 (``benchmarks/bench_pairs.py``, seed 29).
 
 1d-0, a clearance with a velocity-weakening wall on the 1-D simulation. The clearance is named in the first round.
@@ -40,8 +40,8 @@ from bench_diagnose import analyse  # noqa: E402
 from bench_pairs import PAIRS_1D, PAIRS_AXISYMMETRIC, make_pair  # noqa: E402
 from verdict_records import write  # noqa: E402
 
-# slow and long: the three records take about 13 minutes on 2 cores alone (24.5 min beside other jobs, fifty-sixth
-# session), and CI took 67 minutes with them (stop 72): run by hand with -m long
+# long: the three records took 754 s in a CI run of the fifty-sixth session, and CI took 67 minutes with them (stop
+# 72) where it is to stay under 60
 pytestmark = [pytest.mark.slow, pytest.mark.long]
 
 
