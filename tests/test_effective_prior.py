@@ -105,7 +105,7 @@ def _written(dg, tmp_path):
     import xarray as xr
 
     dt = xr.DataTree()
-    outcome.add_to_datatree(dt, dg, F_PRIOR)
+    outcome.add_to_datatree(dt, dg, F_PRIOR, NU_PRIOR)
     dt.to_netcdf(tmp_path / "d.nc", engine="h5netcdf")
     return xr.open_datatree(tmp_path / "d.nc", engine="h5netcdf")
 

@@ -249,11 +249,12 @@ def posterior_method_of(dg: Diagnosis) -> str | None:
             + (", half of it the stationary posterior's draws" if STATIONARY in dg.mixture_weights else "") + prior)
 
 
-def add_to_datatree(dt, dg: Diagnosis, f_prior, nu_prior=None) -> None:
+def add_to_datatree(dt, dg: Diagnosis, f_prior, nu_prior) -> None:
     """One group per fitted model under ``discrepancy``: the draws (posterior: the normal approximation's, and
     for the model the headline f comes from its exact posterior's, :func:`.exact_model.exact_posterior`), beside
     f_effective the log density of its prior at each draw (``log_prior_f_effective``, :mod:`.effective_prior`;
-    ``f_prior``, ``nu_prior``: the prior file's f and nu priors; nu's for a law whose f reads nu), and the pointwise
+    ``f_prior``, ``nu_prior``: the prior file's f and nu priors; nu's is read by a law whose f reads nu, the
+    pressure family's, which every diagnosis fits), and the pointwise
     block elpd (log_likelihood)."""
     import xarray as xr
 
