@@ -63,3 +63,14 @@ def test_f_effective_never_falls_as_f_rises(f, df, fs, x, n, law):
              "pressure_friction": {"p0": 1e9 / max(x, 1e-3), "n_p": n, "nu": 0.4}}[law]
     lo, hi = (float(mech.f_effective({"f": v, **extra}, CTX)) for v in (f, f + df))
     assert hi >= lo - 1e-15
+
+
+def test_the_pressure_familys_further_start_is_a_cap_the_window_sits_on():
+    """A search from the simple law alone (p0 = 1 GPa, n_p = 1) stopped at a mild hyperbola on a capped record of the
+    axisymmetric simulation; the further start is a sharp cap below the window's mean wall pressure."""
+    mech = MECHANISMS["pressure_friction"]
+    (s,) = mech.further_starts(CTX, 0.4)
+    p = CTX.wall_pressure(0.4)
+    assert s["p0"] < p and s["n_p"] > mech.start["n_p"]
+    assert mech.f_effective({"f": 0.08, "nu": 0.4, **s}, CTX) == pytest.approx(0.08 * s["p0"] / p, rel=0.01)
+    assert all(m.further_starts(CTX, 0.4) == () for m in MECHANISMS.values() if m.name != "pressure_friction")

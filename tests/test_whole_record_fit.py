@@ -337,3 +337,26 @@ def test_a_prior_files_hoop_factor_reaches_the_check_and_diagnose(tmp_path, clea
     run_stage.run_diagnose(prep, priors, {"f": 0.06, "nu": 0.4}, hoop=True, seed=1)
     for k in ("check", "diagnose"):
         assert seen[k]["hoop_calibration"] == (pytest.approx(0.85), HOOP_GAIN_SD), k
+
+
+def test_a_mechanisms_further_starts_reach_the_mode_search(clean_record, monkeypatch):
+    """Diagnoser.fit searches the mode from each further start a mechanism places from the window's means (the
+    pressure family's cap), beside the reference's mode."""
+    from friction_uq.discrepancy import extended
+    from friction_uq.discrepancy.mechanisms import MECHANISMS
+
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def capture(*args, extra_starts=(), **kw):
+        seen.extend(extra_starts)
+        raise Stop
+
+    monkeypatch.setattr(extended, "fit_whole_record", capture)
+    dg = Diagnoser(prepare(clean_record), lambda v: 0.0, hoop=True, seed=1)
+    mech = MECHANISMS["pressure_friction"]
+    with pytest.raises(Stop):
+        dg.fit((extended.Variant(mech),), {"f": 0.06, "nu": 0.4}, "pressure_friction")
+    assert list(mech.further_starts(dg.context, 0.4)) == [s for s in seen if "n_p" in s] != []

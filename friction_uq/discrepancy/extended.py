@@ -183,6 +183,7 @@ class Diagnoser:
             extra = ({**{k: self.nominal[k] for k in ("f", "nu") if k in self.nominal}, "sample_modulus": self.E0},)
         else:
             extra = ()
+        extra += tuple(dict(s) for v in variants for s in v.mechanism.further_starts(self.context, st["nu"]))
         block_of = lik.blocks(self.block)
         fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False,
                                prior_scale=scales, extra_starts=extra, score_blocks=block_of)

@@ -60,6 +60,9 @@ class Mechanism:
     #: f_effective reads the sample's nu (the pressure family, at the window's wall pressure): its prior's
     #: push-forward draws nu too
     uses_nu: bool = False
+    #: further_starts(context, nu): starts of the entry's own parameters besides ``start``, placed from the window's
+    #: means (a law's search from its simple form alone can stop short of a sharp one the record holds)
+    further_starts: Callable[[Context, float], tuple[Mapping[str, float], ...]] = field(default=lambda c, nu: ())
 
     @property
     def measurement_chain(self) -> bool:

@@ -72,6 +72,10 @@ def _shape(name: str, what: str) -> Parameter:
 
 
 SHAPE_PRIOR = lognormal(1.0, 1.0)
+#: the pressure family's further start, a cap: reached at this share of the window's mean wall pressure (so it binds
+#: over the plateau), with a sharp corner (n_p two prior sds above the simple law's 1). A start, not a prior
+CAP_START_SHARE = 0.5
+CAP_START_SHAPE = 8.0
 
 
 def stretched_weight(x: Any, n: Any) -> Any:
@@ -126,6 +130,9 @@ register(Mechanism(
     f_effective=lambda v, c: saturating_f(v["f"], c.wall_pressure(v["nu"]), v["p0"], v["n_p"]),
     group="friction_law",
     uses_nu=True,
+    # a cap reached below the window's pressure: from p0 = 1 GPa and n_p = 1 alone, the search stopped at a mild
+    # hyperbola on a capped record, which slip friction then fitted better (docs/trust.md, fifty-fifth session)
+    further_starts=lambda c, nu: ({"p0": CAP_START_SHARE * float(c.wall_pressure(nu)), "n_p": CAP_START_SHAPE},),
 ))
 
 register(Mechanism(
