@@ -4,7 +4,6 @@ simple law the catalogue held before, and whose f_effective is the wall's coeffi
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
