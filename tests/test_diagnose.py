@@ -435,7 +435,8 @@ def test_bare_end_faces_are_named_and_f_recovered(tmp_path):
     import xarray as xr
 
     dt = xr.DataTree()
-    outcome.add_to_datatree(dt, dg, load_priors(default_prior_path("I1"))["f"])
+    priors = load_priors(default_prior_path("I1"))
+    outcome.add_to_datatree(dt, dg, priors["f"], priors["nu"])
     dt.to_netcdf(tmp_path / "d.nc")
     with xr.open_datatree(tmp_path / "d.nc") as back:
         ll = back["discrepancy_end_friction/log_likelihood"]

@@ -89,14 +89,23 @@ def test_robust_covariance_keeps_a_right_model_and_widens_a_wrong_one():
     assert wrong[0, 0] > 3.0 * cov[0, 0]
 
 
-def test_pressure_friction_states_the_coefficient_at_the_window_shear_stress():
-    """tau = f p / (1 + p / p0) (the hyperbolic law): tau / p at the window's tau is f - tau / p0."""
+@pytest.mark.parametrize("n", [0.4, 1.0, 2.7, 50.0])
+def test_pressure_friction_states_the_coefficient_at_the_window_wall_pressure(n):
+    """tau = f p / (1 + (p / p0)^n)^(1/n) (the saturating wall; n = 1 the hyperbola): tau / p at the window's mean wall
+    pressure p = nu / (1 - nu) sigma_mean (eq. 19, 21), whatever the shape; on the cap too (n = 50, p above p0)."""
     from friction_uq.discrepancy.mechanisms import MECHANISMS, Context
+    from friction_uq.simulate.friction import LAWS, shear_strength
 
-    f0, p0, p = 0.08, 1e8, 6e7
-    tau = f0 * p / (1 + p / p0)
-    got = MECHANISMS["pressure_friction"].f_effective({"f": f0, "p0": p0}, Context(V=5.0, tau_mean=tau, slip=1e-3))
-    assert got == pytest.approx(tau / p, rel=1e-12)
+    f0, p0, nu, sigma = 0.08, 6e7, 0.4, 1.35e8
+    ctx = Context(V=5.0, tau_mean=1e6, slip=1e-3, sigma_mean=sigma)
+    p = nu / (1 - nu) * sigma
+    got = MECHANISMS["pressure_friction"].f_effective({"f": f0, "p0": p0, "n_p": n, "nu": nu}, ctx)
+    law = LAWS["pressure_saturating"]
+    assert got == pytest.approx(shear_strength(law.code, np.array([f0, p0, n]), p, 0.0, 0.0) / p, rel=1e-10)
+    if n == 1.0:
+        assert got == pytest.approx(f0 / (1 + p / p0), rel=1e-12)
+    if n == 50.0:
+        assert got == pytest.approx(f0 * p0 / p, rel=0.02)  # on the cap: f0 p0 / p, not 0
 
 
 def test_the_hoop_gauge_factor_is_its_most_probable_value_under_its_prior(lik):
@@ -328,3 +337,26 @@ def test_a_prior_files_hoop_factor_reaches_the_check_and_diagnose(tmp_path, clea
     run_stage.run_diagnose(prep, priors, {"f": 0.06, "nu": 0.4}, hoop=True, seed=1)
     for k in ("check", "diagnose"):
         assert seen[k]["hoop_calibration"] == (pytest.approx(0.85), HOOP_GAIN_SD), k
+
+
+def test_a_mechanisms_further_starts_reach_the_mode_search(clean_record, monkeypatch):
+    """Diagnoser.fit searches the mode from each further start a mechanism places from the window's means (the
+    pressure family's cap), beside the reference's mode."""
+    from friction_uq.discrepancy import extended
+    from friction_uq.discrepancy.mechanisms import MECHANISMS
+
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def capture(*args, extra_starts=(), **kw):
+        seen.extend(extra_starts)
+        raise Stop
+
+    monkeypatch.setattr(extended, "fit_whole_record", capture)
+    dg = Diagnoser(prepare(clean_record), lambda v: 0.0, hoop=True, seed=1)
+    mech = MECHANISMS["pressure_friction"]
+    with pytest.raises(Stop):
+        dg.fit((extended.Variant(mech),), {"f": 0.06, "nu": 0.4}, "pressure_friction")
+    assert list(mech.further_starts(dg.context, 0.4)) == [s for s in seen if "n_p" in s] != []

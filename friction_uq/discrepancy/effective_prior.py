@@ -9,15 +9,18 @@ f_effective = g(f, theta) is the wall's coefficient at the stationary window (:m
   and its prior is the prior file's f prior, evaluated exactly.
 * Otherwise its prior is the push-forward of the joint prior through g,
   pi(y) = E_theta[ density at y of g(f, theta), f ~ pi_f ], computed conditionally on theta: g is
-  nondecreasing in f (a convex combination of f and f_s, or f less tau/p0 clamped at 0), so the f
+  nondecreasing in f (a convex combination of f and f_s, or f times the saturating wall's factor at the
+  window's wall pressure, which reads nu: nu is then drawn from the prior file's nu prior too), so the f
   prior's mass between two points of a fine grid (:data:`GRID`, exact from its CDF) lands evenly
   between their images. The expectation over theta is a mean over :data:`THETA_DRAWS` scrambled
-  Sobol points mapped through the priors' quantile functions (seeded: same seed, same bits). The
-  relative error is below 1 % (tests/test_effective_prior.py: against quadrature for the pressure
-  law, against 10^6 prior draws for the velocity law).
+  Sobol points mapped through the priors' quantile functions (seeded: same seed, same bits). Where the
+  law mixes f with a coefficient of its own (velocity, slip: (1 - w) f + w f_s), a draw whose w > 1/2
+  pushes f_s's grid with f drawn instead: pushing f there squeezes its grid into a spike (one such draw
+  put the velocity law's density 39 % off at one point). The relative error is below 1 %
+  (tests/test_effective_prior.py: against quadrature for the pressure and the velocity laws).
 
-A clamp (pressure_friction's f_effective = 0 when tau/p0 > f) puts an atom of prior mass at 0 that
-the density leaves out: a draw there has density 0 (log -inf), which pooling refuses to divide by.
+A law whose f_effective can be 0 for a whole range of f would put an atom of prior mass at 0 that the density leaves
+out: a draw there has density 0 (log -inf), which pooling refuses to divide by. (No law of the catalogue does now.)
 """
 
 from __future__ import annotations
@@ -48,28 +51,61 @@ def _compose(variants: Sequence[Any], values: dict[str, Any], context: Context) 
     return f
 
 
-def _theta(variants: Sequence[Any], rng: np.random.Generator) -> dict[str, np.ndarray]:
-    """Draws of every mechanism parameter of the model from its prior, (THETA_DRAWS, 1) each."""
+def _companion(variants: Sequence[Any]) -> str | None:
+    """The coefficient a friction law of the model mixes f with (``Mechanism.companion``), or None."""
+    return next((v.mechanism.companion for v in variants if v.mechanism.companion), None)
+
+
+def _theta(variants: Sequence[Any], rng: np.random.Generator, f_prior: Any, nu_prior: Any) -> dict[str, np.ndarray]:
+    """Draws of every mechanism parameter of the model from its prior, (THETA_DRAWS, 1) each; with a companion
+    coefficient, a draw of f too (as ``"f"``: the rows that push the companion hold f fixed); where a mechanism's
+    f_effective reads nu, nu from its prior."""
     params = [(p.name, v.mechanism.priors[p.name]) for v in variants for p in v.mechanism.parameters]
     if not params:
         return {}
+    if _companion(variants):
+        params.append(("f", f_prior))
+    if any(v.mechanism.uses_nu for v in variants):
+        if nu_prior is None:
+            raise ValueError("the prior of f_effective under a model whose f_effective reads nu needs nu's prior")
+        params.append(("nu", nu_prior))
     u = qmc.Sobol(len(params), scramble=True, seed=rng).random_base2(int(np.log2(THETA_DRAWS)))
     u = np.clip(u, 1e-12, 1.0 - 1e-12)
     return {name: np.asarray(prior.ppf(u[:, j]), float)[:, None] for j, (name, prior) in enumerate(params)}
 
 
+def _pushed_rows(variants: Sequence[Any], theta: dict[str, np.ndarray], context: Context, f_prior: Any,
+                 companion: str | None, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each theta draw's image of a fine grid of f (row k: g(grid, theta_k)) and the prior mass between the grid's
+    points. With a companion c (f_effective = (1 - w) f + w c), a row where w > 1/2 pushes a grid of c instead, f
+    held at its draw: its image is then the wider one, where f's would be squeezed into a spike of width (1 - w) x
+    the grid's, whose Monte Carlo average converges slowly. Which is pushed depends on theta's other parameters
+    only (the width of a grid's image), so the mean stays the push-forward's."""
+    grid = np.linspace(lo, hi, GRID)
+    others = {k: x for k, x in theta.items() if k != "f"}
+    G = np.asarray(_compose(variants, {**others, "f": grid[None, :]}, context), float)
+    G = np.broadcast_to(G, (max(1, len(next(iter(theta.values()), []))), GRID))
+    mass = np.broadcast_to(np.diff(f_prior.cdf(grid)), (G.shape[0], GRID - 1))
+    if companion is None:
+        return G, mass
+    prior_c = next(v.mechanism.priors[companion] for v in variants if v.mechanism.companion == companion)
+    grid_c = np.linspace(*(float(x) for x in prior_c.ppf([1e-9, 1.0 - 1e-9])), GRID)
+    Gc = np.asarray(_compose(variants, {**theta, companion: grid_c[None, :]}, context), float)
+    swap = (Gc[:, -1] - Gc[:, 0] > G[:, -1] - G[:, 0])[:, None]
+    return np.where(swap, Gc, G), np.where(swap, np.diff(prior_c.cdf(grid_c))[None, :], mass)
+
+
 def log_prior_f_effective(variants: Sequence[Any], context: Context, f_prior: Any, y: np.ndarray, *,
-                          rng: np.random.Generator) -> tuple[np.ndarray, str]:
+                          rng: np.random.Generator, nu_prior: Any = None) -> tuple[np.ndarray, str]:
     """log pi(y) of f_effective under a model (its ``variants``: extended.Variant) at the draws ``y``, and what
-    that prior is in words (module docstring). ``f_prior``: the prior file's f prior
-    (:class:`~friction_uq.priors.ParameterPrior`: its logpdf, cdf and ppf are used)."""
+    that prior is in words (module docstring). ``f_prior``, ``nu_prior``: the prior file's f and nu priors
+    (:class:`~friction_uq.priors.ParameterPrior`: logpdf, cdf and ppf; nu's is needed only where a mechanism's
+    f_effective reads nu, the pressure family's)."""
     y = np.asarray(y, float)
     lo, hi = (float(x) for x in f_prior.ppf([1e-9, 1.0 - 1e-9]))
-    grid = np.linspace(lo, hi, GRID)
-    theta = _theta(variants, rng)
-    G = np.asarray(_compose(variants, {**theta, "f": grid[None, :]}, context), float)
-    G = np.broadcast_to(G, (max(1, len(next(iter(theta.values()), []))), GRID))
-    if np.array_equal(G, np.broadcast_to(grid, G.shape)):
+    theta, companion = _theta(variants, rng, f_prior, nu_prior), _companion(variants)
+    G, mass = _pushed_rows(variants, theta, context, f_prior, companion, lo, hi)
+    if companion is None and np.array_equal(G, np.broadcast_to(np.linspace(lo, hi, GRID), G.shape)):
         return np.asarray(f_prior.logpdf(y), float), EXACT_NOTE
     if y.size == 0:  # no draw to evaluate it at (a mixture's member whose weight drew none)
         return np.empty(y.shape), PUSHED_NOTE
@@ -78,7 +114,6 @@ def log_prior_f_effective(variants: Sequence[Any], context: Context, f_prior: An
         names = "+".join(v.label for v in variants)
         raise ValueError(f"f_effective of the model {names} decreases with f for some of its prior's parameters: "
                          "its prior cannot be computed by the monotone push-forward")
-    mass = np.diff(f_prior.cdf(grid))
     order = np.argsort(y.ravel())
     flat = y.ravel()[order]  # sorted: numpy's search then starts each key where the last one ended
     dens = np.zeros(flat.size)
@@ -92,8 +127,9 @@ def log_prior_f_effective(variants: Sequence[Any], context: Context, f_prior: An
         ok = (i >= 0) & (i < GRID - 1)
         i = np.clip(i, 0, GRID - 2)
         wi = np.take_along_axis(width[a:a + 512], i, axis=1)
+        mi = np.take_along_axis(mass[a:a + 512], i, axis=1)
         ok &= wi > 0
-        dens += np.where(ok, mass[i] / np.where(ok, wi, 1.0), 0.0).sum(axis=0)
+        dens += np.where(ok, mi / np.where(ok, wi, 1.0), 0.0).sum(axis=0)
     with np.errstate(divide="ignore"):
         out = np.empty(flat.size)
         out[order] = np.log(dens / G.shape[0])

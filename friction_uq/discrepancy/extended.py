@@ -134,7 +134,9 @@ class Diagnoser:
         tau = float(np.mean(d.F_eo)) / (2.0 * math.pi * d.radius * d.length)  # eq. 18, 20
         # a sample that does not slide has a window mean V and slip of either sign within the noise; the laws of the
         # catalogue read speed and slip as magnitudes (a negative one made f_effective fall with f: an internal error)
-        self.context = Context(V=max(float(np.mean(d.V)), 0.0), tau_mean=tau, slip=max(float(np.mean(d.slip)), 0.0))
+        sigma = (float(np.mean(d.F_io)) + 0.5 * float(np.mean(d.F_eo))) / (math.pi * d.radius**2)  # eq. 19, 21
+        self.context = Context(V=max(float(np.mean(d.V)), 0.0), tau_mean=tau, slip=max(float(np.mean(d.slip)), 0.0),
+                               sigma_mean=sigma)
         self.base_scales = dict(base_scales or {})
         #: f and nu of the stationary analysis: with the header's modulus, a second start of every extended fit
         self.nominal = dict(nominal or {})
@@ -181,6 +183,7 @@ class Diagnoser:
             extra = ({**{k: self.nominal[k] for k in ("f", "nu") if k in self.nominal}, "sample_modulus": self.E0},)
         else:
             extra = ()
+        extra += tuple(dict(s) for v in variants for s in v.mechanism.further_starts(self.context, st["nu"]))
         block_of = lik.blocks(self.block)
         fit = fit_whole_record(lik, log_prior, st, n_draws=self.n_draws, rng=rng, importance=False,
                                prior_scale=scales, extra_starts=extra, score_blocks=block_of)

@@ -23,11 +23,17 @@ Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, Reading], str |
 @dataclass(frozen=True)
 class Context:
     """Stationary-window means a mechanism needs to state its effective f: sliding speed V (m/s), wall shear
-    stress tau_mean (Pa, eq. 18 from F_eo), slip (m)."""
+    stress tau_mean (Pa, eq. 18 from F_eo), slip (m), and the sample's mean axial stress sigma_mean (Pa, eq. 19 and
+    21: (F_io + F_eo / 2) / (pi R^2)), whose nu / (1 - nu) is the mean wall pressure."""
 
     V: float
     tau_mean: float
     slip: float
+    sigma_mean: float
+
+    def wall_pressure(self, nu: Any) -> Any:
+        """The window's mean wall pressure (Pa) under a Poisson ratio nu: nu / (1 - nu) sigma_mean (eq. 19, 21)."""
+        return nu / (1.0 - nu) * self.sigma_mean
 
 
 @dataclass(frozen=True)
@@ -48,6 +54,15 @@ class Mechanism:
     group: str | None = None  # mechanisms of one group replace the same thing (the friction law): one at a time
     per_gauge: tuple[str, ...] = ()  # a measurement-chain fault fitted on every gauge at once: parameter i is gauge i's
     neutral: float = 0.0  # per_gauge: the parameter's value where its gauge reads right
+    #: a friction law whose f_effective mixes f with another coefficient of its own, (1 - w) f + w f_s: that
+    #: coefficient's name (its prior is pushed through f_effective where it carries the larger share, :mod:`.effective_prior`)
+    companion: str | None = None
+    #: f_effective reads the sample's nu (the pressure family, at the window's wall pressure): its prior's
+    #: push-forward draws nu too
+    uses_nu: bool = False
+    #: further_starts(context, nu): starts of the entry's own parameters besides ``start``, placed from the window's
+    #: means (a law's search from its simple form alone can stop short of a sharp one the record holds)
+    further_starts: Callable[[Context, float], tuple[Mapping[str, float], ...]] = field(default=lambda c, nu: ())
 
     @property
     def measurement_chain(self) -> bool:

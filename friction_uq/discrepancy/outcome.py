@@ -213,7 +213,7 @@ def group_key(label: str) -> str:
     return label.replace("[", "_").replace("]", "").replace("+", "__")
 
 
-def _mixture_dataset(dg: Diagnosis, f_prior):
+def _mixture_dataset(dg: Diagnosis, f_prior, nu_prior):
     """The stacking mixture's draws of f_effective, each with the log density of the prior of the model it was
     drawn from (what a campaign divides out when it pools the f this record quotes)."""
     import xarray as xr
@@ -225,7 +225,7 @@ def _mixture_dataset(dg: Diagnosis, f_prior):
         at = dg.mixture_source == i
         rng = stream(dg.seed, "effective prior", f"mixture {label}")
         log_prior[at], note = log_prior_f_effective(member_variants(dg, label), dg.context, f_prior,
-                                                    dg.mixture_f[at], rng=rng)
+                                                    dg.mixture_f[at], rng=rng, nu_prior=nu_prior)
         notes.append(f"{label}: {note}")
     return xr.Dataset({"f_effective": (("chain", "draw"), dg.mixture_f[None]),
                        "model": (("chain", "draw"), np.asarray(labels, dtype=object)[dg.mixture_source][None].astype(str)),
@@ -249,11 +249,13 @@ def posterior_method_of(dg: Diagnosis) -> str | None:
             + (", half of it the stationary posterior's draws" if STATIONARY in dg.mixture_weights else "") + prior)
 
 
-def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
+def add_to_datatree(dt, dg: Diagnosis, f_prior, nu_prior) -> None:
     """One group per fitted model under ``discrepancy``: the draws (posterior: the normal approximation's, and
     for the model the headline f comes from its exact posterior's, :func:`.exact_model.exact_posterior`), beside
     f_effective the log density of its prior at each draw (``log_prior_f_effective``, :mod:`.effective_prior`;
-    ``f_prior``: the prior file's f prior), and the pointwise block elpd (log_likelihood)."""
+    ``f_prior``, ``nu_prior``: the prior file's f and nu priors; nu's is read by a law whose f reads nu, the
+    pressure family's, which every diagnosis fits), and the pointwise
+    block elpd (log_likelihood)."""
     import xarray as xr
 
     fits: list[ModelFit] = [dg.baseline] + [dg.final if dg.causes and r.fit.label == dg.final.label else r.fit
@@ -262,13 +264,14 @@ def add_to_datatree(dt, dg: Diagnosis, f_prior) -> None:
     dt.attrs["discrepancy_final_group"] = f"discrepancy_{group_key(dg.final.label)}" if dg.causes else ""
     if dg.mixture_f is not None:
         dt.attrs["discrepancy_final_group"] = "discrepancy_mixture"
-        dt["discrepancy_mixture/posterior"] = xr.DataTree(_mixture_dataset(dg, f_prior))
+        dt["discrepancy_mixture/posterior"] = xr.DataTree(_mixture_dataset(dg, f_prior, nu_prior))
     for mf in fits:
         key = group_key(mf.label)
         post = {n: (("chain", "draw"), v[None]) for n, v in mf.fit.draws.items()}
         post["f_effective"] = (("chain", "draw"), mf.f_effective[None])
         rng = stream(dg.seed, "effective prior", mf.label)
-        log_prior, prior_note = log_prior_f_effective(mf.variants, dg.context, f_prior, mf.f_effective, rng=rng)
+        log_prior, prior_note = log_prior_f_effective(mf.variants, dg.context, f_prior, mf.f_effective, rng=rng,
+                                                      nu_prior=nu_prior)
         post["log_prior_f_effective"] = (("chain", "draw"), log_prior[None], {"description": prior_note})
         ll = {"block_elpd": (("block",), mf.elpd.pointwise),
               "calibration_elpd": (("calibration",), mf.elpd.calibration)}

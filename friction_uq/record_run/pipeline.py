@@ -236,7 +236,7 @@ def _record_check(s: RunSetup, post: StationaryPosterior, wrc: WholeRecordCheck,
                                  stationary_f=post.samples.flat("f"))
     if post.hoop_or_prior is not None:  # its models read nu through the hoop gauge as well: f from both readings
         diag = dataclasses.replace(diag, f_prior_nu=post.hoop_or_prior.f_prior_draws)
-    outcome.add_to_datatree(post.datatree, diag, s.priors["f"])
+    outcome.add_to_datatree(post.datatree, diag, s.priors["f"], s.priors["nu"])
     return diag
 
 
