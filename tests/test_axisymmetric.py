@@ -88,6 +88,7 @@ def test_ten_millimetre_pressure_band_gives_physics_md_ratios(long_tube, distanc
 
 # --- the confined sample -----------------------------------------------------------------------------
 
+@pytest.mark.slow  # an axisymmetric simulation of the whole test: in the default suite it kept that suite over 10 minutes (28 s in a CI run)
 def test_frictionless_confined_sample_has_eq8_stress_ratio() -> None:
     out = run_axisymmetric(axi(0.0, stiff_tube=100.0))
     ratio = plateau(out, out.wall_pressure_nodes)[1:-1].mean() / plateau(out, out.axial_stress).mean()

@@ -130,6 +130,7 @@ def scheduler_campaign(dask_address, tmp_path_factory):
     return code, d, out, address, worker_log
 
 
+@pytest.mark.slow  # a campaign on a scheduler of its own, shared by the three tests below: in the default suite it kept that suite over 10 minutes (72 s to set up in a CI run)
 def test_a_campaign_runs_on_a_separate_scheduler_and_a_bad_record_does_not_stop_it(scheduler_campaign):
     code, d, out, _, worker_log = scheduler_campaign
     assert code == 1  # one record refused
@@ -150,6 +151,7 @@ def test_a_campaign_runs_on_a_separate_scheduler_and_a_bad_record_does_not_stop_
     assert "posterior (90 % credible intervals)" not in log and "wrote " not in log  # the job prints nothing
 
 
+@pytest.mark.slow  # the scheduler's campaign above: in the default suite it kept that suite over 10 minutes (8 s in a CI run)
 def test_a_rerun_skips_what_is_up_to_date(scheduler_campaign, capsys):
     _, d, out, address, _ = scheduler_campaign
     capsys.readouterr()
@@ -160,6 +162,7 @@ def test_a_rerun_skips_what_is_up_to_date(scheduler_campaign, capsys):
     assert "campaign: 2 done (2 up to date), 1 failed, 0 left" in err
 
 
+@pytest.mark.slow  # the scheduler's campaign above: in the default suite it kept that suite over 10 minutes (29 s in a CI run)
 def test_a_stored_result_edited_is_read_from_its_run_or_redone(scheduler_campaign, capsys):
     """A stored result's summary is its run JSON's, not its own copy's: emptied or made text, the skip reads the
     run back (these were an internal error and a half-written campaign); its test id changed, the record is

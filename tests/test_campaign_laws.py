@@ -162,6 +162,7 @@ def test_f_under_the_diagnosed_model_is_read_from_the_group_the_record_names(tmp
         assert np.mean(t.f_model) == pytest.approx(0.06 if final else 0.05, rel=0.02)
 
 
+@pytest.mark.slow  # a 15-test law comparison: in the default suite it kept that suite over 10 minutes (40 s in a CI run)
 def test_a_constant_friction_campaign_names_constant_and_flags_nothing():
     rng = np.random.default_rng(7)
     tests = [_test(rng, f"A-0{k}", "A", V, 9e6 * V, 0.05) for k, V in enumerate(np.linspace(5, 13, 6))]

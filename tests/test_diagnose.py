@@ -325,6 +325,7 @@ def test_clean_record_names_no_cause(tmp_path):
     assert doc["sentence"].startswith("The simulated test reproduces every gauge") and "nothing to explain" in doc["sentence"]
 
 
+@pytest.mark.slow  # a whole diagnose: in the default suite it kept that suite over 10 minutes (24 s in a CI run)
 def test_a_hoop_gauge_calibration_error_is_said_not_named(tmp_path):
     """The hoop gauge's factor is marginalised in every model under its 5 % prior: a 5 % calibration error is
     no mechanism, but its most probable value (shrunk toward 1, where nu could also explain the hoop's
@@ -366,6 +367,7 @@ def test_plug_friction_is_named_and_f_recovered(tmp_path):
     assert f"f = {fq['q50']:.3f} [{fq['q05']:.3f}, {fq['q95']:.3f}] with them (the f to quote)" in doc["sentence"]
 
 
+@pytest.mark.slow  # a whole diagnose: in the default suite it kept that suite over 10 minutes (31 s in a CI run)
 def test_an_external_gauge_gain_the_check_cannot_see_is_not_named(tmp_path):
     """A 12 % gain on the external output gauge is, over the stationary phase, a 12 % higher f (eq. 17 reads
     F_eo / F_io): only the fronts could tell it, by a few nats (about 8 here), less than two simulators of the
@@ -378,6 +380,7 @@ def test_an_external_gauge_gain_the_check_cannot_see_is_not_named(tmp_path):
     assert diagnosed_f.headline(dg) is None
 
 
+@pytest.mark.slow  # a whole diagnose: in the default suite it kept that suite over 10 minutes (107 s in a CI run)
 def test_clearance_is_named_and_the_gap_measured(tmp_path):
     prep, dg = _diagnose(tmp_path, noisy_config(gap=8e-6, tube_compliance=True), seed=24)
     assert dg.cause is not None and dg.cause.mechanism.name == "clearance"

@@ -148,6 +148,7 @@ def test_a_forked_map_gives_in_order_the_values_of_a_map_in_line():
     assert {pid for pid, _ in in_line} == {os.getpid()}
 
 
+@pytest.mark.slow  # a campaign's law comparison twice: in the default suite it kept that suite over 10 minutes (53 s in a CI run)
 def test_the_campaign_law_comparison_is_the_same_on_one_or_two_processes(monkeypatch):
     from friction_uq.campaigns import analysis, law_comparison
 
