@@ -74,6 +74,7 @@ def test_laws_without_a_spread_keep_their_parameters_but_log_r():
     np.testing.assert_allclose(one.to_sampling(y)[:, :5], y[:, :5])
 
 
+@pytest.mark.slow  # the law's prior sampled: in the default suite it kept that suite over 10 minutes (16 s in a CI run)
 def test_sampling_the_prior_through_the_change_gives_the_prior_back():
     """No data: the draws of d and s must be uniform on (0, 5), log v_c uniform on its range and r half-normal
     (sd 0.1), as the law's priors say. The walkers start from the prior itself (the ensemble's stationary state),

@@ -47,6 +47,7 @@ def _doc(ca):
     return json.loads(json.dumps(campaign_doc(results, ca, seed=1, settings={}), default=float))
 
 
+@pytest.mark.slow  # a diagnosed campaign's law comparison: in the default suite it kept that suite over 10 minutes (11 s in a CI run)
 def test_a_diagnosed_campaign_pools_the_diagnosed_f_and_labels_both(tmp_path):
     tests = _tests(diagnosed=True)
     ca = analyse_tests(tests, tally_causes([]), seed=1)

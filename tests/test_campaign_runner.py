@@ -50,6 +50,7 @@ def test_seeds_do_not_depend_on_order_or_on_the_other_records(folder, tmp_path):
     assert all(c[p] != a[p] for p in a)
 
 
+@pytest.mark.slow  # a campaign twice: in the default suite it kept that suite over 10 minutes (13 s in a CI run)
 def test_results_are_the_same_on_one_and_two_workers_in_any_order(folder, tmp_path):
     headers = [read_header(p) for p in find_records([folder])]
     tasks = make_tasks(headers, out_dir=tmp_path, seed=3)

@@ -782,6 +782,7 @@ def test_an_output_channel_off_by_a_factor_gets_no_f(record_copy, capsys):
     assert not (path.parent / "out").exists()
 
 
+@pytest.mark.slow  # a whole run: in the default suite it kept that suite over 10 minutes (15 s in a CI run)
 def test_a_prior_whose_support_leaves_out_the_datas_f_starts_inside_it(tmp_path, capsys):
     """[f] uniform on [0.1, 1], a valid prior: the sampler once started at the data's f (0.049), where it has no
     density, and refused the record naming no key; it starts at the support's nearest end, and the prior-data check

@@ -64,6 +64,7 @@ def _quiet_run(record, out, *extra) -> int:
 # ---------------------------------------------------------------- system errors inside the writers
 
 
+@pytest.mark.slow  # a whole run per fault: in the default suite it kept that suite over 10 minutes (16 s each in a CI run)
 @pytest.mark.parametrize("code, words", [(errno.ENOSPC, "No space left on device"),
                                          (errno.EROFS, "Read-only file system")])
 def test_output_writer_fault_keeps_the_previous_outputs(record, tmp_path, capsys, monkeypatch, code, words):
@@ -171,6 +172,7 @@ def _mount_tmpfs(where: Path, size: str) -> bool:
     return r.returncode == 0
 
 
+@pytest.mark.slow  # a whole run onto a 2 MB tmpfs: in the default suite it kept that suite over 10 minutes (25 s in a CI run)
 def test_a_real_full_disk_is_one_sentence_and_leaves_nothing(record, tmp_path):
     mnt = tmp_path / f"tmpfs-{uuid.uuid4().hex[:6]}"
     mnt.mkdir()

@@ -210,6 +210,7 @@ def test_a_late_channel_is_measured_where_the_fault_was_made_by_other_code(chain
     assert np.quantile(mf.fit.draws["f"], 0.05) <= 0.05 <= np.quantile(mf.fit.draws["f"], 0.95)
 
 
+@pytest.mark.slow  # five whole-record fits: in the default suite it kept that suite over 10 minutes (12 s in a CI run)
 def test_a_slow_amplifier_is_seen_on_its_channel_and_a_clean_record_gains_nothing(chain_records):
     mf, delpd, se = _fits(chain_records["slow"], ("bandwidth",))["bandwidth"]
     tc = {c: float(np.median(mf.fit.draws[f"time_constant_{c}"]))
