@@ -29,6 +29,7 @@ from .._parallel import can_fork, forked_map
 from ..analysis import Prepared
 from ..models import Parameter, SimulatorModel, measured_loading
 from ..models.parameters import summarize_draws
+from ..physics.cell import mean_friction_stress
 from ..models.measurement_chain import Reading
 from ..stats.ar1 import ar1_block_loo
 from ..stats.streams import stream
@@ -131,7 +132,7 @@ class Diagnoser:
         self.modulus_prior = stats.lognorm(s=SAMPLE_MODULUS_SD_LOG, scale=E0)
         self.block = max(1, int(round(BLOCK * rec.sample_rate)))
         d = prep.data
-        tau = float(np.mean(d.F_eo)) / (2.0 * math.pi * d.radius * d.length)  # eq. 18, 20
+        tau = float(mean_friction_stress(np.mean(d.F_eo), radius=d.radius, length=d.length))  # eq. 18, 20
         # a sample that does not slide has a window mean V and slip of either sign within the noise; the laws of the
         # catalogue read speed and slip as magnitudes (a negative one made f_effective fall with f: an internal error)
         sigma = (float(np.mean(d.F_io)) + 0.5 * float(np.mean(d.F_eo))) / (math.pi * d.radius**2)  # eq. 19, 21

@@ -14,6 +14,7 @@ from scipy import stats
 
 from ..models.measurement_chain import Reading
 from ..models.parameters import Parameter
+from ..physics.cell import lateral_ratio
 
 Apply = Callable[[Mapping[str, float], dict[str, Any], dict[str, Reading], str | None], None]
 """apply(values, settings, readings, channel): edit the simulator settings and the gauges' measurement chains
@@ -33,7 +34,7 @@ class Context:
 
     def wall_pressure(self, nu: Any) -> Any:
         """The window's mean wall pressure (Pa) under a Poisson ratio nu: nu / (1 - nu) sigma_mean (eq. 19, 21)."""
-        return nu / (1.0 - nu) * self.sigma_mean
+        return lateral_ratio(nu) * self.sigma_mean
 
 
 @dataclass(frozen=True)
