@@ -229,10 +229,13 @@ class WholeRecordLikelihood:
         k = int(nz.offset_sd > 0.0)  # the columns: [offset], gain
         return float(d[k]), float(np.linalg.inv(V.T @ V + np.diag(1.0 / sds**2))[k, k])
 
-    def unit_strains(self, values: Mapping[str, float]) -> dict[str, np.ndarray]:
+    def unit_strains(self, values: Mapping[str, float], *, spans_only: bool = False) -> dict[str, np.ndarray]:
         """Predicted strains with the hoop gauge's factor at its known median (1 unless a prior file says otherwise):
-        what the likelihood conditions on (the gauges' calibration errors are its nuisances)."""
-        return self.model.predict(dict(values) | {"hoop_gain": self.hoop_median}).strains
+        what the likelihood conditions on (the gauges' calibration errors are its nuisances). ``spans_only``: each
+        gauge's series over its span only (the simulation stops where they need it; NaN after them, the same bits on
+        them)."""
+        until = {c: b[3] for c, b in self.bounds.items()} if spans_only else None
+        return self.model.predict(dict(values) | {"hoop_gain": self.hoop_median}, until=until).strains
 
     def strains(self, values: Mapping[str, float]) -> tuple[dict[str, np.ndarray], float]:
         """Predicted strains with the hoop gauge's most probable factor applied; returns (strains, factor)."""
@@ -251,7 +254,7 @@ class WholeRecordLikelihood:
         """AR(1)-whitened residuals of every channel with its nuisances removed, concatenated, then one
         pseudo-residual per nuisance (value / its sd): log-likelihood = const - |w|^2 / 2 (up to the
         nuisances' log determinant)."""
-        return self.whitened_from(self.unit_strains(values))
+        return self.whitened_from(self.unit_strains(values, spans_only=True))
 
     @property
     def n_samples(self) -> int:
@@ -259,7 +262,7 @@ class WholeRecordLikelihood:
 
     def loglike(self, values: Mapping[str, float]) -> float:
         try:
-            pred = self.unit_strains(values)
+            pred = self.unit_strains(values, spans_only=True)
         except ValueError:
             return -np.inf
         w, logdet = self._whitened_logdet(pred)

@@ -16,6 +16,7 @@ into each gauge's measurement chain (:mod:`.measurement_chain`: a gain, a drift,
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -117,11 +118,20 @@ class SimulatorModel:
             self._apply(values, settings, readings)
         return SimulationConfig(**settings), readings
 
-    def predict(self, values: Mapping[str, float]) -> Prediction:
-        """Gauge strains over the whole record for one set of parameter values."""
+    def predict(self, values: Mapping[str, float], *, until: Mapping[str, int] | None = None) -> Prediction:
+        """Gauge strains over the whole record for one set of parameter values.
+
+        ``until`` (gauge -> samples): only each named gauge's first samples are asked for (a likelihood's spans);
+        the simulation stops where they need it and the rest is NaN (:func:`~friction_uq.simulate.model_1d.run_model`;
+        the samples asked for are the whole run's to the bit). A dispersive configuration runs over the whole
+        record."""
         cfg, readings = self.config(values)
         loading = self.dispersive_loading if cfg.dispersion and self.dispersive_loading is not None else self.loading
-        out = run_model(cfg, loading=true_incident(loading, readings["input_bar"]))
+        dt = loading.sample_interval
+        # a channel read early (a negative delay) shows at t what its gauge saw at t + |delay|
+        asked = None if until is None or cfg.dispersion else \
+            {c: k + math.ceil(max(0.0, -readings[c].delay) / dt) + 2 for c, k in until.items()}
+        out = run_model(cfg, loading=true_incident(loading, readings["input_bar"]), until=asked)
         t = loading.time
         strains = {k: v if readings[k].exact else readings[k].applied(t, v) for k, v in out.strains.items()}
         return Prediction(strains, out.force_internal, out.force_external, out.force_input, out.sliding_velocity)

@@ -25,6 +25,7 @@ transit ~7 us, tube m_t / Z_eo ~5 us) are long over and the output bars' far-end
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,6 +38,15 @@ from .config import SimulationConfig
 from .friction import LAWS
 from .hoop import hoop_strain
 from .loading import Loading
+
+
+def cell_horizon(until: Mapping[str, int], *, apparatus, dt: float) -> int:
+    """Record samples of the cell's history that gauges asked for their first ``until[gauge]`` samples read:
+    a bar's gauge reads what left the cell d / c earlier (the input bar's: its reflected wave), the hoop gauge
+    the cell at once; two samples more for the interpolation between samples."""
+    lag = {"input_bar": apparatus.input_bar.gauge_delay, "internal_output_bar": apparatus.internal_output_bar.gauge_delay,
+           "external_output_bar": apparatus.external_output_bar.gauge_delay, "tube_hoop": 0.0}
+    return max((k - math.floor(lag[c] / dt) for c, k in until.items()), default=0) + 2
 
 
 #: Most time steps of the cell per record sample (a stiffer column would need more memory than a record is worth).
@@ -86,13 +96,22 @@ class ModelOutput:
     substeps: int
 
 
-def run_model(config: SimulationConfig, *, loading: Loading | None = None) -> ModelOutput:
+def run_model(config: SimulationConfig, *, loading: Loading | None = None,
+              until: Mapping[str, int] | None = None) -> ModelOutput:
     """Integrate the test described by ``config`` (deterministic, no noise).
 
     With ``loading`` (a measured incident wave, :mod:`.loading`), the cell is driven by that wave
     on the loading's time grid instead of the configuration's trapezoid (striker velocity and rise
     time are then unused; sample rate, duration and pre-trigger come from the loading's grid).
+
+    ``until`` (gauge -> samples): only each named gauge's first samples are asked for (a likelihood's
+    spans). The cell is then integrated only as long as they need (:func:`cell_horizon`), and everything
+    after is NaN: each gauge's strain after its own count (a gauge not named: all of it), the cell's series
+    after the horizon. The samples asked for are those of the whole run, to the bit (the model is causal).
+    Not with dispersive bars, whose Fourier transfer reads the whole series.
     """
+    if until is not None and config.dispersion:
+        raise ValueError("a dispersive simulation runs over the whole record (until must be None)")
     app = config.apparatus
     ib, iob, eob, tube, sample = app.input_bar, app.internal_output_bar, app.external_output_bar, app.tube, app.sample
     plug = app.plug
@@ -167,9 +186,10 @@ def run_model(config: SimulationConfig, *, loading: Loading | None = None) -> Mo
     rec_s = np.zeros((n_out, cell.N_REC))
     legs = (ib, iob, eob)
     block = min(int(2.0 * bar.length / bar.wave_speed / dt) for bar in legs)
+    n_cell = n if until is None else min(n, n_sub * cell_horizon(until, apparatus=app, dt=dt_out))
     k0 = 0
-    while k0 < n:
-        k1 = min(n, k0 + block)
+    while k0 < n_cell:
+        k1 = min(n_cell, k0 + block)
         if k0 > 0:  # waves back from the free far ends, from what left the cell before k0
             for j, bar in enumerate(legs):
                 back = bars.returning_wave(eps_out[j], dt=dt, bar=bar, dispersive=disp)
@@ -190,6 +210,12 @@ def run_model(config: SimulationConfig, *, loading: Loading | None = None) -> Mo
         hoop = hoop_strain(rec_p, rec_u, tube=tube, sample_length=sample.length, beta=config.hoop_beta,
                            tube_force=tube_force if config.hoop_axial_term else None)
         strains["tube_hoop"] = -hoop  # compression positive inside the package
+    if until is not None:
+        m = n_cell // n_sub
+        for c, x in strains.items():
+            x[min(until.get(c, 0), n_out):] = np.nan
+        for x in (*forces, rec_p, rec_u, rec_ff, rec_s):
+            x[m * (n_sub if x.shape[0] == n else 1):] = np.nan
     t_c = ib.gauge_distance / ib.wave_speed
     tr = config.rise_time
     plateau = (t_c + tr + 0.75 * (pulse - tr), t_c + pulse)
