@@ -232,8 +232,8 @@ class WholeRecordLikelihood:
     def unit_strains(self, values: Mapping[str, float], *, spans_only: bool = False) -> dict[str, np.ndarray]:
         """Predicted strains with the hoop gauge's factor at its known median (1 unless a prior file says otherwise):
         what the likelihood conditions on (the gauges' calibration errors are its nuisances). ``spans_only``: each
-        gauge's series over its span only (the simulation stops where they need it; NaN after them, the same bits on
-        them)."""
+        gauge's series up to its span's end only (the simulation stops where they need it; NaN a few samples after
+        them, the same bits up to them)."""
         until = {c: b[3] for c, b in self.bounds.items()} if spans_only else None
         return self.model.predict(dict(values) | {"hoop_gain": self.hoop_median}, until=until).strains
 

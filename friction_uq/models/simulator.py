@@ -122,15 +122,16 @@ class SimulatorModel:
         """Gauge strains over the whole record for one set of parameter values.
 
         ``until`` (gauge -> samples): only each named gauge's first samples are asked for (a likelihood's spans);
-        the simulation stops where they need it and the rest is NaN (:func:`~friction_uq.simulate.model_1d.run_model`;
-        the samples asked for are the whole run's to the bit). A dispersive configuration runs over the whole
-        record."""
+        the simulation stops where they need it, a few samples' margin later, and the rest of every series, the
+        forces and the sliding velocity too, is NaN (:func:`~friction_uq.simulate.model_1d.run_model`; the samples
+        asked for are the whole run's to the bit). A dispersive configuration runs over the whole record."""
         cfg, readings = self.config(values)
         loading = self.dispersive_loading if cfg.dispersion and self.dispersive_loading is not None else self.loading
         dt = loading.sample_interval
-        # a channel read early (a negative delay) shows at t what its gauge saw at t + |delay|
+        # a channel read early (a negative delay) shows at t what its gauge saw at t + |delay| (at most the record)
+        span = len(loading.time) * dt
         asked = None if until is None or cfg.dispersion else \
-            {c: k + math.ceil(max(0.0, -readings[c].delay) / dt) + 2 for c, k in until.items()}
+            {c: k + math.ceil(min(max(0.0, -readings[c].delay), span) / dt) + 2 for c, k in until.items()}
         out = run_model(cfg, loading=true_incident(loading, readings["input_bar"]), until=asked)
         t = loading.time
         strains = {k: v if readings[k].exact else readings[k].applied(t, v) for k, v in out.strains.items()}
