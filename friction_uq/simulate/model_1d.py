@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import ConfigError
 from ..physics.tube import bore_compliance_factor
 from ..plausible import MAX_SIMULATION_STEPS
+from ..record import Apparatus
 from . import bars, cell
 from .config import SimulationConfig
 from .friction import LAWS
@@ -40,13 +41,26 @@ from .hoop import hoop_strain
 from .loading import Loading
 
 
-def cell_horizon(until: Mapping[str, int], *, apparatus, dt: float) -> int:
+def cell_horizon(until: Mapping[str, int], *, apparatus: Apparatus, dt: float) -> int:
     """Record samples of the cell's history that gauges asked for their first ``until[gauge]`` samples read:
     a bar's gauge reads what left the cell d / c earlier (the input bar's: its reflected wave), the hoop gauge
     the cell at once; two samples more for the interpolation between samples."""
     lag = {"input_bar": apparatus.input_bar.gauge_delay, "internal_output_bar": apparatus.internal_output_bar.gauge_delay,
            "external_output_bar": apparatus.external_output_bar.gauge_delay, "tube_hoop": 0.0}
     return max((k - math.floor(lag[c] / dt) for c, k in until.items()), default=0) + 2
+
+
+def _unread_to_nan(until: Mapping[str, int], strains: dict[str, np.ndarray], *, fine: list[np.ndarray],
+                   recorded: tuple[np.ndarray, ...], steps: int, n_sub: int) -> None:
+    """NaN where a run stopped at ``steps`` time steps was not asked to be right: each gauge's strain after its own
+    ``until`` (a gauge not named: all of it), the per-step series after ``steps``, the recorded ones after
+    ``steps / n_sub`` samples."""
+    for c, x in strains.items():
+        x[until.get(c, 0):] = np.nan
+    for x in fine:
+        x[steps:] = np.nan
+    for x in recorded:
+        x[steps // n_sub:] = np.nan
 
 
 #: Most time steps of the cell per record sample (a stiffer column would need more memory than a record is worth).
@@ -211,11 +225,7 @@ def run_model(config: SimulationConfig, *, loading: Loading | None = None,
                            tube_force=tube_force if config.hoop_axial_term else None)
         strains["tube_hoop"] = -hoop  # compression positive inside the package
     if until is not None:
-        m = n_cell // n_sub
-        for c, x in strains.items():
-            x[min(until.get(c, 0), n_out):] = np.nan
-        for x in (*forces, rec_p, rec_u, rec_ff, rec_s):
-            x[m * (n_sub if x.shape[0] == n else 1):] = np.nan
+        _unread_to_nan(until, strains, fine=forces, recorded=(rec_p, rec_u, rec_ff, rec_s), steps=n_cell, n_sub=n_sub)
     t_c = ib.gauge_distance / ib.wave_speed
     tr = config.rise_time
     plateau = (t_c + tr + 0.75 * (pulse - tr), t_c + pulse)
